@@ -1,0 +1,245 @@
+"""The hand-off between a stiffness source and the reduced model: a `StiffnessCurve`.
+
+A stiffness curve is plain data: the cup spring force F0 (Sec. 3, eq. 7) sampled over the
+top-plate displacement u = h1 - h, optionally with what a finite-element model knows better
+than the rigid-cone laws -- the inner contact radius r_c(h) (cf. eq. 3), the contact-strip
+width l(h) (cf. eq. 5) and the enclosed cavity volume V(h) (cf. eq. 4) -- and its provenance.
+
+It can come from an FEM run, a measured CSV or the Appendix A formula; the reduced model does
+not know which. Arrays are SI inside; the CSV names every unit in its column names::
+
+    # provenance: {"source": "fem", ...}
+    u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3
+    0.0,12.0,0.0,...
+
+Interpolation is monotone piecewise-cubic (PCHIP): it never overshoots between samples, so
+a monotone measured curve stays monotone. Evaluating outside the sampled range is an error,
+not an extrapolation.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+
+__all__ = ["StiffnessCurve", "CSV_COLUMNS"]
+
+#: CSV column name -> (dataclass field, factor from the CSV unit to SI)
+CSV_COLUMNS: dict[str, tuple[str, float]] = {
+    "u_mm": ("u_m", 1e-3),
+    "h_mm": ("h_m", 1e-3),
+    "F0_N": ("F0_N", 1.0),
+    "r_c_mm": ("r_c_m", 1e-3),
+    "l_mm": ("l_m", 1e-3),
+    "V_mm3": ("V_m3", 1e-9),
+}
+_OPTIONAL = ("r_c_m", "l_m", "V_m3")
+_PROVENANCE_TAG = "# provenance:"
+
+
+@dataclass(frozen=True)
+class StiffnessCurve:
+    """Cup spring force F0 over the plate displacement u, with optional geometry (SI units).
+
+    Parameters
+    ----------
+    u_m : strictly increasing plate displacements u = h1 - h [m].
+    F0_N : stiffness force F0(u) [N] (eq. 7), measured with p_b = p_a.
+    h1_m : undeformed cup height h1 [m], so that h = h1 - u.
+    r_c_m, l_m, V_m3 : optional inner contact radius [m], contact-strip width [m] and
+        enclosed cavity volume [m^3] at the same samples.
+    provenance : free-form description of where the data come from (source, parameters).
+    """
+
+    u_m: np.ndarray
+    F0_N: np.ndarray
+    h1_m: float
+    r_c_m: np.ndarray | None = None
+    l_m: np.ndarray | None = None
+    V_m3: np.ndarray | None = None
+    provenance: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        u = _frozen_array(self.u_m, "u_m")
+        if u.size < 2:
+            raise ValueError(f"u_m: a stiffness curve needs at least 2 samples, got {u.size}")
+        if np.any(np.diff(u) <= 0):
+            raise ValueError("u_m: displacements must be strictly increasing")
+        if not (np.isfinite(self.h1_m) and self.h1_m > 0):
+            raise ValueError(f"h1_m: undeformed cup height must be > 0 m, got {self.h1_m}")
+        object.__setattr__(self, "u_m", u)
+        object.__setattr__(self, "F0_N", _frozen_array(self.F0_N, "F0_N", u.size))
+        for name in _OPTIONAL:
+            value = getattr(self, name)
+            if value is not None:
+                arr = _frozen_array(value, name, u.size)
+                if np.any(arr < 0):
+                    raise ValueError(f"{name}: must be >= 0")
+                object.__setattr__(self, name, arr)
+        object.__setattr__(self, "provenance", dict(self.provenance))
+
+    # ------------------------------------------------------------------ views
+    @property
+    def h_m(self) -> np.ndarray:
+        """Cup height h = h1 - u at the samples [m]."""
+        return self.h1_m - self.u_m
+
+    @property
+    def u_range_m(self) -> tuple[float, float]:
+        return float(self.u_m[0]), float(self.u_m[-1])
+
+    @property
+    def h_range_m(self) -> tuple[float, float]:
+        """(smallest, largest) sampled cup height [m]."""
+        return float(self.h1_m - self.u_m[-1]), float(self.h1_m - self.u_m[0])
+
+    def has(self, name: str) -> bool:
+        """True if the optional column `name` ('r_c_m', 'l_m' or 'V_m3') is present."""
+        return getattr(self, name) is not None
+
+    # --------------------------------------------------------- interpolation
+    def force(self, h_m: float | np.ndarray) -> np.ndarray:
+        """Stiffness force F0(h) [N] by monotone (PCHIP) interpolation."""
+        return self._interpolant("F0_N")(self._u_of(h_m))
+
+    def force_slope(self, h_m: float | np.ndarray) -> np.ndarray:
+        """dF0/du = -dF0/dh [N/m] of the interpolant."""
+        return self._interpolant("F0_N").derivative()(self._u_of(h_m))
+
+    def contact_radius(self, h_m: float | np.ndarray) -> np.ndarray:
+        """Inner contact radius r_c(h) [m]."""
+        return self._interpolant("r_c_m")(self._u_of(h_m))
+
+    def contact_width(self, h_m: float | np.ndarray) -> np.ndarray:
+        """Contact-strip width l(h) [m]."""
+        return self._interpolant("l_m")(self._u_of(h_m))
+
+    def volume(self, h_m: float | np.ndarray) -> np.ndarray:
+        """Enclosed cavity volume V(h) [m^3]."""
+        return self._interpolant("V_m3")(self._u_of(h_m))
+
+    def scaled(self, kappa: float) -> StiffnessCurve:
+        """The curve with F0 replaced by kappa*F0 (the paper's stiffness factor, Fig. 1stiffnessFactor)."""
+        if not (np.isfinite(kappa) and kappa > 0):
+            raise ValueError(f"kappa: stiffness scale factor must be > 0, got {kappa}")
+        prov = dict(self.provenance, scaled_by=float(kappa))
+        return StiffnessCurve(self.u_m, kappa * self.F0_N, self.h1_m, self.r_c_m, self.l_m,
+                              self.V_m3, prov)
+
+    def _u_of(self, h_m: float | np.ndarray) -> np.ndarray:
+        u = self.h1_m - np.asarray(h_m, dtype=float)
+        lo, hi = self.u_range_m
+        tol = 1e-12 * max(1.0, hi - lo)
+        outside = ~((u >= lo - tol) & (u <= hi + tol))  # also True for NaN
+        if np.any(outside):
+            bad = float(np.atleast_1d(u)[np.atleast_1d(outside)][0])
+            raise ValueError(
+                f"h_mm: {1e3 * (self.h1_m - bad):.6g} mm is outside the stiffness curve's "
+                f"range [{1e3 * (self.h1_m - hi):.6g}, {1e3 * (self.h1_m - lo):.6g}] mm")
+        return np.clip(u, lo, hi)
+
+    def _interpolant(self, name: str) -> PchipInterpolator:
+        interps = self._interpolants
+        if name not in interps:
+            raise ValueError(f"{name}: this stiffness curve has no such column "
+                             f"(provenance: {self.provenance.get('source', 'unknown')})")
+        return interps[name]
+
+    @cached_property
+    def _interpolants(self) -> dict[str, PchipInterpolator]:
+        names = ("F0_N",) + tuple(n for n in _OPTIONAL if self.has(n))
+        return {n: PchipInterpolator(self.u_m, getattr(self, n), extrapolate=False) for n in names}
+
+    # --------------------------------------------------------------------- IO
+    def to_csv(self, path: str | os.PathLike) -> Path:
+        """Write the curve (units in the column names, provenance as a JSON comment line).
+
+        The file appears atomically: it is written to a temporary file and renamed.
+        """
+        cols = {"u_mm": self.u_m * 1e3, "h_mm": self.h_m * 1e3, "F0_N": self.F0_N}
+        for csv_name, (name, factor) in CSV_COLUMNS.items():
+            if name in _OPTIONAL and self.has(name):
+                cols[csv_name] = getattr(self, name) / factor
+        table = np.column_stack(list(cols.values()))
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write(f"{_PROVENANCE_TAG} {json.dumps(self.provenance, sort_keys=True, default=str)}\n")
+                f.write(",".join(cols) + "\n")
+                np.savetxt(f, table, delimiter=",", fmt="%.10g")
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        return path
+
+    @classmethod
+    def from_csv(cls, path: str | os.PathLike, h1_m: float | None = None) -> StiffnessCurve:
+        """Read a curve written by `to_csv`, or a measured one with at least `u_mm,F0_N`.
+
+        h1 is taken from the `h_mm` column (h1 = u + h) when present; otherwise `h1_m` must
+        be given (the undeformed height of the cup the curve was measured on).
+        """
+        path = Path(path)
+        if not path.is_file():
+            raise ValueError(f"stiffness: no such file '{path}'")
+        provenance: dict[str, Any] = {}
+        with open(path) as f:
+            lines = f.read().splitlines()
+        body = []
+        for line in lines:
+            if line.startswith(_PROVENANCE_TAG):
+                provenance = json.loads(line[len(_PROVENANCE_TAG):])
+            elif line.strip() and not line.startswith("#"):
+                body.append(line)
+        if not body:
+            raise ValueError(f"stiffness: '{path}' has no header line")
+        header = [c.strip() for c in body[0].split(",")]
+        unknown = [c for c in header if c not in CSV_COLUMNS]
+        if unknown:
+            raise ValueError(f"stiffness: unknown column(s) {unknown} in '{path}'; "
+                             f"allowed: {', '.join(CSV_COLUMNS)}")
+        for required in ("u_mm", "F0_N"):
+            if required not in header:
+                raise ValueError(f"stiffness: '{path}' lacks the required column '{required}'")
+        try:
+            data = np.loadtxt(body[1:], delimiter=",", ndmin=2)
+        except ValueError as exc:
+            raise ValueError(f"stiffness: '{path}' has a non-numeric entry ({exc})") from None
+        if data.shape[1] != len(header):
+            raise ValueError(f"stiffness: '{path}' rows have {data.shape[1]} fields, header {len(header)}")
+        si = {CSV_COLUMNS[c][0]: data[:, i] * CSV_COLUMNS[c][1] for i, c in enumerate(header)}
+        if "h_m" in si:
+            h1 = si["u_m"] + si.pop("h_m")
+            if np.ptp(h1) > 1e-6 * max(abs(h1.mean()), 1e-12) + 1e-9:
+                raise ValueError(f"stiffness: '{path}': u_mm + h_mm is not constant (h1 varies by "
+                                 f"{1e3 * np.ptp(h1):.3g} mm)")
+            h1_csv = float(h1.mean())
+            if h1_m is not None and abs(h1_m - h1_csv) > 1e-6:
+                raise ValueError(f"h1_mm: given {1e3 * h1_m:.6g} mm but '{path}' implies {1e3 * h1_csv:.6g} mm")
+            h1_m = h1_csv
+        if h1_m is None:
+            raise ValueError(f"h1_mm: '{path}' has no h_mm column; give the cup's undeformed height")
+        provenance.setdefault("source", f"csv:{path.name}")
+        return cls(h1_m=h1_m, provenance=provenance, **si)
+
+
+def _frozen_array(value: Any, name: str, size: int | None = None) -> np.ndarray:
+    arr = np.array(value, dtype=float).reshape(-1)
+    if size is not None and arr.size != size:
+        raise ValueError(f"{name}: expected {size} samples, got {arr.size}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name}: contains NaN or infinite values")
+    arr.flags.writeable = False
+    return arr

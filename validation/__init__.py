@@ -1,0 +1,1 @@
+"""Cross-checks, benchmarks, scenes, figures and the `cupcheck` command line (composes fem and reduced)."""

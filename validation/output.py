@@ -1,0 +1,81 @@
+"""Output that never leaves half-written results behind, and progress on a terminal."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+#: progress callback used by long computations: progress(fraction_done in [0, 1], message)
+Progress = Callable[[float, str], None]
+
+
+@contextmanager
+def atomic_directory(out: str | os.PathLike) -> Iterator[Path]:
+    """Yield a fresh temporary directory next to `out`; on success its files move into `out`.
+
+    On any exception nothing is written to `out` and the temporary directory is removed, so a
+    failed or interrupted run leaves no half-written output.
+    """
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp"))
+    try:
+        yield tmp
+        out.mkdir(parents=True, exist_ok=True)
+        for item in sorted(tmp.rglob("*")):
+            target = out / item.relative_to(tmp)
+            if item.is_dir():
+                target.mkdir(parents=True, exist_ok=True)
+            else:
+                os.replace(item, target)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+@contextmanager
+def atomic_file(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary path next to `path`; on success it is renamed to `path`."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    finally:
+        Path(tmp).unlink(missing_ok=True)
+
+
+def terminal_progress(label: str, stream=None, min_interval_s: float = 0.2) -> Progress:
+    """A `Progress` callback that redraws one status line on a terminal (stderr by default).
+
+    When the stream is not a terminal (CI, pipes) it prints a plain line at most every ~10 %.
+    """
+    stream = stream or sys.stderr
+    tty = stream.isatty()
+    state = {"t": 0.0, "decile": -1}
+
+    def report(fraction: float, message: str) -> None:
+        now = time.monotonic()
+        fraction = min(max(fraction, 0.0), 1.0)
+        if tty:
+            if now - state["t"] < min_interval_s and fraction < 1.0:
+                return
+            state["t"] = now
+            end = "\n" if fraction >= 1.0 else ""
+            stream.write(f"\r{label}: {100 * fraction:5.1f}% {message}\033[K{end}")
+        else:
+            decile = int(10 * fraction)
+            if decile == state["decile"]:
+                return
+            state["decile"] = decile
+            stream.write(f"{label}: {100 * fraction:5.1f}% {message}\n")
+        stream.flush()
+
+    return report
