@@ -15,7 +15,8 @@ Choices where the literature leaves room (stated here once):
   ``-dA`` that appears at magnification zeta has separation ``u1(zeta)`` (see `persson`) spread by
   the roughness not yet resolved, a Gaussian of variance ``h^2(zeta) = 2 pi int_{zeta q0}^{q1} q C dq``
   reflected at u = 0 (the mirror term keeps u >= 0). The zeta integral is a midpoint rule in A
-  (``n_zeta`` cells of equal area), the Gaussian average is Gauss-Hermite (``n_herm`` nodes).
+  (``n_zeta`` cells, graded); the Gaussians are binned exactly on a log grid in u, on which
+  the Bruggeman integrand, smooth in ln u, is summed (`gap_distribution`).
 * Bruggeman's rule in the form with a threshold: ``int P(u) (sigma(u) - sigma_eff)/(sigma(u) +
   kappa sigma_eff) du = 0`` with ``kappa = a_c/(1 - a_c)``. For ``kappa = 1`` (a_c = 1/2) this is the
   classic 2D Bruggeman equation of Lorenz & Persson; choosing kappa from the same threshold a_c
@@ -27,35 +28,44 @@ Choices where the literature leaves room (stated here once):
 from __future__ import annotations
 
 import numpy as np
-from numpy.polynomial.hermite_e import hermegauss
-from scipy.special import erfinv
+from scipy.special import erf, erfinv
 
-from .persson import Moments, contact_area_ratio, noncontact_separation
+from .persson import Moments, contact_area_ratio, mean_separation
 
 
-def gap_distribution(mom: Moments, pstar: float, gamma: float = 0.45, n_zeta: int = 24,
-                     n_herm: int = 16) -> tuple[np.ndarray, np.ndarray, float]:
-    """Discrete P(u) of the open area: (u nodes [m], weights, contact fraction A1/A0).
+def gap_distribution(mom: Moments, pstar: np.ndarray, gamma: float = 0.45, n_zeta: int = 16,
+                     n_u: int = 120, u_span: float = 1e-6) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Binned P(u) of the open area: (u [m] per bin, weight per bin, A1/A0), one row per pressure.
 
-    The weights sum to ``1 - A1/A0``; nodes/weights have shape (n_zeta * n_herm,).
+    The ``n_zeta`` cells split [A1, 1] (graded towards both ends, where u1 varies fastest: cell
+    edges at ``A = 1 - (1 - A1)(1 - cos(pi theta))/2``, theta uniform); cell j contributes a reflected
+    Gaussian (centre u1 at the cell's midpoint, variance h^2 there). Its mass is binned exactly
+    (folded-normal CDF) into ``n_u`` log-spaced bins spanning ``u_span`` to 1 times the largest
+    ``u1 + 8h``; the mass below goes into the first bin. Row weights sum to ``1 - A1/A0``.
+    ``u1`` at a cell midpoint uses the cell's edges for ``du/dA`` (same formula as `persson`).
     """
-    u, w, A1 = _gap_nodes(mom, np.atleast_1d(float(pstar)), gamma, n_zeta, n_herm)
-    return u[0].ravel(), w[0].ravel(), float(A1[0])
-
-
-def _gap_nodes(mom: Moments, pstar: np.ndarray, gamma: float, n_zeta: int, n_herm: int):
-    A1 = contact_area_ratio(mom.m[-1], pstar)                          # (Np,)
-    frac = (np.arange(n_zeta) + 0.5) / n_zeta
-    A_mid = 1.0 - frac[None, :] * (1.0 - A1[:, None])                  # (Np, Nz) cell centres
-    m = (pstar[:, None] / erfinv(A_mid)) ** 2 / np.pi                  # A(zeta) = A_mid
+    pstar = np.atleast_1d(np.asarray(pstar, float))
+    A1 = contact_area_ratio(mom.m[-1], pstar)                               # (Np,)
+    theta = np.linspace(0.0, 1.0, 2 * n_zeta + 1)                           # edges and midpoints
+    frac = 0.5 * (1.0 - np.cos(np.pi * theta))                              # graded at both ends
+    A = 1.0 - frac[None, :] * (1.0 - A1[:, None])                           # (Np, 2Nz+1)
+    with np.errstate(divide="ignore"):
+        m = (pstar[:, None] / erfinv(A)) ** 2 / np.pi                       # A(zeta) = A
     lnq = mom.lnq_at_m(np.minimum(m, mom.m[-1]))
-    u1 = noncontact_separation(mom, pstar[:, None], lnq, gamma)
-    h = np.sqrt(np.interp(lnq, np.log(mom.q), mom.tail_ms))
-    xi, om = hermegauss(n_herm)
-    om = om / om.sum()
-    u = np.abs(u1[..., None] + h[..., None] * xi)                      # (Np, Nz, Nh)
-    w = ((1.0 - A1) / n_zeta)[:, None, None] * om[None, None, :] * np.ones_like(u)
-    return u, w, A1
+    u = mean_separation(mom, pstar[:, None] / A, lnq, gamma)
+    Am, um, lnqm = A[:, 1::2], u[:, 1::2], lnq[:, 1::2]
+    u1 = um + Am * (u[:, 2::2] - u[:, 0:-1:2]) / (A[:, 2::2] - A[:, 0:-1:2])
+    h = np.sqrt(np.interp(lnqm, np.log(mom.q), mom.tail_ms))
+    top = np.max(u1 + 8 * h, axis=1)                                       # (Np,)
+    edges = top[:, None] * np.geomspace(u_span, 1.0, n_u + 1)[None, :]     # (Np, Nu+1)
+    z = np.sqrt(2.0) * np.maximum(h, 1e-300)[:, :, None]
+    cdf = 0.5 * (erf((edges[:, None, :] - u1[..., None]) / z)
+                 + erf((edges[:, None, :] + u1[..., None]) / z))            # (Np, Nz, Nu+1)
+    dA = (1.0 - A1)[:, None] * np.diff(frac[::2])[None, :]                 # (Np, Nz)
+    mass = np.einsum("pz,pzu->pu", dA, np.diff(cdf, axis=2))                # (Np, Nu)
+    mass[:, 0] += np.sum(dA * cdf[:, :, 0], axis=1)
+    centres = np.sqrt(edges[:, 1:] * edges[:, :-1])
+    return centres, mass, A1
 
 
 def bruggeman_conductance(u3: np.ndarray, w: np.ndarray, A1: np.ndarray, a_c: float,
@@ -78,7 +88,7 @@ def bruggeman_conductance(u3: np.ndarray, w: np.ndarray, A1: np.ndarray, a_c: fl
 
 
 def effective_medium_gap(mom: Moments, pstar: np.ndarray, gamma: float = 0.45, a_c: float = 0.42,
-                         n_zeta: int = 24, n_herm: int = 16, chunk: int = 50,
+                         n_zeta: int = 16, n_u: int = 120, chunk: int = 40,
                          progress=None) -> tuple[np.ndarray, np.ndarray]:
     """(u_c [m], sealed): the EMT leak rate expressed as the equivalent critical-junction gap."""
     pstar = np.atleast_1d(np.asarray(pstar, float))
@@ -88,9 +98,8 @@ def effective_medium_gap(mom: Moments, pstar: np.ndarray, gamma: float = 0.45, a
     idx = np.flatnonzero(~sealed)
     for k in range(0, idx.size, chunk):
         sel = idx[k:k + chunk]
-        u, w, a1 = _gap_nodes(mom, pstar[sel], gamma, n_zeta, n_herm)
-        n = u.shape[0]
-        u_c[sel] = np.cbrt(bruggeman_conductance(u.reshape(n, -1) ** 3, w.reshape(n, -1), a1, a_c))
+        u, w, a1 = gap_distribution(mom, pstar[sel], gamma, n_zeta, n_u)
+        u_c[sel] = np.cbrt(bruggeman_conductance(u ** 3, w, a1, a_c))
         if progress is not None:
             progress(min(1.0, (k + sel.size) / max(idx.size, 1)), "effective-medium u_c")
     return u_c, sealed

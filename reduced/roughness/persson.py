@@ -12,7 +12,8 @@ Notation (Persson convention, see `reduced.roughness.spectrum`): ``E* = E/(1 - n
   integral is a universal function ``F(x0) = int_{x0}^inf dx/x [gamma + 3(1-gamma) erf(x)^2] e^(-x^2)``
   (tabulated once: ``gamma E1(x0^2)/2`` plus a tabulated erf^2 part). With ``s = sqrt(m)`` the outer
   integral becomes ``u = 2 int F(p*/(sqrt(pi) s)) / q ds``, which has no endpoint singularity
-  (``w`` diverges at q0 like ``(q - q0)^(-1/2)``); trapezoid rule in s.
+  (``w`` diverges at q0 like ``(q - q0)^(-1/2)``). Product integration in s: F is integrated
+  exactly over each cell through its antiderivative, 1/q by the trapezoid rule.
 * Small-pressure asymptote: ``-du/dln p -> sqrt(pi) gamma int q^2 C w dq = 2 gamma int ds/q``.
 * Critical junction (Lorenz & Persson, Eur. Phys. J. E 31, 159 (2010); percolation threshold
   ``a_c = 0.42`` from Dapp et al., PRL 108, 244301 (2012)): ``zeta_c`` solves ``A(zeta_c)/A0 = a_c``
@@ -22,13 +23,14 @@ Notation (Persson convention, see `reduced.roughness.spectrum`): ``E* = E/(1 - n
   ``zeta q0`` and ``q1`` under the pressure ``p(zeta) = p A0/A(zeta)``. (Derivation: the gap volume
   ``u(zeta) A(zeta)`` of the apparent contact at zeta equals that at zeta + dzeta plus the newly
   resolved non-contact area ``-dA`` at separation u1.) Derivatives are central differences in
-  ln zeta, with the step ``delta`` a few grid cells wide.
+  ln zeta (step ``delta = 0.01``).
 * If ``A/A0 >= a_c`` at full magnification the contact percolates: the interface is sealed and
   ``u_c = 0`` (reported, never NaN).
 
 Numerics: the input spectrum is integrated on its own grid (cumulative trapezoid in ln q); the
-Persson integrals then run on a log-spaced working grid of ``n_q`` nodes between q0 and q1 holding
-the exact cumulative moments (``n_q = 400`` is converged to < 0.1 %, see tests/test_rough_persson.py).
+cumulative moments are kept on a log-spaced working grid of ``n_q`` nodes, and each mean-separation
+integral runs on its own ``n_sub`` log-spaced nodes from its lower limit to q1 (defaults converged
+to ~0.1 %, see tests/test_rough_persson.py).
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.special import erf, erfinv, exp1
+from scipy.special import erf, erfc, erfinv, exp1
 
 from .spectrum import PowerSpectrum, cumulative_trapezoid
 
@@ -67,6 +69,15 @@ def _erf2_tail() -> np.ndarray:
     return head[-1] - head
 
 
+@lru_cache(maxsize=1)
+def _erf2_tail_sq() -> np.ndarray:
+    """K(x0) = int_{x0}^inf erf(x)^2 e^(-x^2) dx/x^2 on _LNX (integrand ~ 4x/pi near 0)."""
+    x = np.exp(_LNX)
+    g = erf(x) ** 2 * np.exp(-x ** 2) / x
+    head = cumulative_trapezoid(g, _LNX)
+    return head[-1] - head
+
+
 @lru_cache(maxsize=8)
 def _F_table(gamma: float) -> np.ndarray:
     x = np.exp(_LNX)
@@ -78,6 +89,23 @@ def separation_kernel(x0: np.ndarray, gamma: float) -> np.ndarray:
     with np.errstate(divide="ignore"):
         lnx = np.log(x0)
     return np.interp(lnx, _LNX, _F_table(float(gamma)), right=0.0)
+
+
+def _kernel_antiderivative(s: np.ndarray, c: np.ndarray, gamma: float) -> np.ndarray:
+    """I(s) = int_0^s F(c/t) dt = s F(c/s) - c Psi(c/s)  (integration by parts, F' known).
+
+    ``Psi(x0) = int_{x0}^inf [gamma + 3(1-gamma) erf^2] e^(-x^2) dx/x^2
+    = gamma (e^(-x0^2)/x0 - sqrt(pi) erfc(x0)) + 3(1-gamma) K(x0)``. Used as a product-integration
+    rule: F(c/s) switches on within s ~ c, far inside the first grid cell at small pressure, which
+    a trapezoid rule in s would resolve badly. ``I(0) = 0``.
+    """
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        x = c / s
+        lnx = np.log(x)
+        K = np.interp(lnx, _LNX, _erf2_tail_sq(), right=0.0)
+        gauss = gamma * (s * np.exp(-x * x) - c * np.sqrt(np.pi) * erfc(x))
+        out = s * separation_kernel(x, gamma) - gauss - 3.0 * (1.0 - gamma) * c * K
+    return np.where(s > 0, out, 0.0)
 
 
 # --------------------------------------------------------------------------------------------
@@ -97,11 +125,11 @@ class Moments:
     tail_ms: np.ndarray
 
     @classmethod
-    def of(cls, spectrum: PowerSpectrum, n_q: int = 400) -> "Moments":
+    def of(cls, spectrum: PowerSpectrum, n_q: int | None = None) -> "Moments":
         qf = spectrum.q_per_m
         mf = spectrum.moment(2) / (2 * np.pi)
         msf = spectrum.moment(0)
-        if n_q >= qf.size:
+        if n_q is None or n_q >= qf.size:
             q, m, ms = qf, mf, msf
         else:
             q = np.geomspace(qf[0], qf[-1], n_q)
@@ -124,24 +152,28 @@ def contact_area_ratio(m: np.ndarray, pstar: np.ndarray) -> np.ndarray:
         return erf(pstar / np.sqrt(np.pi * np.maximum(m, 0.0)))
 
 
-def mean_separation(mom: Moments, pstar: np.ndarray, m_lo: np.ndarray | float = 0.0,
-                    gamma: float = 0.45, chunk: int = 4096) -> np.ndarray:
-    """Mean separation [m] of the roughness above the lower limit m_lo under pressure p* (module doc).
+def mean_separation(mom: Moments, pstar: np.ndarray, lnq_lo: np.ndarray | float | None = None,
+                    gamma: float = 0.45, n_sub: int = 192, chunk: int = 2048) -> np.ndarray:
+    """Mean separation [m] of the roughness between exp(lnq_lo) and q1 under pressure p* (module doc).
 
-    `pstar` and `m_lo` broadcast to one shape; ``m_lo = 0`` is the full surface (Yang & Persson 2008).
-    The result for p* = 0 is +inf (the surfaces separate).
+    `pstar` and `lnq_lo` broadcast to one shape; ``lnq_lo = ln q0`` (default) is the full surface
+    (Yang & Persson 2008). Each evaluation runs on its own `n_sub` log-spaced nodes from
+    exp(lnq_lo) to q1 (m interpolated from the working grid), so u(zeta) is smooth in zeta.
     """
-    pstar, m_lo = np.broadcast_arrays(np.asarray(pstar, float), np.asarray(m_lo, float))
+    lnq0, lnq1 = np.log(mom.q[0]), np.log(mom.q[-1])
+    lnq_lo = lnq0 if lnq_lo is None else lnq_lo
+    pstar, lnq_lo = np.broadcast_arrays(np.asarray(pstar, float), np.asarray(lnq_lo, float))
     shape = pstar.shape
-    pstar, m_lo = pstar.ravel(), m_lo.ravel()
+    pstar, lnq_lo = pstar.ravel(), np.clip(lnq_lo.ravel(), lnq0, lnq1)
+    t = np.linspace(0.0, 1.0, n_sub)
     out = np.empty(pstar.size)
     for a in range(0, pstar.size, chunk):
         b = min(a + chunk, pstar.size)
-        s = np.sqrt(np.maximum(mom.m[None, :] - m_lo[a:b, None], 0.0))
-        with np.errstate(divide="ignore"):
-            x = pstar[a:b, None] / (np.sqrt(np.pi) * s)
-        f = separation_kernel(x, gamma) / mom.q[None, :]
-        out[a:b] = np.sum((f[:, 1:] + f[:, :-1]) * np.diff(s, axis=1), axis=1)   # 2 * trapezoid/2
+        lnq = lnq_lo[a:b, None] + (lnq1 - lnq_lo[a:b, None]) * t[None, :]
+        s = np.sqrt(np.maximum(mom.m_at(lnq) - mom.m_at(lnq_lo[a:b, None]), 0.0))
+        dI = np.diff(_kernel_antiderivative(s, pstar[a:b, None] / np.sqrt(np.pi), gamma), axis=1)
+        inv_q = np.exp(-lnq)
+        out[a:b] = 2.0 * np.sum(dI * 0.5 * (inv_q[:, 1:] + inv_q[:, :-1]), axis=1)
     return out.reshape(shape)
 
 
@@ -159,15 +191,12 @@ def noncontact_separation(mom: Moments, pstar: np.ndarray, lnq: np.ndarray,
     ``u1 = u(zeta) + A(zeta) du/dA`` with central differences of width 2 delta in ln zeta (module doc).
     """
     lnq0, lnq1 = np.log(mom.q[0]), np.log(mom.q[-1])
-    if delta is None:
-        delta = max(0.02, 2.0 * (lnq1 - lnq0) / (mom.q.size - 1))
-    delta = min(delta, (lnq1 - lnq0) / 4)
+    delta = min(0.01 if delta is None else delta, (lnq1 - lnq0) / 4)
     pstar, lnq = np.broadcast_arrays(np.asarray(pstar, float), np.asarray(lnq, float))
     lo = np.clip(lnq - delta, lnq0, lnq1 - 2 * delta)
     pts = np.stack([lo, lnq, lo + 2 * delta])                 # (3, ...)
-    m = mom.m_at(pts)
-    A = contact_area_ratio(m, pstar[None])
-    u = mean_separation(mom, pstar[None] / np.maximum(A, 1e-300), m, gamma)
+    A = contact_area_ratio(mom.m_at(pts), pstar[None])
+    u = mean_separation(mom, pstar[None] / np.maximum(A, 1e-300), pts, gamma)
     dA = A[2] - A[0]
     safe = dA < 0
     slope = np.where(safe, (u[2] - u[0]) / np.where(safe, dA, -1.0), 0.0)
@@ -236,7 +265,7 @@ def _check_params(p_over_E: np.ndarray, method: str, gamma: float, a_c: float) -
 
 def critical_gap_table(spectrum: PowerSpectrum, E_Pa: float, nu: float, p_over_E,
                        *, method: str = "emt", gamma: float = 0.45, a_c: float = 0.42,
-                       n_q: int = 400, progress=None) -> GapTable:
+                       n_q: int | None = None, progress=None) -> GapTable:
     """u_c(p/E) of `spectrum` pressed by an elastic half-space (E_Pa, nu) against it.
 
     `method`: ``"emt"`` (default; the route the paper used, Sec. 5.1: Bruggeman effective-medium leak
@@ -253,7 +282,7 @@ def critical_gap_table(spectrum: PowerSpectrum, E_Pa: float, nu: float, p_over_E
         u_c, sealed = effective_medium_gap(mom, pstar, gamma, a_c, progress=progress)
     else:
         u_c, sealed = critical_junction_gap(mom, pstar, gamma, a_c)
-    u_mean = mean_separation(mom, pstar, 0.0, gamma)
+    u_mean = mean_separation(mom, pstar, None, gamma)
     area = contact_area_ratio(mom.m[-1], pstar)
     return GapTable(p_over_E, u_c, u_mean, area, sealed, float(E_Pa), float(nu), method,
                     float(gamma), float(a_c), spectrum.provenance)
