@@ -57,7 +57,9 @@ def effective_modulus(E_Pa: float, nu: float) -> float:
 # the universal inner integral F(x0)
 # --------------------------------------------------------------------------------------------
 
-_LNX = np.linspace(np.log(1e-15), np.log(6.5), 6000)   # F(6.5) ~ e^-42: zero beyond
+# F(6.5) ~ e^-42: zero beyond. Denser where F decays like e^(-x^2) (linear interpolation in ln x)
+_LNX = np.concatenate([np.linspace(np.log(1e-15), np.log(0.05), 1500, endpoint=False),
+                       np.linspace(np.log(0.05), np.log(6.5), 8000)])
 
 
 @lru_cache(maxsize=1)
