@@ -21,8 +21,9 @@ Choices where the literature leaves room (stated here once):
   kappa sigma_eff) du = 0`` with ``kappa = a_c/(1 - a_c)``. For ``kappa = 1`` (a_c = 1/2) this is the
   classic 2D Bruggeman equation of Lorenz & Persson; choosing kappa from the same threshold a_c
   (0.42, Dapp et al. 2012) as the critical-junction route makes both routes seal at exactly the same
-  pressure (the 2D Bruggeman threshold 1/2 would seal later). sigma_eff -> 0 continuously at the
-  threshold, whereas the critical-junction u_c jumps to 0 there.
+  pressure (the 2D Bruggeman threshold 1/2 would seal later). Near the threshold
+  sigma_eff ~ (1 - A1/a_c), so u_c ~ (distance)^(1/3); the critical-junction u_c also goes to 0
+  there, but much faster (u1(zeta_c) -> 0 as zeta_c -> zeta1).
 """
 
 from __future__ import annotations

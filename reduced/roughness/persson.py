@@ -223,7 +223,9 @@ def critical_junction_gap(mom: Moments, pstar: np.ndarray, gamma: float = 0.45,
     u_c = np.zeros(np.shape(pstar))
     open_ = ~sealed
     if np.any(open_):
-        u_c[open_] = noncontact_separation(mom, np.asarray(pstar)[open_], lnq_c[open_], gamma)
+        # u1 -> 0 as zeta_c -> zeta1 (no roughness left); clamp the round-off below 0 there
+        u_c[open_] = np.maximum(noncontact_separation(mom, np.asarray(pstar)[open_], lnq_c[open_],
+                                                      gamma), 0.0)
     return u_c, sealed
 
 
