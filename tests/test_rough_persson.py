@@ -151,3 +151,17 @@ def test_bad_parameters():
         critical_gap_table(spec, 4e6, 0.7, [0.01])
     with pytest.raises(ValueError, match="method"):
         critical_gap_table(spec, 4e6, 0.5, [0.01], method="magic")
+
+
+def test_bem_kernel_on_johnson_wavy_contact():
+    """The BEM behind the slow comparison, on Johnson's 1D wavy surface (Contact Mechanics, 13.2):
+    h = D cos(2 pi x/lam), full contact at p* = pi E* D/lam, contact fraction (2/pi) asin(sqrt(p/p*))."""
+    from reduced.roughness.bem import solve_contact
+    n, lam, D = 512, 1.0, 1e-3
+    x = (np.arange(n) + 0.5) / n * lam
+    h = np.repeat((D * np.cos(2 * np.pi * x / lam))[:, None], 4, axis=1)
+    p_full = np.pi * D / lam
+    for ratio in (0.25, 0.5):
+        state = solve_contact(h, lam, ratio * p_full, 1.0, tol=1e-10)
+        # one cell in 512 either side of the contact edge: 2/512 in the fraction
+        assert state.contact_area_ratio == pytest.approx(2 / np.pi * np.arcsin(np.sqrt(ratio)), abs=4 / n)
