@@ -57,57 +57,68 @@ def effective_modulus(E_Pa: float, nu: float) -> float:
 # the universal inner integral F(x0)
 # --------------------------------------------------------------------------------------------
 
-# F(6.5) ~ e^-42: zero beyond. Denser where F decays like e^(-x^2) (linear interpolation in ln x)
-_LNX = np.concatenate([np.linspace(np.log(1e-15), np.log(0.05), 1500, endpoint=False),
-                       np.linspace(np.log(0.05), np.log(6.5), 8000)])
+# Tables on one uniform grid in ln x (index arithmetic instead of a search). F(6.5) ~ e^-42.
+_LNX0, _LNX1, _NX = np.log(1e-15), np.log(6.5), 65536
+_LNX = np.linspace(_LNX0, _LNX1, _NX)
+_DLNX = _LNX[1] - _LNX[0]
+
+
+def _tail_integral(g: np.ndarray) -> np.ndarray:
+    """int_{x_i}^{x_end} g d(ln x) on _LNX, summed from the top (keeps tiny tails accurate)."""
+    seg = 0.5 * (g[1:] + g[:-1]) * _DLNX
+    out = np.zeros_like(g)
+    out[:-1] = np.cumsum(seg[::-1])[::-1]
+    return out
 
 
 @lru_cache(maxsize=1)
-def _erf2_tail() -> np.ndarray:
-    """J(x0) = int_{x0}^inf erf(x)^2 e^(-x^2) dx/x on _LNX (trapezoid in ln x, integrand smooth)."""
+def _erf2_tails() -> tuple[np.ndarray, np.ndarray]:
+    """J(x0) = int_{x0}^inf erf^2 e^(-x^2) dx/x and K(x0) = int_{x0}^inf erf^2 e^(-x^2) dx/x^2."""
     x = np.exp(_LNX)
     g = erf(x) ** 2 * np.exp(-x ** 2)
-    head = cumulative_trapezoid(g, _LNX)
-    return head[-1] - head
-
-
-@lru_cache(maxsize=1)
-def _erf2_tail_sq() -> np.ndarray:
-    """K(x0) = int_{x0}^inf erf(x)^2 e^(-x^2) dx/x^2 on _LNX (integrand ~ 4x/pi near 0)."""
-    x = np.exp(_LNX)
-    g = erf(x) ** 2 * np.exp(-x ** 2) / x
-    head = cumulative_trapezoid(g, _LNX)
-    return head[-1] - head
+    return _tail_integral(g), _tail_integral(g / x)
 
 
 @lru_cache(maxsize=8)
-def _F_table(gamma: float) -> np.ndarray:
+def _tables(gamma: float) -> tuple[np.ndarray, np.ndarray]:
+    """F(x) and ln Phi(x) on _LNX, with Phi(x) = (1/c) int_0^(c/x) F(c/t) dt (see below)."""
     x = np.exp(_LNX)
-    return gamma * 0.5 * exp1(x ** 2) + 3.0 * (1.0 - gamma) * _erf2_tail()
+    J, K = _erf2_tails()
+    F = gamma * 0.5 * exp1(x ** 2) + 3.0 * (1.0 - gamma) * J
+    # integration by parts, F'(x) = -[gamma + 3(1-gamma) erf^2] e^(-x^2)/x:
+    # Phi = F/x - Psi, Psi = int_x^inf [..] e^(-t^2) dt/t^2 = gamma (e^(-x^2)/x - sqrt(pi) erfc x) + 3(1-gamma) K
+    Phi = F / x - gamma * (np.exp(-x ** 2) / x - np.sqrt(np.pi) * erfc(x)) - 3.0 * (1.0 - gamma) * K
+    # Phi > 0; where round-off of the (tiny) large-x tail makes it <= 0 use 0 (ln -> -inf)
+    with np.errstate(divide="ignore"):
+        return F, np.log(np.where(Phi > 0, Phi, 0.0))
+
+
+def _lerp_uniform(lnx: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """Linear interpolation of `table` on _LNX; clamped to its first/last value outside."""
+    t = np.clip((lnx - _LNX0) / _DLNX, 0.0, _NX - 1.000001)
+    i = t.astype(np.intp)
+    f = t - i
+    return table[i] * (1.0 - f) + table[i + 1] * f
 
 
 def separation_kernel(x0: np.ndarray, gamma: float) -> np.ndarray:
     """F(x0) = int_{x0}^inf dx/x [gamma + 3(1-gamma) erf(x)^2] exp(-x^2); F(inf) = 0."""
     with np.errstate(divide="ignore"):
         lnx = np.log(x0)
-    return np.interp(lnx, _LNX, _F_table(float(gamma)), right=0.0)
+    F = _lerp_uniform(np.nan_to_num(lnx, nan=_LNX1, posinf=_LNX1), _tables(float(gamma))[0])
+    return np.where(lnx < _LNX1, F, 0.0)
 
 
 def _kernel_antiderivative(s: np.ndarray, c: np.ndarray, gamma: float) -> np.ndarray:
-    """I(s) = int_0^s F(c/t) dt = s F(c/s) - c Psi(c/s)  (integration by parts, F' known).
+    """I(s) = int_0^s F(c/t) dt = c Phi(c/s), Phi tabulated in ln-ln form; I(0) = 0.
 
-    ``Psi(x0) = int_{x0}^inf [gamma + 3(1-gamma) erf^2] e^(-x^2) dx/x^2
-    = gamma (e^(-x0^2)/x0 - sqrt(pi) erfc(x0)) + 3(1-gamma) K(x0)``. Used as a product-integration
-    rule: F(c/s) switches on within s ~ c, far inside the first grid cell at small pressure, which
-    a trapezoid rule in s would resolve badly. ``I(0) = 0``.
+    Used as a product-integration rule: F(c/s) switches on within s ~ c, far inside the first
+    grid cell at small pressure, which a trapezoid rule in s would resolve badly.
     """
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        x = c / s
-        lnx = np.log(x)
-        K = np.interp(lnx, _LNX, _erf2_tail_sq(), right=0.0)
-        gauss = gamma * (s * np.exp(-x * x) - c * np.sqrt(np.pi) * erfc(x))
-        out = s * separation_kernel(x, gamma) - gauss - 3.0 * (1.0 - gamma) * c * K
-    return np.where(s > 0, out, 0.0)
+    with np.errstate(divide="ignore"):
+        lnx = np.log(c) - np.log(s)                      # +inf where s = 0
+    ln_phi = _lerp_uniform(np.minimum(lnx, _LNX1), _tables(float(gamma))[1])
+    return np.where(lnx < _LNX1, c * np.exp(ln_phi), 0.0)
 
 
 # --------------------------------------------------------------------------------------------
@@ -116,7 +127,8 @@ def _kernel_antiderivative(s: np.ndarray, c: np.ndarray, gamma: float) -> np.nda
 
 @dataclass(frozen=True)
 class Moments:
-    """Cumulative moments of C on a log-spaced working grid (all SI).
+    """Cumulative moments of C on a working grid uniform in ln q (all SI; default 4096 nodes or
+    the input's size if larger; the input's own cumulative integrals are interpolated onto it).
 
     ``m[i] = int_{q0}^{q_i} q^3 C dq`` and ``tail_ms[i] = 2 pi int_{q_i}^{q1} q C dq`` (the
     mean-square height of the roughness not yet resolved at magnification q_i/q0).
@@ -131,16 +143,20 @@ class Moments:
         qf = spectrum.q_per_m
         mf = spectrum.moment(2) / (2 * np.pi)
         msf = spectrum.moment(0)
-        if n_q is None or n_q >= qf.size:
-            q, m, ms = qf, mf, msf
-        else:
-            q = np.geomspace(qf[0], qf[-1], n_q)
-            m = np.interp(np.log(q), np.log(qf), mf)
-            ms = np.interp(np.log(q), np.log(qf), msf)
+        n = max(4096, qf.size) if n_q is None else n_q
+        q = np.geomspace(qf[0], qf[-1], n)            # uniform in ln q: lookups by index
+        m = np.interp(np.log(q), np.log(qf), mf)
+        ms = np.interp(np.log(q), np.log(qf), msf)
         return cls(q, m, ms[-1] - ms)
 
     def m_at(self, lnq: np.ndarray) -> np.ndarray:
-        return np.interp(lnq, np.log(self.q), self.m)
+        """m at ln q (linear in ln q between the uniform working nodes; clamped to [q0, q1])."""
+        lnq0 = np.log(self.q[0])
+        step = (np.log(self.q[-1]) - lnq0) / (self.q.size - 1)
+        t = np.clip((np.asarray(lnq) - lnq0) / step, 0.0, self.q.size - 1.000001)
+        i = t.astype(np.intp)
+        f = t - i
+        return self.m[i] * (1.0 - f) + self.m[i + 1] * f
 
     def lnq_at_m(self, m: np.ndarray) -> np.ndarray:
         """Inverse of m(q) (m is non-decreasing; flat parts resolve to their lower end)."""
