@@ -57,3 +57,14 @@ def test_bad_input_exits_2_without_output(tmp_path, capsys, argv, field):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and field in err[0]
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_line_scan_input(tmp_path, capsys):
+    from test_rough_line_scan import synthetic_scan
+    x, z, *_ = synthetic_scan(h_rms=1.5e-6)
+    path = tmp_path / "scan.csv"
+    np.savetxt(path, np.c_[x * 1e6, z * 1e6], delimiter=",", header="x_um,z_um", comments="")
+    assert main(["uc", "--line-scan", str(path), "--E-MPa", "4", "--p-kPa", "0.3", "3",
+                 "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert rows[0]["u_c_m"] > rows[1]["u_c_m"] > 0

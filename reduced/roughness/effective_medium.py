@@ -72,7 +72,7 @@ def gap_distribution(mom: Moments, pstar: np.ndarray, gamma: float = 0.45, n_zet
 
 
 def bruggeman_conductance(u3: np.ndarray, w: np.ndarray, A1: np.ndarray, a_c: float,
-                          iterations: int = 100) -> np.ndarray:
+                          iterations: int = 64) -> np.ndarray:
     """S = 12 eta sigma_eff [m^3]: root of sum w (u^3 - S)/(u^3 + kappa S) = A1/kappa per row.
 
     Rows are pressures (u3, w have shape (Np, n)); bisection in ln S, vectorised; S = 0 where the
