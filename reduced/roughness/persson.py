@@ -10,10 +10,11 @@ Notation (Persson convention, see `reduced.roughness.spectrum`): ``E* = E/(1 - n
   (2008)): ``u = sqrt(pi) int dq q^2 C w int_p^inf dp'/p' [gamma + 3(1-gamma) P^2] exp(-(w p'/E*)^2)``
   with ``w = (pi m(q))^(-1/2)`` and ``P(q, p') = erf(w p'/E*)``. With ``x = w p'/E*`` the inner
   integral is a universal function ``F(x0) = int_{x0}^inf dx/x [gamma + 3(1-gamma) erf(x)^2] e^(-x^2)``
-  (tabulated once: ``gamma E1(x0^2)/2`` plus a tabulated erf^2 part). With ``s = sqrt(m)`` the outer
-  integral becomes ``u = 2 int F(p*/(sqrt(pi) s)) / q ds``, which has no endpoint singularity
-  (``w`` diverges at q0 like ``(q - q0)^(-1/2)``). Product integration in s: F is integrated
-  exactly over each cell through its antiderivative, 1/q by the trapezoid rule.
+  (``gamma E1(x0^2)/2`` plus a tabulated erf^2 part). With ``s = sqrt(m)`` the outer integral
+  becomes ``u = 2 int F(p*/(sqrt(pi) s)) / q ds``, which has no endpoint singularity (``w``
+  diverges at q0 like ``(q - q0)^(-1/2)``). Product integration in s: F is integrated exactly over
+  each cell through its antiderivative ``int_0^s F(c/t) dt = c Phi(c/s)`` (closed form by parts,
+  tabulated once in ln-ln form), 1/q by the trapezoid rule.
 * Small-pressure asymptote: ``-du/dln p -> sqrt(pi) gamma int q^2 C w dq = 2 gamma int ds/q``.
 * Critical junction (Lorenz & Persson, Eur. Phys. J. E 31, 159 (2010); percolation threshold
   ``a_c = 0.42`` from Dapp et al., PRL 108, 244301 (2012)): ``zeta_c`` solves ``A(zeta_c)/A0 = a_c``
@@ -28,13 +29,14 @@ Notation (Persson convention, see `reduced.roughness.spectrum`): ``E* = E/(1 - n
   ``u_c = 0`` (reported, never NaN).
 
 Numerics: the input spectrum is integrated on its own grid (cumulative trapezoid in ln q); the
-cumulative moments are kept on a log-spaced working grid of ``n_q`` nodes, and each mean-separation
+cumulative moments are kept on a working grid uniform in ln q (``n_q``, default 4096), and each mean-separation
 integral runs on its own ``n_sub`` log-spaced nodes from its lower limit to q1 (defaults converged
 to ~0.1 %, see tests/test_rough_persson.py).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -270,7 +272,8 @@ class GapTable:
     provenance: str = ""
 
 
-def _check_params(p_over_E: np.ndarray, method: str, gamma: float, a_c: float) -> None:
+def check_gap_parameters(p_over_E: np.ndarray, method: str, gamma: float, a_c: float) -> None:
+    """Raise ValueError naming the field if a table request is out of range (cheap; call first)."""
     if p_over_E.ndim != 1 or p_over_E.size == 0:
         raise ValueError("p_over_E: need a non-empty 1D array of pressures over E")
     if not np.all(np.isfinite(p_over_E)) or np.any(p_over_E <= 0):
@@ -285,7 +288,8 @@ def _check_params(p_over_E: np.ndarray, method: str, gamma: float, a_c: float) -
 
 def critical_gap_table(spectrum: PowerSpectrum, E_Pa: float, nu: float, p_over_E,
                        *, method: str = "emt", gamma: float = 0.45, a_c: float = 0.42,
-                       n_q: int | None = None, progress=None) -> GapTable:
+                       n_q: int | None = None,
+                       progress: Callable[[float, str], None] | None = None) -> GapTable:
     """u_c(p/E) of `spectrum` pressed by an elastic half-space (E_Pa, nu) against it.
 
     `method`: ``"emt"`` (default; the route the paper used, Sec. 5.1: Bruggeman effective-medium leak
@@ -293,7 +297,7 @@ def critical_gap_table(spectrum: PowerSpectrum, E_Pa: float, nu: float, p_over_E
     ``"critical-junction"``. Both use the same contact area, threshold `a_c` and `gamma`.
     """
     p_over_E = np.atleast_1d(np.asarray(p_over_E, float))
-    _check_params(p_over_E, method, gamma, a_c)
+    check_gap_parameters(p_over_E, method, gamma, a_c)
     Estar = effective_modulus(E_Pa, nu)
     pstar = p_over_E * E_Pa / Estar
     mom = Moments.of(spectrum, n_q)

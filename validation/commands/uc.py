@@ -107,7 +107,7 @@ def _list_surfaces() -> int:
 def run(args) -> int:
     if args.list_surfaces:
         return _list_surfaces()
-    from reduced.roughness.persson import _check_params, critical_gap_table, effective_modulus
+    from reduced.roughness.persson import check_gap_parameters, critical_gap_table, effective_modulus
 
     if args.surface is None and args.psd is None and args.line_scan is None:
         raise ValueError("surface: give one of --surface NAME, --psd FILE, --line-scan FILE")
@@ -116,7 +116,7 @@ def run(args) -> int:
     E_Pa = args.E_MPa * 1e6
     effective_modulus(E_Pa, args.nu)                          # validates E and nu
     p_Pa = _pressures_Pa(args)
-    _check_params(p_Pa / E_Pa, args.method, args.gamma, args.a_c)
+    check_gap_parameters(p_Pa / E_Pa, args.method, args.gamma, args.a_c)
     if args.out is not None and len(np.unique(p_Pa)) < 2:
         raise ValueError("--out: a u_c table needs at least 2 distinct pressures")
     spectrum = _spectrum(args)
