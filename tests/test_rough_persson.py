@@ -6,7 +6,7 @@ from scipy.integrate import quad
 from scipy.special import beta, betainc, erf, erfinv
 
 from reduced.roughness.persson import (Moments, contact_area_ratio, critical_gap_table,
-                                       critical_junction_gap, mean_separation,
+                                       mean_separation,
                                        noncontact_separation, separation_kernel,
                                        small_pressure_slope)
 from reduced.roughness.spectrum import self_affine

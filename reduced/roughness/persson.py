@@ -43,7 +43,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.special import erf, erfc, erfinv, exp1
 
-from .spectrum import PowerSpectrum, cumulative_trapezoid
+from .spectrum import PowerSpectrum
 
 
 def effective_modulus(E_Pa: float, nu: float) -> float:
