@@ -1,0 +1,558 @@
+"""Lifetime of a suction cup: the leakage dynamics of Sec. 3 (eqs 3-10) with the flow of Sec. 4.
+
+State and equations. The gas content N of the cavity and (with relaxation) the contact-time state
+phi evolve in time; the cup height h is algebraic, fixed by the force balance
+
+    G(h, N, phi) = kappa(phi) F0(h) + F1 - pi r(h)^2 (p_a - N kT / V(h)) = 0        (7), (8)
+
+with kappa = E_eff(phi) / E_eff(phi0) (Sec. 3), kappa = 1 in reference mode. Then
+
+    dN/dt   = (2 pi r / l) f(p, p_a, p_b),  p = kappa F0 / (2 pi r l) + beta (p_a - p_b)   (9), (23), (6)
+    dphi/dt = 1 - rdot phi / l,   rdot = r'(h) hdot                                       (10)
+
+and hdot follows from differentiating G = 0 (implicit function theorem); phi_dot contains rdot, so
+(hdot, phi_dot) solve a 2x2 linear system, singular where D = G_h - (r' phi / l) G_phi = 0.
+
+Equilibrium branch. At fixed kappa and F1 the gas content in equilibrium is explicit in h,
+
+    N_eq(h) = V(h) [p_a - (kappa F0(h) + F1) / (pi r(h)^2)] / kT,
+
+and stable equilibria are where N_eq increases with h (G_h < 0). h is found from N by a safeguarded
+Newton iteration on that branch, to ~1e-14 relative, at every evaluation ("projection"): the force
+balance then holds at every output to round-off. The branch ends where N_eq has its first local
+maximum (the fold: no equilibrium holds more gas) or where r = r1.
+
+Start. At r_start with F1 = 0 the force balance fixes the trapped gas N0. F1 is then applied at
+t = 0 with N0 fixed; h follows the equilibrium continuously from r_start (continuation in F1). The
+holding force at fixed N0, F_hold(h) = pi r^2 (p_a - N0 kT/V) - kappa F0, must rise to F1 before its
+first local maximum: that maximum (or its value at r1) is the largest force the cup can hold;
+at or above it the cup detaches at t = 0.
+
+End (reason): "reached_r1", "fold" (static fold, or with relaxation the dynamic singularity D -> 0
+where rdot diverges), "over_force" (t = 0), "sealed" (u_c = 0 somewhere on the way: the leak rate
+vanishes, the lifetime is infinite) or "horizon" (still holding at t_max).
+
+Reference mode (`reference_model`): Appendix A stiffness (x0 = r0, x1 = r1, d0 = 2 mm, d1 = 0,
+E = 4 MPa), no relaxation (kappa = 1, E = 4 MPa for p/E), air at 293.15 K (eta = 1.81e-5 Pa s,
+m = 28.97 u), p_a = 1e5 Pa, lambda_a from eq (12) at p_a, u_c from the given table, rigid-cone
+geometry eqs (3)-(5), start and detachment as above. There the state is one-dimensional and
+`lifetime_by_quadrature` gives the lifetime independently as t = int dN_eq/dh / Ndot dh.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from reduced.appendix_a import appendix_a_curve
+from reduced.cup import CupParameters
+from reduced.fast_curve import CurveRangeError, ScalarPchip
+from reduced.gas import AIR, XI, Gas
+from reduced.geometry import geometry_source
+from reduced.ode import dopri5
+from reduced.stiffness_curve import StiffnessCurve
+from reduced.viscoelastic import RelaxationModulus, measurement_contact_time
+
+__all__ = ["LeakageModel", "LifetimeResult", "reference_model", "lifetime", "lifetime_sweep",
+           "lifetime_by_quadrature", "largest_holdable_force", "REASONS"]
+
+REASONS = ("reached_r1", "fold", "over_force", "sealed", "horizon")
+_GRID = 1200          # h samples for locating folds (refined by brentq)
+_DYNAMIC_FOLD = 1e-4  # |D| / |D(0)| at which the relaxed dynamics is declared singular
+
+
+@dataclass(frozen=True)
+class LeakageModel:
+    """Everything a lifetime depends on except the pull force F1.
+
+    cup: geometry and Table 1 parameters. stiffness: F0 over u = h1 - h (any `StiffnessCurve`).
+    u_c: critical gap [m] as a function of p/E (e.g. a `UcTable`). gas, p_a_Pa: the gas and the
+    ambient pressure. relaxation: E_eff(t), or None for no relaxation (then kappa = 1 and E_Pa is the
+    modulus in p/E). phi0_s: contact time of the stiffness measurement (default: eq 10 steady state
+    at the paper's 0.12 mm/s, see `measurement_contact_time`). geometry: 'cone' (eqs 3-5) or 'curve'
+    (r, V, l from the stiffness curve).
+    """
+
+    cup: CupParameters
+    stiffness: StiffnessCurve
+    u_c: Callable[[float], float]
+    gas: Gas = AIR
+    p_a_Pa: float = 1e5
+    E_Pa: float = 4e6
+    relaxation: RelaxationModulus | None = None
+    phi0_s: float | None = None
+    geometry: str = "cone"
+    label: str = field(default="", compare=False)
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.p_a_Pa) and self.p_a_Pa > 0):
+            raise ValueError(f"p_a_Pa: ambient pressure must be > 0 Pa, got {self.p_a_Pa}")
+        if not (math.isfinite(self.E_Pa) and self.E_Pa > 0):
+            raise ValueError(f"E_Pa: modulus must be > 0 Pa, got {self.E_Pa}")
+        if self.phi0_s is not None and not self.phi0_s > 0:
+            raise ValueError(f"phi0_s: measurement contact time must be > 0 s, got {self.phi0_s}")
+        if self.geometry not in ("cone", "curve"):
+            raise ValueError(f"geometry: unknown source '{self.geometry}', allowed: cone, curve")
+
+    @property
+    def reference(self) -> bool:
+        return self.relaxation is None
+
+    @cached_property
+    def _core(self) -> _Core:
+        return _Core(self)
+
+
+def reference_model(cup: CupParameters, u_c: Callable[[float], float]) -> LeakageModel:
+    """The reference-mode model of the issue (module docstring) for `cup` and `u_c`."""
+    return LeakageModel(cup=cup, stiffness=appendix_a_curve(cup, E_Pa=4e6, d0_m=2e-3), u_c=u_c,
+                        gas=Gas(T_K=293.15, molecular_mass_u=28.97, viscosity_Pa_s=1.81e-5),
+                        p_a_Pa=1e5, E_Pa=4e6, relaxation=None, geometry="cone", label="reference")
+
+
+@dataclass(frozen=True, eq=False)
+class LifetimeResult:
+    """Lifetime and trajectories (SI). lifetime_s is inf when sealed or beyond the horizon."""
+
+    force_N: float
+    lifetime_s: float
+    reason: str
+    message: str
+    largest_force_N: float
+    N0: float
+    t_s: np.ndarray
+    r_m: np.ndarray
+    h_m: np.ndarray
+    p_b_Pa: np.ndarray
+    p_Pa: np.ndarray
+    u_c_m: np.ndarray
+    N: np.ndarray
+    N_dot_per_s: np.ndarray
+    phi_s: np.ndarray
+    ballistic_share_t: np.ndarray
+    force_residual: np.ndarray
+    steps: int = 0
+
+    @property
+    def sealed(self) -> bool:
+        return self.reason == "sealed"
+
+    @property
+    def ballistic_share(self) -> float:
+        """Share of the leaked molecules that went through eq (19)'s ballistic term."""
+        if self.t_s.size < 2:
+            return float(self.ballistic_share_t[0]) if self.ballistic_share_t.size else float("nan")
+        total = _trapezoid(self.N_dot_per_s, self.t_s)
+        if total <= 0:
+            return float(self.ballistic_share_t[0])
+        return float(_trapezoid(self.ballistic_share_t * self.N_dot_per_s, self.t_s) / total)
+
+    def summary(self) -> dict:
+        """JSON-ready summary (lifetime_s null when infinite)."""
+        return {"force_N": self.force_N,
+                "lifetime_s": self.lifetime_s if math.isfinite(self.lifetime_s) else None,
+                "reason": self.reason, "sealed": self.sealed,
+                "ballistic_share": self.ballistic_share, "largest_force_N": self.largest_force_N,
+                "r_final_mm": 1e3 * float(self.r_m[-1]), "p_b_final_Pa": float(self.p_b_Pa[-1]),
+                "steps": self.steps, "message": self.message}
+
+    def trajectory_columns(self) -> dict[str, np.ndarray]:
+        """Trajectory arrays under CSV column names that carry their units."""
+        return {"t_s": self.t_s, "r_mm": 1e3 * self.r_m, "h_mm": 1e3 * self.h_m,
+                "p_b_Pa": self.p_b_Pa, "p_Pa": self.p_Pa, "u_c_nm": 1e9 * self.u_c_m,
+                "N": self.N, "N_dot_per_s": self.N_dot_per_s, "phi_s": self.phi_s,
+                "ballistic_share": self.ballistic_share_t}
+
+
+def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+
+
+# ----------------------------------------------------------------------------- the physics
+class _Core:
+    """Scalar evaluation of eqs (3)-(10), (23) for one model, plus the h grid for folds."""
+
+    def __init__(self, m: LeakageModel):
+        self.m = m
+        self.geo = geometry_source(m.geometry, m.cup, m.stiffness)
+        self.h1 = self.geo.h_detach_m          # F0 is taken at u = h1 - h
+        self.F0 = ScalarPchip(m.stiffness.u_m, m.stiffness.F0_N, "stiffness curve (u)")
+        self.kT = m.gas.kT_J
+        self.pa = m.p_a_Pa
+        self.beta = m.cup.beta
+        self.lam_a = m.gas.mean_free_path_m(m.p_a_Pa)
+        self.flow_coef = 1.0 / (24.0 * self.kT * m.gas.viscosity_Pa_s)   # eq (23)
+        self.uc = getattr(m.u_c, "scalar", m.u_c)
+        self.relax = m.relaxation
+        if self.relax is not None:
+            self.phi0 = m.phi0_s if m.phi0_s is not None else measurement_contact_time(m.cup)
+            self.E_ref = self.relax.modulus_and_log_slope(self.phi0)[0]
+        u_lo, u_hi = self.F0.lo, self.F0.hi
+        self.h_lo = max(self.h1 - u_hi, self.geo.h_min_m, 1e-3 * self.h1)
+        self.h_hi = min(self.geo.h_detach_m, self.h1 - u_lo)
+
+    # kappa(phi), dkappa/dphi and the modulus for p/E
+    def modulus(self, phi: float) -> tuple[float, float, float]:
+        if self.relax is None:
+            return 1.0, 0.0, self.m.E_Pa
+        E, slope = self.relax.modulus_and_log_slope(phi)
+        dk = slope * E / (phi * self.E_ref) if slope != 0.0 else 0.0
+        return E / self.E_ref, dk, E
+
+    def spring(self, h: float) -> tuple[float, float]:
+        """F0(h) and dF0/dh."""
+        F, dF_du = self.F0.value_and_slope(self.h1 - h)
+        return F, -dF_du
+
+    def n_eq(self, h: float, kappa: float, F1: float) -> tuple[float, float]:
+        """N_eq(h) and dN_eq/dh on the equilibrium branch (eqs 3, 4, 7, 8)."""
+        r, rp, V, Vp, _ = self.geo.at(h)
+        F, Fh = self.spring(h)
+        A = math.pi * r * r
+        X = (kappa * F + F1) / A
+        N = V * (self.pa - X) / self.kT
+        dN = (Vp * (self.pa - X) - V * (kappa * Fh / A - 2.0 * X * rp / r)) / self.kT
+        return N, dN
+
+    def holding_force(self, h: float, N0: float, kappa: float) -> tuple[float, float]:
+        """F_hold(h) = pi r^2 (p_a - N0 kT/V) - kappa F0 and its h-derivative."""
+        r, rp, V, Vp, _ = self.geo.at(h)
+        F, Fh = self.spring(h)
+        pb = N0 * self.kT / V
+        A = math.pi * r * r
+        return A * (self.pa - pb) - kappa * F, 2 * math.pi * r * rp * (self.pa - pb) + A * pb * Vp / V - kappa * Fh
+
+    def state(self, h: float, N: float, kappa: float, E: float, F1: float):
+        """(Ndot, p_b, p, u_c, ballistic share, r, rp, l, V, Vp, F, Fh) at a point, eqs (6), (9), (23)."""
+        r, rp, V, Vp, l = self.geo.at(h)
+        F, Fh = self.spring(h)
+        pa = self.pa
+        pb = N * self.kT / V
+        p = kappa * F / (2.0 * math.pi * r * l) + self.beta * (pa - pb)
+        uc = self.uc(p / E)
+        x = XI * self.lam_a * pa / (pa + pb)       # xi <lambda>, eq (20)
+        Ndot = (2.0 * math.pi * r / l) * self.flow_coef * (pa * pa - pb * pb) * (uc * uc * uc + x * uc * uc)
+        share = x / (x + uc) if uc > 0 else 1.0
+        return Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh
+
+    # ------------------------------------------------------------------ the h grid
+    @cached_property
+    def grid(self):
+        """h samples and the pieces of dN_eq/dh = (S0 - kappa S1 - F1 S2) / kT on them."""
+        h = np.linspace(self.h_lo, self.h_hi, _GRID)
+        S = np.empty((3, h.size))
+        for i, hi in enumerate(h):
+            r, rp, V, Vp, _ = self.geo.at(float(hi))
+            F, Fh = self.spring(float(hi))
+            A = math.pi * r * r
+            S[0, i] = Vp * self.pa
+            S[1, i] = Vp * F / A + V * Fh / A - 2.0 * V * F * rp / (r * A)
+            S[2, i] = Vp / A - 2.0 * V * rp / (r * A)
+        return h, S
+
+    def branch_end(self, h_from: float, kappa: float, F1: float) -> tuple[float, str]:
+        """First local maximum of N_eq above h_from (the fold), or the detachment height."""
+        h, S = self.grid
+        i0 = int(np.searchsorted(h, h_from, side="right"))
+        d = S[0, i0:] - kappa * S[1, i0:] - F1 * S[2, i0:]
+        bad = np.flatnonzero(d <= 0.0)
+        if self.n_eq(h_from, kappa, F1)[1] <= 0.0:
+            return h_from, "fold"
+        if bad.size == 0:
+            if self.n_eq(self.h_hi, kappa, F1)[1] > 0.0 or self.h_hi >= self.geo.h_detach_m:
+                return self.h_hi, "reached_r1" if self.h_hi >= self.geo.h_detach_m * (1 - 1e-12) else "fold"
+            bad = np.array([h.size - 1 - i0])
+        j = i0 + int(bad[0])
+        a = h_from if j == i0 else float(h[j - 1])
+        b = float(h[j])
+        hf = brentq(lambda x: self.n_eq(x, kappa, F1)[1], a, b, xtol=1e-15 * self.h1, rtol=1e-14)
+        return hf, "fold"
+
+    def branch_root(self, N: float, kappa: float, F1: float, h_guess: float, lo: float, hi: float) -> float:
+        """h in [lo, hi] with N_eq(h) = N to 1e-13 relative, N_eq increasing there (safeguarded Newton)."""
+        h = min(max(h_guess, lo), hi)
+        tol_N = 1e-13 * abs(N)
+        for _ in range(100):
+            f, df = self.n_eq(h, kappa, F1)
+            f -= N
+            if abs(f) <= tol_N:
+                return h
+            if f > 0.0:
+                hi = h
+            else:
+                lo = h
+            h_new = h - f / df if df > 0.0 else lo - 1.0
+            if not (lo < h_new < hi):
+                h_new = 0.5 * (lo + hi)
+            if hi - lo <= 4e-16 * hi:
+                return h_new
+            h = h_new
+        raise RuntimeError(f"force balance: no convergence for N = {N:.6g} in h = [{lo:.6g}, {hi:.6g}] m")
+
+    # ------------------------------------------------------------------ the start
+    def start(self):
+        """(h_start, N0, kappa0, F_max, h_max): the trapped gas and the largest holdable force."""
+        kappa0 = self.modulus(0.0)[0]
+        hs = self.geo.h_start_m
+        if not self.h_lo <= hs <= self.h_hi:
+            raise CurveRangeError(f"stiffness curve: r_start needs h = {1e3 * hs:.6g} mm, outside the "
+                                  f"curve's range [{1e3 * self.h_lo:.6g}, {1e3 * self.h_hi:.6g}] mm")
+        N0 = self.n_eq(hs, kappa0, 0.0)[0]
+        if N0 <= 0:
+            raise ValueError(f"r_start_m: the stiffness force at r_start exceeds the full vacuum force "
+                             f"(no gas can be trapped); check the stiffness curve or r_start")
+        h, _ = self.grid
+        hh = np.concatenate(([hs], h[h > hs]))
+        slope = np.array([self.holding_force(float(x), N0, kappa0)[1] for x in hh])
+        bad = np.flatnonzero(slope <= 0.0)
+        if bad.size == 0:
+            hm = self.h_hi
+        elif bad[0] == 0:
+            hm = hs
+        else:
+            j = int(bad[0])
+            hm = brentq(lambda x: self.holding_force(x, N0, kappa0)[1], float(hh[j - 1]), float(hh[j]),
+                        xtol=1e-15 * self.h1)
+        return hs, N0, kappa0, self.holding_force(hm, N0, kappa0)[0], hm
+
+    @cached_property
+    def initial(self):
+        return self.start()
+
+
+def largest_holdable_force(model: LeakageModel) -> float:
+    """The largest F1 [N] the freshly pressed cup holds at t = 0 (the first maximum of F_hold)."""
+    return float(model._core.initial[3])
+
+
+# ----------------------------------------------------------------------------- lifetime
+def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol: float = 1e-6,
+             progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
+    """Lifetime [s] of the cup under the pull force F1 = force_N, with trajectories.
+
+    Integrates N (and phi with relaxation) by an adaptive Dormand-Prince pair with terminal events;
+    h is solved from the force balance at every evaluation. Raises ValueError for bad input and
+    `CurveRangeError` (a ValueError) if the state leaves the stiffness curve.
+    """
+    F1 = float(force_N)
+    if not (math.isfinite(F1) and F1 > 0):
+        # F1 = 0 ends only asymptotically at r1, where the contact pressure p -> 0
+        raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
+    if not (t_max_s > 0 and 0 < rtol < 1e-2):
+        raise ValueError(f"t_max_s, rtol: need t_max_s > 0 and 0 < rtol < 0.01, got {t_max_s}, {rtol}")
+    core = model._core
+    hs, N0, kappa0, Fmax, hm = core.initial
+    if F1 >= Fmax:
+        msg = (f"F1 = {F1:g} N is at or above the largest force the cup can hold at t = 0, "
+               f"{Fmax:.4g} N: it detaches at once")
+        return _result(core, F1, 0.0, "over_force", msg, Fmax, N0, [0.0], [[N0, 0.0]], [hs], 0)
+    h0 = brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
+                                   xtol=1e-15 * core.h1, rtol=1e-15)
+    run = _run_reference if model.reference else _run_relaxed
+    return run(core, F1, N0, h0, Fmax, t_max_s, rtol, progress)
+
+
+def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, progress) -> LifetimeResult:
+    h_end, reason = core.branch_end(h0, 1.0, F1)
+    N_end = core.n_eq(h_end, 1.0, F1)[0]
+    E = core.m.E_Pa
+    # sealed anywhere on the branch? (u_c = 0 makes Ndot vanish; it is never crossed in finite time)
+    sealed_at = _sealed_on_branch(core, h0, h_end, F1)
+    if sealed_at is not None:
+        return _result(core, F1, math.inf, "sealed",
+                       f"u_c = 0 at h = {1e3 * sealed_at:.4g} mm on the way: the interface seals, no "
+                       f"further leak", Fmax, N0, [0.0], [[N0, 0.0]], [h0], 0)
+    last = [h0]
+
+    def h_of(N: float) -> float:
+        if N >= N_end:
+            return h_end
+        h = core.branch_root(N, 1.0, F1, last[0], h0, h_end)
+        last[0] = h
+        return h
+
+    Ndot_end = core.state(h_end, N_end, 1.0, E, F1)[0]
+
+    # The integrated variable is the leaked content Q = N - N0, so that the error control is
+    # relative to what leaks (N itself hardly changes at large F1).
+    def rhs(t, y):     # beyond the end of the branch: continued with the end value (event there)
+        N = N0 + y[0]
+        return [core.state(h_of(N), N, 1.0, E, F1)[0] if N < N_end else Ndot_end]
+
+    Ndot0 = rhs(0.0, [0.0])[0]
+    Q_end = N_end - N0
+    sol = dopri5(rhs, 0.0, [0.0], t_max, rtol, [rtol * Q_end], events=[lambda t, y: y[0] - Q_end],
+                 h0=1e-2 * Q_end / Ndot0 if Ndot0 > 0 else None)
+    if progress:
+        progress(1.0, f"F1 = {F1:g} N")
+    ys = [[N0 + y[0], 0.0] for y in sol.y]
+    if sol.event is not None:
+        ys[-1][0] = N_end      # the event is N = N_end; only its time is interpolated
+    hs = [h_of(y[0]) for y in ys]
+    if sol.event is None:
+        return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s",
+                       Fmax, N0, sol.t, ys, hs, sol.steps)
+    return _result(core, F1, sol.t[-1], reason, _end_message(reason, sol.t[-1]), Fmax, N0, sol.t, ys,
+                   hs, sol.steps)
+
+
+def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, progress) -> LifetimeResult:
+    last = {"h": h0}
+
+    def solve(N: float, phi: float):
+        kappa, dk, E = core.modulus(phi)
+        lo = last["h"]
+        step = 1e-4 * core.h1
+        while core.n_eq(lo, kappa, F1)[0] > N:      # step down to bracket the root
+            lo = max(lo - step, core.h_lo)
+            step *= 2.0
+            if lo <= core.h_lo:
+                if core.n_eq(lo, kappa, F1)[0] > N:
+                    raise CurveRangeError(f"state: the cup height fell below {1e3 * core.h_lo:.4g} mm, "
+                                          f"the lower end of the stiffness curve / geometry")
+                break
+        top, why = core.branch_end(lo, kappa, F1)
+        N_top = core.n_eq(top, kappa, F1)[0]
+        h = top if N >= N_top else core.branch_root(N, kappa, F1, last["h"], lo, top)
+        last["h"] = h
+        return h, kappa, dk, E, N_top, why
+
+    def derivatives(h, N, phi, kappa, dk, E):
+        Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh = core.state(h, N, kappa, E, F1)
+        pa, kT = core.pa, core.kT
+        A = math.pi * r * r
+        G_h = kappa * Fh - 2 * math.pi * r * rp * (pa - pb) - A * pb * Vp / V
+        G_N = A * kT / V
+        G_phi = dk * F
+        a = rp * phi / l
+        D = G_h - a * G_phi
+        hdot = -(G_N * Ndot + G_phi) / D
+        return Ndot, 1.0 - a * hdot, D
+
+    def rhs(t, y):      # y = (N - N0, phi)
+        N, phi = N0 + y[0], max(y[1], 0.0)
+        h, kappa, dk, E, _, _ = solve(N, phi)
+        Ndot, phidot, _ = derivatives(h, N, phi, kappa, dk, E)
+        return [Ndot, phidot]
+
+    D0 = abs(derivatives(h0, N0, 0.0, *core.modulus(0.0))[2])
+
+    def end_event(t, y):          # N reaches the top of the branch (fold or r1)
+        h, kappa, dk, E, N_top, _ = solve(N0 + y[0], max(y[1], 0.0))
+        return N0 + y[0] - N_top
+
+    def dynamic_fold(t, y):       # D -> 0: rdot diverges
+        phi = max(y[1], 0.0)
+        h, kappa, dk, E, _, _ = solve(N0 + y[0], phi)
+        return _DYNAMIC_FOLD - abs(derivatives(h, N0 + y[0], phi, kappa, dk, E)[2]) / D0
+
+    Ndot0 = rhs(0.0, [0.0, 0.0])[0]
+    if Ndot0 <= 0.0:
+        return _result(core, F1, math.inf, "sealed", "u_c = 0 at t = 0: the interface is sealed",
+                       Fmax, N0, [0.0], [[N0, 0.0]], [h0], 0)
+    h_top0, _ = core.branch_end(h0, core.modulus(0.0)[0], F1)
+    Q_scale = core.n_eq(h_top0, core.modulus(0.0)[0], F1)[0] - N0   # leak to the static end at t = 0
+    sol = dopri5(rhs, 0.0, [0.0, 0.0], t_max, rtol, [rtol * Q_scale, 1e-6],
+                 events=[end_event, dynamic_fold], h0=1e-3 * Q_scale / Ndot0)
+    sol_y = [[N0 + y[0], y[1]] for y in sol.y]
+    if progress:
+        progress(1.0, f"F1 = {F1:g} N")
+    hs = []
+    for y in sol_y:
+        last["h"] = hs[-1] if hs else h0
+        hs.append(solve(y[0], max(y[1], 0.0))[0])
+    if sol.event is None:
+        return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s",
+                       Fmax, N0, sol.t, sol_y, hs, sol.steps)
+    last["h"] = hs[-1]
+    reason = solve(sol_y[-1][0], max(sol_y[-1][1], 0.0))[5] if sol.event == 0 else "fold"
+    return _result(core, F1, sol.t[-1], reason, _end_message(reason, sol.t[-1]), Fmax, N0, sol.t,
+                   sol_y, hs, sol.steps)
+
+
+def _sealed_on_branch(core: _Core, h0: float, h_end: float, F1: float) -> float | None:
+    """First h on [h0, h_end] (checked on the fold-search grid) where u_c = 0, or None."""
+    if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf:
+        return None        # a table without sealed rows never seals
+    h, _ = core.grid
+    for x in [h0] + [float(x) for x in h[(h > h0) & (h < h_end)]] + [h_end]:
+        N = core.n_eq(x, 1.0, F1)[0]
+        if core.state(x, N, 1.0, core.m.E_Pa, F1)[3] <= 0.0:
+            return x
+    return None
+
+
+def _end_message(reason: str, t: float) -> str:
+    what = {"reached_r1": "the contact radius reached r1", "fold": "the force balance lost its "
+            "equilibrium (fold)"}[reason]
+    return f"detached at t = {t:.6g} s: {what}"
+
+
+def _result(core: _Core, F1, t_life, reason, msg, Fmax, N0, ts, ys, hs, steps) -> LifetimeResult:
+    rows = []
+    for t, y, h in zip(ts, ys, hs):
+        N, phi = y[0], max(y[1], 0.0)
+        kappa, _, E = core.modulus(phi)
+        Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh = core.state(h, N, kappa, E, F1)
+        G = kappa * F + F1 - math.pi * r * r * (core.pa - pb)
+        scale = abs(kappa * F) + F1 + math.pi * r * r * core.pa
+        rows.append((t, r, h, pb, p, uc, N, Ndot, phi, share, abs(G) / scale))
+    a = np.array(rows, dtype=float).T
+    for arr in a:
+        arr.flags.writeable = False
+    return LifetimeResult(force_N=F1, lifetime_s=float(t_life), reason=reason, message=msg,
+                          largest_force_N=float(Fmax), N0=float(N0), t_s=a[0], r_m=a[1], h_m=a[2],
+                          p_b_Pa=a[3], p_Pa=a[4], u_c_m=a[5], N=a[6], N_dot_per_s=a[7], phi_s=a[8],
+                          ballistic_share_t=a[9], force_residual=a[10], steps=steps)
+
+
+def lifetime_sweep(model: LeakageModel, forces_N, progress=None, **kw) -> list[LifetimeResult]:
+    """`lifetime` for each force (sharing the model's precomputation)."""
+    forces = [float(f) for f in forces_N]
+    out = []
+    for i, F1 in enumerate(forces):
+        out.append(lifetime(model, F1, **kw))
+        if progress:
+            progress((i + 1) / len(forces), f"F1 = {F1:g} N")
+    return out
+
+
+# ----------------------------------------------------------------------------- quadrature
+def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 1e-10) -> float:
+    """Reference-mode lifetime as t = int_{h(0+)}^{h_end} (dN_eq/dh) / Ndot(h) dh (no time stepping).
+
+    An independent evaluation for checking `lifetime`: without relaxation the state is
+    one-dimensional and the time to move along the equilibrium branch is a quadrature.
+    Returns inf if u_c vanishes on the branch and 0 for an over-force.
+    """
+    if not model.reference:
+        raise ValueError("lifetime_by_quadrature: only without relaxation (reference mode)")
+    core = model._core
+    F1 = float(force_N)
+    if not (math.isfinite(F1) and F1 > 0):
+        raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
+    hs, N0, kappa0, Fmax, hm = core.initial
+    if F1 >= Fmax:
+        return 0.0
+    h0 = brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
+                                   xtol=1e-15 * core.h1, rtol=1e-15)
+    h_end, _ = core.branch_end(h0, 1.0, F1)
+
+    def integrand(h: float) -> float:
+        N, dN = core.n_eq(h, 1.0, F1)
+        Ndot = core.state(h, N, 1.0, core.m.E_Pa, F1)[0]
+        return math.inf if Ndot <= 0 else dN / Ndot
+
+    if _sealed_on_branch(core, h0, h_end, F1) is not None:
+        return math.inf
+    # the PCHIP breakpoints are kinks of higher derivatives: hand them to quad
+    knots = sorted(x for x in (core.h1 - u for u in core.F0.x) if h0 < x < h_end)
+    t, err = quad(integrand, h0, h_end, epsabs=0.0, epsrel=epsrel, limit=4 * len(knots) + 200,
+                  points=knots[:: max(1, len(knots) // 100)] or None)
+    return t
