@@ -333,12 +333,14 @@ def largest_holdable_force(model: LeakageModel) -> float:
 
 # ----------------------------------------------------------------------------- lifetime
 def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol: float = 1e-6,
-             progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
+             refine: int = 1, progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
     """Lifetime [s] of the cup under the pull force F1 = force_N, with trajectories.
 
     Integrates N (and phi with relaxation) by an adaptive Dormand-Prince pair with terminal events;
-    h is solved from the force balance at every evaluation. Raises ValueError for bad input and
-    `CurveRangeError` (a ValueError) if the state leaves the stiffness curve.
+    h is solved from the force balance at every evaluation. The trajectories hold the accepted
+    steps, or `refine` points per step from the solver's 4th-order dense output (each projected
+    onto the force balance). Raises ValueError for bad input and `CurveRangeError` (a ValueError)
+    if the state leaves the stiffness curve.
     """
     F1 = float(force_N)
     if not (math.isfinite(F1) and F1 > 0):
@@ -346,6 +348,8 @@ def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol
         raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
     if not (t_max_s > 0 and 0 < rtol < 1e-2):
         raise ValueError(f"t_max_s, rtol: need t_max_s > 0 and 0 < rtol < 0.01, got {t_max_s}, {rtol}")
+    if not (isinstance(refine, int) and 1 <= refine <= 1000):
+        raise ValueError(f"refine: output points per step must be an integer in [1, 1000], got {refine}")
     core = model._core
     hs, N0, kappa0, Fmax, hm = core.initial
     if F1 >= Fmax:
@@ -353,12 +357,31 @@ def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol
                f"{Fmax:.4g} N: it detaches at once")
         return _result(core, F1, 0.0, "over_force", msg, Fmax, N0, [0.0], [[N0, 0.0]], [hs], 0)
     h0 = brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
-                                   xtol=1e-15 * core.h1, rtol=1e-15)
+                xtol=1e-15 * core.h1, rtol=1e-15)
     run = _run_reference if model.reference else _run_relaxed
-    return run(core, F1, N0, h0, Fmax, t_max_s, rtol, progress)
+    result = run(core, F1, N0, h0, Fmax, t_max_s, rtol, refine)
+    if progress:
+        progress(1.0, f"F1 = {F1:g} N: {result.reason}")
+    return result
 
 
-def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, progress) -> LifetimeResult:
+def _outputs(sol, refine: int) -> tuple[list, list]:
+    """Output times and states: the accepted steps, refined by the dense output if asked."""
+    if refine == 1 or not sol.dense:
+        return list(sol.t), [list(y) for y in sol.y]
+    ts, ys = [sol.t[0]], [list(sol.y[0])]
+    for i, dense in enumerate(sol.dense):
+        t0, t1 = sol.t[i], sol.t[i + 1]
+        for j in range(1, refine):
+            tj = t0 + (t1 - t0) * j / refine
+            ts.append(tj)
+            ys.append(dense(tj))
+        ts.append(t1)
+        ys.append(list(sol.y[i + 1]))
+    return ts, ys
+
+
+def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> LifetimeResult:
     h_end, reason = core.branch_end(h0, 1.0, F1)
     N_end = core.n_eq(h_end, 1.0, F1)[0]
     E = core.m.E_Pa
@@ -388,21 +411,21 @@ def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, progress) -> Life
     Ndot0 = rhs(0.0, [0.0])[0]
     Q_end = N_end - N0
     sol = dopri5(rhs, 0.0, [0.0], t_max, rtol, [rtol * Q_end], events=[lambda t, y: y[0] - Q_end],
-                 h0=1e-2 * Q_end / Ndot0 if Ndot0 > 0 else None)
-    if progress:
-        progress(1.0, f"F1 = {F1:g} N")
-    ys = [[N0 + y[0], 0.0] for y in sol.y]
+                 h0=1e-2 * Q_end / Ndot0 if Ndot0 > 0 else None, dense_output=refine > 1)
+    ts, ys = _outputs(sol, refine)
+    ys = [[N0 + y[0], 0.0] for y in ys]
     if sol.event is not None:
         ys[-1][0] = N_end      # the event is N = N_end; only its time is interpolated
+    last[0] = h0
     hs = [h_of(y[0]) for y in ys]
     if sol.event is None:
         return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s",
-                       Fmax, N0, sol.t, ys, hs, sol.steps)
-    return _result(core, F1, sol.t[-1], reason, _end_message(reason, sol.t[-1]), Fmax, N0, sol.t, ys,
+                       Fmax, N0, ts, ys, hs, sol.steps)
+    return _result(core, F1, ts[-1], reason, _end_message(reason, ts[-1]), Fmax, N0, ts, ys,
                    hs, sol.steps)
 
 
-def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, progress) -> LifetimeResult:
+def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> LifetimeResult:
     last = {"h": h0}
 
     def solve(N: float, phi: float):
@@ -459,20 +482,22 @@ def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, progress) -> Lifeti
     h_top0, _ = core.branch_end(h0, core.modulus(0.0)[0], F1)
     Q_scale = core.n_eq(h_top0, core.modulus(0.0)[0], F1)[0] - N0   # leak to the static end at t = 0
     sol = dopri5(rhs, 0.0, [0.0, 0.0], t_max, rtol, [rtol * Q_scale, 1e-6],
-                 events=[end_event, dynamic_fold], h0=1e-3 * Q_scale / Ndot0)
-    sol_y = [[N0 + y[0], y[1]] for y in sol.y]
-    if progress:
-        progress(1.0, f"F1 = {F1:g} N")
+                 events=[end_event, dynamic_fold], h0=1e-3 * Q_scale / Ndot0, dense_output=refine > 1)
+    ts, sol_y = _outputs(sol, refine)
+    sol_y = [[N0 + y[0], y[1]] for y in sol_y]
+    if sol.event == 0:       # the event is N = N_top(phi); only its time is interpolated
+        sol_y[-1][0] = solve(sol_y[-1][0], max(sol_y[-1][1], 0.0))[4]
+    last["h"] = h0
     hs = []
     for y in sol_y:
         last["h"] = hs[-1] if hs else h0
         hs.append(solve(y[0], max(y[1], 0.0))[0])
     if sol.event is None:
         return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s",
-                       Fmax, N0, sol.t, sol_y, hs, sol.steps)
+                       Fmax, N0, ts, sol_y, hs, sol.steps)
     last["h"] = hs[-1]
     reason = solve(sol_y[-1][0], max(sol_y[-1][1], 0.0))[5] if sol.event == 0 else "fold"
-    return _result(core, F1, sol.t[-1], reason, _end_message(reason, sol.t[-1]), Fmax, N0, sol.t,
+    return _result(core, F1, ts[-1], reason, _end_message(reason, ts[-1]), Fmax, N0, ts,
                    sol_y, hs, sol.steps)
 
 

@@ -49,21 +49,24 @@ class OdeSolution:
     event: int | None  # index of the terminal event that fired, None if t_end was reached
     steps: int
     rejected: int
+    dense: list | None = None   # per step, y(t) on [t[i], t[i+1]] (with dense_output=True)
 
 
 def dopri5(fun: Callable[[float, list], list], t0: float, y0: Sequence[float], t_end: float,
            rtol: float, atol: Sequence[float], events: Sequence[Callable[[float, list], float]] = (),
-           h0: float | None = None, max_steps: int = 100_000) -> OdeSolution:
+           h0: float | None = None, max_steps: int = 100_000, dense_output: bool = False) -> OdeSolution:
     """Integrate y' = fun(t, y) from t0 until t_end or until an event g(t, y) changes sign.
 
     An event fires when g goes from negative to >= 0 (write events so they start negative).
     The returned solution ends at the event time, with the state interpolated there.
+    With dense_output, `dense[i]` is the 4th-order interpolant of step i.
     """
     n = len(y0)
     y = [float(v) for v in y0]
     t = float(t0)
     f = list(fun(t, y))
     ts, ys, fs = [t], [list(y)], [list(f)]
+    dense_steps = [] if dense_output else None
     g_old = [g(t, y) for g in events]
     if h0 is None:
         # Hairer's first guess: 1 % of the time the first component needs to change by itself
@@ -110,16 +113,21 @@ def dopri5(fun: Callable[[float, list], list], t0: float, y0: Sequence[float], t
             # event, refining the event time by the Illinois method on those steps.
             te, ye = _locate(events[i], lambda tau: _step(fun, t, y, f, tau - t)[0] if tau > t else y,
                              t, t_new, g_old[i], g_new[i], guess=te, iters=8)
+            if dense_output:
+                ye, fe, ke = _step(fun, t, y, f, te - t)
+                dense_steps.append(_dense(t, y, te - t, ke))
             ts.append(te)
             ys.append(ye)
             fs.append(list(fun(te, ye)))
-            return OdeSolution(ts, ys, fs, i, steps, rejected)
+            return OdeSolution(ts, ys, fs, i, steps, rejected, dense_steps)
+        if dense_output:
+            dense_steps.append(_dense(t, y, h, k))
         t, y, f, g_old = t_new, y_new, f_new, g_new
         ts.append(t)
         ys.append(list(y))
         fs.append(list(f))
         h *= min(5.0, 0.9 * max(err, 1e-10) ** -0.2)
-    return OdeSolution(ts, ys, fs, None, steps, rejected)
+    return OdeSolution(ts, ys, fs, None, steps, rejected, dense_steps)
 
 
 def _step(fun, t: float, y: list, f: list, h: float):
