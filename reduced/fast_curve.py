@@ -23,10 +23,11 @@ class CurveRangeError(ValueError):
 class ScalarPchip:
     """value_and_slope(x) of the PCHIP interpolant through (x, y), on Python floats."""
 
-    __slots__ = ("x", "c0", "c1", "c2", "c3", "lo", "hi", "name", "unit_scale", "unit")
+    __slots__ = ("x", "c0", "c1", "c2", "c3", "lo", "hi", "name", "unit_scale", "unit", "pp")
 
     def __init__(self, x, y, name: str = "curve", unit_scale: float = 1e3, unit: str = "mm"):
         pp = PchipInterpolator(np.asarray(x, float), np.asarray(y, float), extrapolate=False)
+        self.pp = pp
         self.x = [float(v) for v in pp.x]
         c = np.asarray(pp.c, float)
         self.c3, self.c2, self.c1, self.c0 = ([float(v) for v in row] for row in c)
@@ -38,6 +39,16 @@ class ScalarPchip:
         d = x - self.x[i]
         c1, c2, c3 = self.c1[i], self.c2[i], self.c3[i]
         return self.c0[i] + d * (c1 + d * (c2 + d * c3)), c1 + d * (2.0 * c2 + 3.0 * d * c3)
+
+    def values_and_slopes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised value_and_slope (numpy arrays), same range check."""
+        x = np.asarray(x, dtype=float)
+        if x.size and not (x.min() >= self.lo - 1e-12 * (self.hi - self.lo)
+                           and x.max() <= self.hi + 1e-12 * (self.hi - self.lo)):
+            bad = x[(x < self.lo) | (x > self.hi)][0]
+            self._index(float(bad))          # raises with the message
+        x = np.clip(x, self.lo, self.hi)
+        return self.pp(x), self.pp(x, 1)
 
     def value(self, x: float) -> float:
         i = self._index(x)

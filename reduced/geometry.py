@@ -11,6 +11,7 @@ The cup detaches when r reaches r1, i.e. at the undeformed height h1 (u = 0): `h
 
 from __future__ import annotations
 
+import numpy as np
 from scipy.optimize import brentq
 
 from reduced.cup import CupParameters
@@ -41,6 +42,12 @@ class ConeGeometry:
         rp = self.r0 / self.h0           # dr/dh
         return (self.r0 * x, rp, self.V0 * (x * x * x - 1.0), 3.0 * self.V0 * x * x / self.h0,
                 self.l0 + self.la * (1.0 - x))      # eq (5)
+
+    def at_array(self, h: np.ndarray) -> tuple[np.ndarray, ...]:
+        """`at` on an array of heights inside (0, h1]."""
+        x = 1.0 + np.asarray(h, dtype=float) / self.h0
+        return (self.r0 * x, np.full_like(x, self.r0 / self.h0), self.V0 * (x ** 3 - 1.0),
+                3.0 * self.V0 * x * x / self.h0, self.l0 + self.la * (1.0 - x))
 
 
 class CurveGeometry:
@@ -73,6 +80,12 @@ class CurveGeometry:
         r, dr_du = self._r.value_and_slope(u)
         V, dV_du = self._V.value_and_slope(u)
         return r, -dr_du, V, -dV_du, self._l.value(u)
+
+    def at_array(self, h: np.ndarray) -> tuple[np.ndarray, ...]:
+        u = self.h1 - np.asarray(h, dtype=float)
+        r, dr_du = self._r.values_and_slopes(u)
+        V, dV_du = self._V.values_and_slopes(u)
+        return r, -dr_du, V, -dV_du, self._l.values_and_slopes(u)[0]
 
 
 def geometry_source(kind: str, cup: CupParameters, curve: StiffnessCurve):

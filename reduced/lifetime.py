@@ -242,18 +242,20 @@ class _Core:
         return Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh
 
     # ------------------------------------------------------------------ the h grid
+    def spring_array(self, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        F, dF_du = self.F0.values_and_slopes(self.h1 - h)
+        return F, -dF_du
+
     @cached_property
     def grid(self):
         """h samples and the pieces of dN_eq/dh = (S0 - kappa S1 - F1 S2) / kT on them."""
         h = np.linspace(self.h_lo, self.h_hi, _GRID)
-        S = np.empty((3, h.size))
-        for i, hi in enumerate(h):
-            r, rp, V, Vp, _ = self.geo.at(float(hi))
-            F, Fh = self.spring(float(hi))
-            A = math.pi * r * r
-            S[0, i] = Vp * self.pa
-            S[1, i] = Vp * F / A + V * Fh / A - 2.0 * V * F * rp / (r * A)
-            S[2, i] = Vp / A - 2.0 * V * rp / (r * A)
+        r, rp, V, Vp, _ = self.geo.at_array(h)
+        F, Fh = self.spring_array(h)
+        A = math.pi * r * r
+        S = np.array([Vp * self.pa,
+                      Vp * F / A + V * Fh / A - 2.0 * V * F * rp / (r * A),
+                      Vp / A - 2.0 * V * rp / (r * A)])
         return h, S
 
     def branch_end(self, h_from: float, kappa: float, F1: float) -> tuple[float, str]:
@@ -274,24 +276,30 @@ class _Core:
         hf = brentq(lambda x: self.n_eq(x, kappa, F1)[1], a, b, xtol=1e-15 * self.h1, rtol=1e-14)
         return hf, "fold"
 
-    def branch_root(self, N: float, kappa: float, F1: float, h_guess: float, lo: float, hi: float) -> float:
-        """h in [lo, hi] with N_eq(h) = N to 1e-13 relative, N_eq increasing there (safeguarded Newton)."""
+    def branch_root(self, N: float, kappa: float, F1: float, h_guess: float, lo: float,
+                    hi: float) -> tuple[float, float]:
+        """(h, dN_eq/dh) with N_eq(h) = N to 1e-13 relative, h in [lo, hi] where N_eq increases.
+
+        Safeguarded Newton: a Newton step that leaves the bracket is replaced by bisection.
+        """
         h = min(max(h_guess, lo), hi)
         tol_N = 1e-13 * abs(N)
         for _ in range(100):
             f, df = self.n_eq(h, kappa, F1)
             f -= N
             if abs(f) <= tol_N:
-                return h
+                return h, df
             if f > 0.0:
                 hi = h
             else:
                 lo = h
             h_new = h - f / df if df > 0.0 else lo - 1.0
+            if lo < h_new < hi and abs(h_new - h) < 1e-7 * hi:
+                return h_new, df       # converged quadratically: the next residual is ~1e-14
             if not (lo < h_new < hi):
                 h_new = 0.5 * (lo + hi)
             if hi - lo <= 4e-16 * hi:
-                return h_new
+                return h_new, df
             h = h_new
         raise RuntimeError(f"force balance: no convergence for N = {N:.6g} in h = [{lo:.6g}, {hi:.6g}] m")
 
@@ -309,7 +317,10 @@ class _Core:
                              f"(no gas can be trapped); check the stiffness curve or r_start")
         h, _ = self.grid
         hh = np.concatenate(([hs], h[h > hs]))
-        slope = np.array([self.holding_force(float(x), N0, kappa0)[1] for x in hh])
+        r, rp, V, Vp, _ = self.geo.at_array(hh)
+        F, Fh = self.spring_array(hh)
+        pb = N0 * self.kT / V           # d/dh of F_hold, as in holding_force, on the grid
+        slope = 2 * math.pi * r * rp * (self.pa - pb) + math.pi * r * r * pb * Vp / V - kappa0 * Fh
         bad = np.flatnonzero(slope <= 0.0)
         if bad.size == 0:
             hm = self.h_hi
@@ -391,13 +402,14 @@ def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifeti
         return _result(core, F1, math.inf, "sealed",
                        f"u_c = 0 at h = {1e3 * sealed_at:.4g} mm on the way: the interface seals, no "
                        f"further leak", Fmax, N0, [0.0], [[N0, 0.0]], [h0], 0)
-    last = [h0]
+    last = [h0, N0, core.n_eq(h0, 1.0, F1)[1]]     # last root, its N and dN_eq/dh: a predictor
 
     def h_of(N: float) -> float:
         if N >= N_end:
             return h_end
-        h = core.branch_root(N, 1.0, F1, last[0], h0, h_end)
-        last[0] = h
+        guess = last[0] + (N - last[1]) / last[2] if last[2] > 0 else last[0]
+        h, slope = core.branch_root(N, 1.0, F1, guess, h0, h_end)
+        last[:] = h, N, slope
         return h
 
     Ndot_end = core.state(h_end, N_end, 1.0, E, F1)[0]
@@ -416,7 +428,7 @@ def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifeti
     ys = [[N0 + y[0], 0.0] for y in ys]
     if sol.event is not None:
         ys[-1][0] = N_end      # the event is N = N_end; only its time is interpolated
-    last[0] = h0
+    last[:] = h0, N0, core.n_eq(h0, 1.0, F1)[1]
     hs = [h_of(y[0]) for y in ys]
     if sol.event is None:
         return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s",
@@ -442,7 +454,7 @@ def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifetime
                 break
         top, why = core.branch_end(lo, kappa, F1)
         N_top = core.n_eq(top, kappa, F1)[0]
-        h = top if N >= N_top else core.branch_root(N, kappa, F1, last["h"], lo, top)
+        h = top if N >= N_top else core.branch_root(N, kappa, F1, last["h"], lo, top)[0]
         last["h"] = h
         return h, kappa, dk, E, N_top, why
 

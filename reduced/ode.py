@@ -161,6 +161,7 @@ def _locate(g, dense, t0, t1, g0, g1, iters: int = 60, guess: float | None = Non
     a, b, ga, gb = t0, t1, g0, g1
     side = 0
     tol = 1e-15 * max(abs(t1), 1e-300) + 1e-15 * (t1 - t0)
+    gtol = 1e-12 * (g1 - g0)           # |g| this small puts the event within 1e-12 of the step
     for it in range(iters):
         if gb == ga:
             break
@@ -170,6 +171,8 @@ def _locate(g, dense, t0, t1, g0, g1, iters: int = 60, guess: float | None = Non
         if not (a < c < b):
             c = 0.5 * (a + b)
         gc = g(c, dense(c))
+        if abs(gc) <= gtol:
+            return c, dense(c)
         if gc >= 0.0:
             b, gb = c, gc
             if side == 1:
