@@ -149,7 +149,9 @@ def run(args: argparse.Namespace) -> int:
     model = build_model(args)
     if args.uc_table is None and not args.json:
         print("note: using the ILLUSTRATIVE u_c table (reduced/data/uc_illustrative.csv)", file=sys.stderr)
-    progress = terminal_progress("lifetime") if len(args.force_N) > 4 else None
+    # a reference-mode lifetime takes milliseconds, a relaxed one ~0.1 s: report only long sweeps
+    cost = len(args.force_N) * (1 if model.reference else 30)
+    progress = terminal_progress("lifetime") if cost >= 100 else None
 
     def compute():
         return lifetime_sweep(model, args.force_N, progress=progress, t_max_s=args.t_max_s, rtol=args.rtol)
