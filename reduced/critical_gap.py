@@ -40,6 +40,7 @@ class UcTable:
     provenance: str = ""
     _log_p: list = field(init=False, repr=False, compare=False)
     _log_u: list = field(init=False, repr=False, compare=False)
+    _seal: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         p = np.array(self.p_over_E, dtype=float).reshape(-1)
@@ -63,12 +64,12 @@ class UcTable:
         object.__setattr__(self, "u_c_m", u)
         object.__setattr__(self, "_log_p", [math.log(v) for v in p[:open_rows]])
         object.__setattr__(self, "_log_u", [math.log(v) for v in u[:open_rows]])
+        object.__setattr__(self, "_seal", float(p[open_rows]) if open_rows < p.size else math.inf)
 
     @property
     def sealing_p_over_E(self) -> float:
         """Smallest tabulated p/E that is sealed (inf if none)."""
-        n = len(self._log_p)
-        return float(self.p_over_E[n]) if n < self.p_over_E.size else math.inf
+        return self._seal
 
     def __call__(self, p_over_E):
         """u_c [m] at p/E (float -> float, array -> array)."""
@@ -79,12 +80,11 @@ class UcTable:
     def scalar(self, x: float) -> float:
         if not x > 0:
             raise ValueError(f"p_over_E: contact pressure over modulus must be > 0, got {x}")
-        lp, lu = self._log_p, self._log_u
+        lp, lu, seal = self._log_p, self._log_u, self._seal
         n = len(lp)
-        seal = self.sealing_p_over_E
-        if x >= seal:
-            return 0.0
-        if n < self.p_over_E.size and x > self.p_over_E[n - 1]:
+        if seal < math.inf and x > self.p_over_E[n - 1]:
+            if x >= seal:
+                return 0.0
             # between the last open row and the first sealed row: linear in p/E down to 0
             p_last = float(self.p_over_E[n - 1])
             return float(self.u_c_m[n - 1]) * (seal - x) / (seal - p_last)

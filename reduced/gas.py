@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 __all__ = ["K_B", "ATOMIC_MASS", "XI", "Gas", "AIR", "WATER_VISCOSITY_PA_S",
            "diffusive_leak_rate", "ballistic_leak_rate", "average_mean_free_path",
@@ -40,15 +41,15 @@ class Gas:
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name}: must be > 0, got {value}")
 
-    @property
+    @cached_property
     def kT_J(self) -> float:
         return K_B * self.T_K
 
-    @property
+    @cached_property
     def mass_kg(self) -> float:
         return self.molecular_mass_u * ATOMIC_MASS
 
-    @property
+    @cached_property
     def mean_speed_m_s(self) -> float:
         """v = (8 kT / (pi m))^(1/2), eq (11)."""
         return math.sqrt(8.0 * self.kT_J / (math.pi * self.mass_kg))

@@ -6,7 +6,8 @@ One mechanism with two sources, both answering `at(h) -> (r, dr/dh, V, dV/dh, l)
 - `CurveGeometry`: the inner contact radius, cavity volume and strip width that a stiffness curve
   carries (e.g. from the FEM), interpolated by PCHIP over u = h1 - h.
 
-The cup detaches when r reaches r1, i.e. at the undeformed height h1 (u = 0): `h_detach_m`.
+The cup detaches when r reaches r1, i.e. at the undeformed height (u = 0): `h_detach_m`. The plate
+displacement u = h_ref_m - h is measured from `h_ref_m`, the source's undeformed height.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ class ConeGeometry:
         self.cup = cup
         self.r0, self.h0, self.V0 = cup.r0_m, cup.h0_m, cup.V0_m3
         self.l0, self.la = cup.l0_m, cup.l_a_m
-        self.h_detach_m = cup.h1_m
+        self.h_detach_m = self.h_ref_m = cup.h1_m
         self.h_min_m = 0.0
         self.h_start_m = cup.h_start_m
 
@@ -62,7 +63,7 @@ class CurveGeometry:
                              f"V_mm3; '{curve.provenance.get('source', '?')}' lacks "
                              f"{', '.join(m[:-2] + '_mm' for m in missing)}")
         self.cup = cup
-        self.h1 = curve.h1_m
+        self.h1 = self.h_ref_m = curve.h1_m
         self._r = ScalarPchip(curve.u_m, curve.r_c_m, "stiffness curve (u for r_c)")
         self._V = ScalarPchip(curve.u_m, curve.V_m3, "stiffness curve (u for V)")
         self._l = ScalarPchip(curve.u_m, curve.l_m, "stiffness curve (u for l)")

@@ -53,7 +53,7 @@ from scipy.optimize import brentq
 from reduced.appendix_a import appendix_a_curve
 from reduced.cup import CupParameters
 from reduced.fast_curve import CurveRangeError, ScalarPchip
-from reduced.gas import AIR, XI, Gas
+from reduced.gas import AIR, Gas, ballistic_share, interpolated_leak_rate
 from reduced.geometry import geometry_source
 from reduced.ode import dopri5
 from reduced.stiffness_curve import StiffnessCurve
@@ -71,7 +71,8 @@ _DYNAMIC_FOLD = 1e-4  # |D| / |D(0)| at which the relaxed dynamics is declared s
 class LeakageModel:
     """Everything a lifetime depends on except the pull force F1.
 
-    cup: geometry and Table 1 parameters. stiffness: F0 over u = h1 - h (any `StiffnessCurve`).
+    cup: geometry and Table 1 parameters. stiffness: F0 over u = h1 - h (any `StiffnessCurve`; with
+    the cone geometry h1 is the cup's, eq 3, with the curve geometry the curve's).
     u_c: critical gap [m] as a function of p/E (e.g. a `UcTable`). gas, p_a_Pa: the gas and the
     ambient pressure. relaxation: E_eff(t), or None for no relaxation (then kappa = 1 and E_Pa is the
     modulus in p/E). phi0_s: contact time of the stiffness measurement (default: eq 10 steady state
@@ -147,7 +148,7 @@ class LifetimeResult:
     def ballistic_share(self) -> float:
         """Share of the leaked molecules that went through eq (19)'s ballistic term."""
         if self.t_s.size < 2:
-            return float(self.ballistic_share_t[0]) if self.ballistic_share_t.size else float("nan")
+            return float(self.ballistic_share_t[0])
         total = _trapezoid(self.N_dot_per_s, self.t_s)
         if total <= 0:
             return float(self.ballistic_share_t[0])
@@ -181,13 +182,12 @@ class _Core:
     def __init__(self, m: LeakageModel):
         self.m = m
         self.geo = geometry_source(m.geometry, m.cup, m.stiffness)
-        self.h1 = self.geo.h_detach_m          # F0 is taken at u = h1 - h
+        self.h1 = self.geo.h_ref_m             # F0 is taken at u = h1 - h
         self.F0 = ScalarPchip(m.stiffness.u_m, m.stiffness.F0_N, "stiffness curve (u)")
+        self.gas = m.gas
         self.kT = m.gas.kT_J
         self.pa = m.p_a_Pa
         self.beta = m.cup.beta
-        self.lam_a = m.gas.mean_free_path_m(m.p_a_Pa)
-        self.flow_coef = 1.0 / (24.0 * self.kT * m.gas.viscosity_Pa_s)   # eq (23)
         self.uc = getattr(m.u_c, "scalar", m.u_c)
         self.relax = m.relaxation
         if self.relax is not None:
@@ -236,9 +236,8 @@ class _Core:
         pb = N * self.kT / V
         p = kappa * F / (2.0 * math.pi * r * l) + self.beta * (pa - pb)
         uc = self.uc(p / E)
-        x = XI * self.lam_a * pa / (pa + pb)       # xi <lambda>, eq (20)
-        Ndot = (2.0 * math.pi * r / l) * self.flow_coef * (pa * pa - pb * pb) * (uc * uc * uc + x * uc * uc)
-        share = x / (x + uc) if uc > 0 else 1.0
+        Ndot = interpolated_leak_rate(self.gas, pa, pb, uc, 2.0 * math.pi * r / l)
+        share = ballistic_share(self.gas, pa, pb, uc)
         return Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh
 
     # ------------------------------------------------------------------ the h grid
@@ -509,8 +508,10 @@ def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifetime
                        Fmax, N0, ts, sol_y, hs, sol.steps)
     last["h"] = hs[-1]
     reason = solve(sol_y[-1][0], max(sol_y[-1][1], 0.0))[5] if sol.event == 0 else "fold"
-    return _result(core, F1, ts[-1], reason, _end_message(reason, ts[-1]), Fmax, N0, ts,
-                   sol_y, hs, sol.steps)
+    msg = _end_message(reason, ts[-1])
+    if sol.event == 1:
+        msg += " (dynamic: D = G_h - (r' phi / l) G_phi -> 0, rdot diverges in eq 10)"
+    return _result(core, F1, ts[-1], reason, msg, Fmax, N0, ts, sol_y, hs, sol.steps)
 
 
 def _sealed_on_branch(core: _Core, h0: float, h_end: float, F1: float) -> float | None:
