@@ -173,3 +173,31 @@ def test_leaving_the_stiffness_curve_is_an_error_not_a_clamp():
 def test_bad_force_is_rejected(force):
     with pytest.raises(ValueError, match="force_N: pull force must be > 0 N"):
         lifetime(REF_A, force)
+
+
+def test_initial_state_and_leak_rate_by_hand():
+    """t = 0+ from eqs (3)-(9), (20), (23) written out here, independently of the model's code."""
+    F1, c = 20.0, CUP_A
+    r = lifetime(REF_A, F1)
+    k_B, T, pa = 1.380649e-23, 293.15, 1e5
+    kT = k_B * T
+    h, rr = r.h_m[0], r.r_m[0]
+    F0 = appendix_a_force(c.h1_m - h, 33.0, 4e6, 2e-3, c.r0_m, c.r1_m)
+    V = math.pi * c.r0_m ** 2 * c.h0_m / 3 * ((rr / c.r0_m) ** 3 - 1)          # eq (4)
+    pb = pa - (F0 + F1) / (math.pi * rr ** 2)                                   # eq (7)
+    assert r.p_b_Pa[0] == pytest.approx(pb, rel=1e-10)
+    assert r.N0 == pytest.approx(pb * V / kT, rel=1e-10)                        # eq (8), N fixed at t=0
+    l = 4e-3 + (0.8e-3 - 4e-3) / (1 - 19 / 5) * (1 - rr / c.r0_m)             # eq (5)
+    p = F0 / (2 * math.pi * rr * l) + 0.8 * (pa - pb)                            # eq (6)
+    # the model's F0 is the PCHIP of 401 samples of the closed form: ~1e-7 relative (see inputs tests)
+    assert r.p_Pa[0] == pytest.approx(p, rel=1e-7)
+    uc = 0.68e-6 * (p / 4e6 / 0.025) ** -1                                       # the illustrative law
+    assert r.u_c_m[0] == pytest.approx(uc, rel=1e-7)
+    m = 28.97 * 1.66053906660e-27
+    vbar = math.sqrt(8 * kT / (math.pi * m))                                     # eq (11)
+    lam_a = 3 * 1.81e-5 / (m * (pa / kT) * vbar)                                 # eq (12)
+    lam_b = 3 * 1.81e-5 / (m * (pb / kT) * vbar)                                 # eq (12) at p_b
+    lam = 0.5 * (pa * lam_a + pb * lam_b) / (pa + pb)                            # eq (20)
+    Ndot = (2 * math.pi * rr / l) * (pa ** 2 - pb ** 2) / (24 * kT) * uc ** 3 / 1.81e-5 * (
+        1 + 32 / math.pi * lam / uc)                                             # eqs (9), (23)
+    assert r.N_dot_per_s[0] == pytest.approx(Ndot, rel=1e-6)
