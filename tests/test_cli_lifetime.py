@@ -88,3 +88,15 @@ def test_example_writes_table_and_figure(capsys, tmp_path):
     assert all(math.isfinite(t) and t > 0 for t in lives)
     png = (tmp_path / "ex" / "lifetime_vs_force.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+
+
+def test_stiffness_csv_is_the_same_mechanism_as_appendix_a(capsys, tmp_path):
+    from reduced.appendix_a import appendix_a_curve
+    path = appendix_a_curve(CUP_A).to_csv(tmp_path / "F0.csv")
+    code, out, _ = _run(capsys, "lifetime", "--stiffness", str(path), "--force", "20", "--json")
+    code_ref, out_ref, _ = _run(capsys, "lifetime", "--reference-mode", "--force", "20", "--json")
+    assert code == code_ref == 0
+    # the CSV holds the same samples to 10 digits: the same lifetime to ~1e-9
+    assert json.loads(out)[0]["lifetime_s"] == pytest.approx(json.loads(out_ref)[0]["lifetime_s"], rel=1e-7)
+    code, _, err = _run(capsys, "lifetime", "--stiffness", str(path), "--geometry", "curve", "--force", "20")
+    assert code == 2 and "geometry: 'curve' needs" in err

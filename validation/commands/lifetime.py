@@ -80,7 +80,7 @@ def build_model(args: argparse.Namespace):
     from reduced.appendix_a import appendix_a_curve
     from reduced.cup import cup_by_name
     from reduced.gas import Gas
-    from reduced.lifetime import LeakageModel, reference_model
+    from reduced.lifetime import LeakageModel, largest_holdable_force, reference_model
     from reduced.stiffness_curve import StiffnessCurve
     from reduced.viscoelastic import RelaxationModulus, default_relaxation
 
@@ -115,9 +115,11 @@ def build_model(args: argparse.Namespace):
     else:
         relax = RelaxationModulus.from_csv(args.relaxation)
     gas = Gas(T_K=args.T_K)
-    return LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
-                        E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
-                        geometry=args.geometry)
+    model = LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
+                         E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
+                         geometry=args.geometry)
+    largest_holdable_force(model)   # builds the start state: checks geometry and curve range now
+    return model
 
 
 def _has_h(path: str) -> bool:
