@@ -53,7 +53,8 @@ from scipy.optimize import brentq
 from reduced.appendix_a import appendix_a_curve
 from reduced.cup import CupParameters
 from reduced.fast_curve import CurveRangeError, ScalarPchip
-from reduced.gas import AIR, Gas, ballistic_share, interpolated_leak_rate
+from reduced.gas import (AIR, WATER_VISCOSITY_PA_S, Gas, ballistic_share, interpolated_leak_rate,
+                         liquid_volume_rate)
 from reduced.geometry import geometry_source
 from reduced.ode import dopri5
 from reduced.stiffness_curve import StiffnessCurve
@@ -77,7 +78,9 @@ class LeakageModel:
     ambient pressure. relaxation: E_eff(t), or None for no relaxation (then kappa = 1 and E_Pa is the
     modulus in p/E). phi0_s: contact time of the stiffness measurement (default: eq 10 steady state
     at the paper's 0.12 mm/s, see `measurement_contact_time`). geometry: 'cone' (eqs 3-5) or 'curve'
-    (r, V, l from the stiffness curve).
+    (r, V, l from the stiffness curve). fluid: 'air' (the gas leaks in, eqs 8, 19) or 'water' (the
+    cavity is full of an incompressible liquid that flows in by eq 24; its "content" is the liquid
+    volume, p_b follows from the force balance and may become negative, i.e. tension, Sec. 6).
     """
 
     cup: CupParameters
@@ -89,6 +92,8 @@ class LeakageModel:
     relaxation: RelaxationModulus | None = None
     phi0_s: float | None = None
     geometry: str = "cone"
+    fluid: str = "air"
+    liquid_viscosity_Pa_s: float = WATER_VISCOSITY_PA_S
     label: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
@@ -100,6 +105,12 @@ class LeakageModel:
             raise ValueError(f"phi0_s: measurement contact time must be > 0 s, got {self.phi0_s}")
         if self.geometry not in ("cone", "curve"):
             raise ValueError(f"geometry: unknown source '{self.geometry}', allowed: cone, curve")
+        if self.fluid not in ("air", "water"):
+            raise ValueError(f"fluid: unknown fluid '{self.fluid}', allowed: air, water")
+        if self.fluid == "water" and self.relaxation is not None:
+            raise ValueError("fluid: the water-filled cavity is implemented without relaxation only")
+        if not (math.isfinite(self.liquid_viscosity_Pa_s) and self.liquid_viscosity_Pa_s > 0):
+            raise ValueError(f"liquid_viscosity_Pa_s: must be > 0, got {self.liquid_viscosity_Pa_s}")
 
     @property
     def reference(self) -> bool:
@@ -139,6 +150,7 @@ class LifetimeResult:
     ballistic_share_t: np.ndarray
     force_residual: np.ndarray
     steps: int = 0
+    fluid: str = "air"
 
     @property
     def sealed(self) -> bool:
@@ -159,7 +171,8 @@ class LifetimeResult:
         return {"force_N": self.force_N,
                 "lifetime_s": self.lifetime_s if math.isfinite(self.lifetime_s) else None,
                 "reason": self.reason, "sealed": self.sealed,
-                "ballistic_share": self.ballistic_share, "largest_force_N": self.largest_force_N,
+                "ballistic_share": self.ballistic_share,
+                "largest_force_N": self.largest_force_N if math.isfinite(self.largest_force_N) else None,
                 "r_final_mm": 1e3 * float(self.r_m[-1]), "p_b_final_Pa": float(self.p_b_Pa[-1]),
                 "steps": self.steps, "message": self.message}
 
@@ -167,8 +180,9 @@ class LifetimeResult:
         """Trajectory arrays under CSV column names that carry their units."""
         return {"t_s": self.t_s, "r_mm": 1e3 * self.r_m, "h_mm": 1e3 * self.h_m,
                 "p_b_Pa": self.p_b_Pa, "p_Pa": self.p_Pa, "u_c_nm": 1e9 * self.u_c_m,
-                "N": self.N, "N_dot_per_s": self.N_dot_per_s, "phi_s": self.phi_s,
-                "ballistic_share": self.ballistic_share_t}
+                **({"N": self.N, "N_dot_per_s": self.N_dot_per_s} if self.fluid == "air" else
+                   {"V_liquid_mm3": 1e9 * self.N, "V_dot_mm3_per_s": 1e9 * self.N_dot_per_s}),
+                "phi_s": self.phi_s, "ballistic_share": self.ballistic_share_t}
 
 
 def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
@@ -185,6 +199,7 @@ class _Core:
         self.h1 = self.geo.h_ref_m             # F0 is taken at u = h1 - h
         self.F0 = ScalarPchip(m.stiffness.u_m, m.stiffness.F0_N, "stiffness curve (u)")
         self.gas = m.gas
+        self.liquid = m.fluid == "water"
         self.kT = m.gas.kT_J
         self.pa = m.p_a_Pa
         self.beta = m.cup.beta
@@ -211,8 +226,13 @@ class _Core:
         return F, -dF_du
 
     def n_eq(self, h: float, kappa: float, F1: float) -> tuple[float, float]:
-        """N_eq(h) and dN_eq/dh on the equilibrium branch (eqs 3, 4, 7, 8)."""
+        """N_eq(h) and dN_eq/dh on the equilibrium branch (eqs 3, 4, 7, 8).
+
+        For a liquid-filled cavity the content is the liquid volume: V(h) and dV/dh (eq 4).
+        """
         r, rp, V, Vp, _ = self.geo.at(h)
+        if self.liquid:
+            return V, Vp
         F, Fh = self.spring(h)
         A = math.pi * r * r
         X = (kappa * F + F1) / A
@@ -233,9 +253,15 @@ class _Core:
         r, rp, V, Vp, l = self.geo.at(h)
         F, Fh = self.spring(h)
         pa = self.pa
-        pb = N * self.kT / V
+        if self.liquid:          # p_b from the force balance (7); volume flow eq (24)
+            pb = pa - (kappa * F + F1) / (math.pi * r * r)
+        else:                    # p_b from the ideal gas (8); molecule flow eqs (9), (19)
+            pb = N * self.kT / V
         p = kappa * F / (2.0 * math.pi * r * l) + self.beta * (pa - pb)
         uc = self.uc(p / E)
+        if self.liquid:
+            return (liquid_volume_rate(self.m.liquid_viscosity_Pa_s, pa, pb, uc, 2.0 * math.pi * r / l),
+                    pb, p, uc, 0.0, r, rp, l, V, Vp, F, Fh)
         Ndot = interpolated_leak_rate(self.gas, pa, pb, uc, 2.0 * math.pi * r / l)
         share = ballistic_share(self.gas, pa, pb, uc)
         return Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh
@@ -259,6 +285,8 @@ class _Core:
 
     def branch_end(self, h_from: float, kappa: float, F1: float) -> tuple[float, str]:
         """First local maximum of N_eq above h_from (the fold), or the detachment height."""
+        if self.liquid:              # V(h) increases: a liquid-filled cup always reaches r1
+            return self.h_hi, "reached_r1" if self.h_hi >= self.geo.h_detach_m * (1 - 1e-12) else "fold"
         h, S = self.grid
         i0 = int(np.searchsorted(h, h_from, side="right"))
         d = S[0, i0:] - kappa * S[1, i0:] - F1 * S[2, i0:]
@@ -311,6 +339,8 @@ class _Core:
             raise CurveRangeError(f"stiffness curve: r_start needs h = {1e3 * hs:.6g} mm, outside the "
                                   f"curve's range [{1e3 * self.h_lo:.6g}, {1e3 * self.h_hi:.6g}] mm")
         N0 = self.n_eq(hs, kappa0, 0.0)[0]
+        if self.liquid:   # incompressible: h stays at h_start when F1 is applied; p_b takes it all
+            return hs, N0, kappa0, math.inf, hs
         if N0 <= 0:
             raise ValueError(f"r_start_m: the stiffness force at r_start exceeds the full vacuum force "
                              f"(no gas can be trapped); check the stiffness curve or r_start")
@@ -366,8 +396,8 @@ def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol
         msg = (f"F1 = {F1:g} N is at or above the largest force the cup can hold at t = 0, "
                f"{Fmax:.4g} N: it detaches at once")
         return _result(core, F1, 0.0, "over_force", msg, Fmax, N0, [0.0], [[N0, 0.0]], [hs], 0)
-    h0 = brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
-                xtol=1e-15 * core.h1, rtol=1e-15)
+    h0 = hs if core.liquid else brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
+                                       xtol=1e-15 * core.h1, rtol=1e-15)
     run = _run_reference if model.reference else _run_relaxed
     result = run(core, F1, N0, h0, Fmax, t_max_s, rtol, refine)
     if progress:
@@ -544,7 +574,7 @@ def _result(core: _Core, F1, t_life, reason, msg, Fmax, N0, ts, ys, hs, steps) -
     a = np.array(rows, dtype=float).T
     for arr in a:
         arr.flags.writeable = False
-    return LifetimeResult(force_N=F1, lifetime_s=float(t_life), reason=reason, message=msg,
+    return LifetimeResult(force_N=F1, lifetime_s=float(t_life), reason=reason, message=msg, fluid=core.m.fluid,
                           largest_force_N=float(Fmax), N0=float(N0), t_s=a[0], r_m=a[1], h_m=a[2],
                           p_b_Pa=a[3], p_Pa=a[4], u_c_m=a[5], N=a[6], N_dot_per_s=a[7], phi_s=a[8],
                           ballistic_share_t=a[9], force_residual=a[10], steps=steps)
@@ -578,8 +608,8 @@ def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 
     hs, N0, kappa0, Fmax, hm = core.initial
     if F1 >= Fmax:
         return 0.0
-    h0 = brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
-                                   xtol=1e-15 * core.h1, rtol=1e-15)
+    h0 = hs if core.liquid else brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
+                                       xtol=1e-15 * core.h1, rtol=1e-15)
     h_end, _ = core.branch_end(h0, 1.0, F1)
 
     def integrand(h: float) -> float:

@@ -61,6 +61,8 @@ def test_out_writes_trajectories_atomically(capsys, tmp_path):
     (["--relaxation", "/nonexistent/E.csv"], "relaxation: no such file"),
     (["--reference-mode", "--E-MPa", "3"], "--reference-mode: fixes --E-MPa"),
     (["--E-MPa", "0"], "--E-MPa: modulus must be > 0 MPa"),
+    (["--fluid", "water", "--relaxation", "default"], "fluid: the water-filled cavity"),
+    (["--reference-mode", "--fluid", "water"], "--reference-mode: fixes --fluid"),
 ])
 def test_bad_input_exits_2_with_one_line_and_no_output(capsys, tmp_path, argv, message):
     out = tmp_path / "out"
@@ -74,7 +76,7 @@ def test_help_names_every_unit(capsys):
     with pytest.raises(SystemExit):
         main(["lifetime", "--help"])
     text = capsys.readouterr().out
-    for unit in ("F1_N", "in MPa", "in mm", "in K", "in Pa", "in s", "u_c in m"):
+    for unit in ("F1_N", "in MPa", "in mm", "in K", "in Pa", "in s", "u_c in m", "in Pa s"):
         assert unit in text
 
 
@@ -100,3 +102,12 @@ def test_stiffness_csv_is_the_same_mechanism_as_appendix_a(capsys, tmp_path):
     assert json.loads(out)[0]["lifetime_s"] == pytest.approx(json.loads(out_ref)[0]["lifetime_s"], rel=1e-7)
     code, _, err = _run(capsys, "lifetime", "--stiffness", str(path), "--geometry", "curve", "--force", "20")
     assert code == 2 and "geometry: 'curve' needs" in err
+
+
+def test_water_json(capsys):
+    code, out, _ = _run(capsys, "lifetime", "--fluid", "water", "--force", "10", "--json")
+    row = json.loads(out)[0]
+    assert code == 0 and row["reason"] == "reached_r1" and row["largest_force_N"] is None
+    _, out_air, _ = _run(capsys, "lifetime", "--force", "10", "--json")
+    # "the much higher viscosity of water than of air results in a longer failure time" (Sec. 5.4)
+    assert row["lifetime_s"] > 10 * json.loads(out_air)[0]["lifetime_s"]

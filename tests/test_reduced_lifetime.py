@@ -201,3 +201,34 @@ def test_initial_state_and_leak_rate_by_hand():
     Ndot = (2 * math.pi * rr / l) * (pa ** 2 - pb ** 2) / (24 * kT) * uc ** 3 / 1.81e-5 * (
         1 + 32 / math.pi * lam / uc)                                             # eqs (9), (23)
     assert r.N_dot_per_s[0] == pytest.approx(Ndot, rel=1e-6)
+
+
+def test_water_filled_cavity_eq24_against_an_independent_ode():
+    """Liquid mode: h stays at h_start when F1 is applied, then dh/dt = Vdot(eq 24) / V'(h) to r1."""
+    from scipy.integrate import solve_ivp
+    water = dataclasses.replace(REF_A, fluid="water")
+    F1, c = 40.0, CUP_A
+    r = lifetime(water, F1)
+    assert r.reason == "reached_r1" and r.h_m[0] == pytest.approx(c.h_start_m, rel=1e-14)
+    assert r.lifetime_s == pytest.approx(lifetime_by_quadrature(water, F1), rel=1e-4)
+    assert "V_liquid_mm3" in r.trajectory_columns() and r.summary()["largest_force_N"] is None
+
+    def hdot(t, y):   # eqs (3)-(7), (24) by hand, scipy's integrator
+        h = y[0]
+        rr = c.r0_m * (1 + h / c.h0_m)
+        F0 = appendix_a_force(c.h1_m - h, 33.0, 4e6, 2e-3, c.r0_m, c.r1_m)
+        pb = 1e5 - (F0 + F1) / (math.pi * rr ** 2)
+        l = c.contact_width(rr)
+        p = F0 / (2 * math.pi * rr * l) + 0.8 * (1e5 - pb)
+        uc = 0.68e-6 * 0.025 / (p / 4e6)
+        Vdot = (2 * math.pi * rr / l) * uc ** 3 * (1e5 - pb) / (12 * 1.002e-3)
+        dVdh = math.pi * c.r0_m ** 2 * c.h0_m * (rr / c.r0_m) ** 2 / c.h0_m
+        return [Vdot / dVdh]
+
+    top = lambda t, y: y[0] - c.h1_m
+    top.terminal = True
+    sol = solve_ivp(hdot, (0, 1e9), [c.h_start_m], method="LSODA", rtol=1e-10, atol=1e-15, events=top)
+    # the model samples F0 by PCHIP (1e-7) and integrates at rtol 1e-6
+    assert r.lifetime_s == pytest.approx(sol.t_events[0][0], rel=1e-5)
+    with pytest.raises(ValueError, match="fluid"):
+        dataclasses.replace(REF_A, fluid="oil")

@@ -51,6 +51,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--geometry", default="cone", choices=("cone", "curve"),
                    help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 (cone) or from the "
                         "stiffness CSV's r_c_mm, V_mm3, l_mm columns (curve) (default: cone)")
+    p.add_argument("--fluid", default="air", choices=("air", "water"),
+                   help="what fills the cavity and leaks in: air (ideal gas, eqs 8, 19) or water "
+                        "(incompressible, eq 24; p_b from the force balance, may be negative) (default: air)")
+    p.add_argument("--liquid-viscosity-Pa-s", dest="liquid_viscosity", type=float, default=1.002e-3,
+                   help="viscosity of the liquid in Pa s for --fluid water (default: 1.002e-3, water at 20 C)")
     p.add_argument("--T-K", dest="T_K", type=float, default=293.15, help="temperature in K (default: 293.15)")
     p.add_argument("--p-a-Pa", dest="p_a_Pa", type=float, default=1e5,
                    help="ambient pressure in Pa (default: 1e5)")
@@ -96,7 +101,8 @@ def build_model(args: argparse.Namespace):
             ("--stiffness", args.stiffness, "appendix-a"), ("--E-MPa", args.E_MPa, 4.0),
             ("--d0-mm", args.d0_mm, 2.0), ("--relaxation", args.relaxation, "none"),
             ("--geometry", args.geometry, "cone"), ("--T-K", args.T_K, 293.15),
-            ("--p-a-Pa", args.p_a_Pa, 1e5), ("--phi0-s", args.phi0_s, None)) if val != default]
+            ("--p-a-Pa", args.p_a_Pa, 1e5), ("--phi0-s", args.phi0_s, None),
+            ("--fluid", args.fluid, "air")) if val != default]
         if changed:
             raise ValueError(f"--reference-mode: fixes {', '.join(changed)}; drop them")
         return reference_model(cup, uc)
@@ -117,7 +123,8 @@ def build_model(args: argparse.Namespace):
     gas = Gas(T_K=args.T_K)
     model = LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
                          E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
-                         geometry=args.geometry)
+                         geometry=args.geometry, fluid=args.fluid,
+                         liquid_viscosity_Pa_s=args.liquid_viscosity)
     largest_holdable_force(model)   # builds the start state: checks geometry and curve range now
     return model
 
