@@ -32,6 +32,13 @@ End (reason): "reached_r1", "fold" (static fold, or with relaxation the dynamic 
 where rdot diverges), "over_force" (t = 0), "sealed" (u_c = 0 somewhere on the way: the leak rate
 vanishes, the lifetime is infinite) or "horizon" (still holding at t_max).
 
+With relaxation, phi(0) = 0 and E_eff is held at its first sample for shorter times, so the spring
+starts at kappa0 = E_eff(phi=0)/E_eff(phi0) (1.25 for cup A with the default law); N0 is fixed with it.
+
+Liquid (fluid='water'): the cavity is full of an incompressible liquid; its volume V(h) is the
+content, p_b follows from eq (7), the inflow is eq (24). F1 leaves h at h_start (p_b drops by
+F1 / (pi r^2), possibly below zero: tension; no cavitation model) and the cup detaches at r1.
+
 Reference mode (`reference_model`): Appendix A stiffness (x0 = r0, x1 = r1, d0 = 2 mm, d1 = 0,
 E = 4 MPa), no relaxation (kappa = 1, E = 4 MPa for p/E), air at 293.15 K (eta = 1.81e-5 Pa s,
 m = 28.97 u), p_a = 1e5 Pa, lambda_a from eq (12) at p_a, u_c from the given table, rigid-cone
