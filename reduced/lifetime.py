@@ -291,24 +291,29 @@ class _Core:
         return h, S
 
     def branch_end(self, h_from: float, kappa: float, F1: float) -> tuple[float, str]:
-        """First local maximum of N_eq above h_from (the fold), or the detachment height."""
-        if self.liquid:              # V(h) increases: a liquid-filled cup always reaches r1
-            return self.h_hi, "reached_r1" if self.h_hi >= self.geo.h_detach_m * (1 - 1e-12) else "fold"
-        h, S = self.grid
-        i0 = int(np.searchsorted(h, h_from, side="right"))
-        d = S[0, i0:] - kappa * S[1, i0:] - F1 * S[2, i0:]
-        bad = np.flatnonzero(d <= 0.0)
-        if self.n_eq(h_from, kappa, F1)[1] <= 0.0:
-            return h_from, "fold"
-        if bad.size == 0:
-            if self.n_eq(self.h_hi, kappa, F1)[1] > 0.0 or self.h_hi >= self.geo.h_detach_m:
-                return self.h_hi, "reached_r1" if self.h_hi >= self.geo.h_detach_m * (1 - 1e-12) else "fold"
-            bad = np.array([h.size - 1 - i0])
-        j = i0 + int(bad[0])
-        a = h_from if j == i0 else float(h[j - 1])
-        b = float(h[j])
-        hf = brentq(lambda x: self.n_eq(x, kappa, F1)[1], a, b, xtol=1e-15 * self.h1, rtol=1e-14)
-        return hf, "fold"
+        """First local maximum of N_eq above h_from (the fold), else the detachment height (r = r1).
+
+        The sign of dN_eq/dh is scanned on the grid and the fold refined by brentq. A liquid-filled
+        cavity has no fold (V(h) increases). Raises `CurveRangeError` if the stiffness curve ends
+        below the detachment height, since the cup would then leave the curve.
+        """
+        if not self.liquid:
+            if self.n_eq(h_from, kappa, F1)[1] <= 0.0:
+                return h_from, "fold"
+            h, S = self.grid
+            i0 = int(np.searchsorted(h, h_from, side="right"))
+            bad = np.flatnonzero(S[0, i0:] - kappa * S[1, i0:] - F1 * S[2, i0:] <= 0.0)
+            if bad.size:
+                j = i0 + int(bad[0])
+                a = h_from if j == i0 else float(h[j - 1])
+                hf = brentq(lambda x: self.n_eq(x, kappa, F1)[1], a, float(h[j]),
+                            xtol=1e-15 * self.h1, rtol=1e-14)
+                return hf, "fold"
+        if self.h_hi < self.geo.h_detach_m * (1 - 1e-12):
+            raise CurveRangeError(
+                f"stiffness curve: the cup moves towards r1 (u = 0) but the curve starts at "
+                f"u = {1e3 * (self.h1 - self.h_hi):.4g} mm; extend it to u = 0")
+        return self.h_hi, "reached_r1"
 
     def branch_root(self, N: float, kappa: float, F1: float, h_guess: float, lo: float,
                     hi: float) -> tuple[float, float]:

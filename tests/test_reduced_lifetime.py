@@ -165,6 +165,10 @@ def test_leaving_the_stiffness_curve_is_an_error_not_a_clamp():
     short = StiffnessCurve(u, 2.5e3 * u, CUP_A.h1_m, provenance={"source": "short"})
     with pytest.raises(CurveRangeError, match="outside the curve's range"):
         lifetime(dataclasses.replace(REF_A, stiffness=short), 10.0)
+    u = np.linspace(1e-3, CUP_A.h1_m, 81)            # starts at u = 1 mm: cannot reach r1
+    late = StiffnessCurve(u, 2.5e3 * u, CUP_A.h1_m, provenance={"source": "late"})
+    with pytest.raises(CurveRangeError, match="extend it to u = 0"):
+        lifetime(dataclasses.replace(REF_A, stiffness=late), 10.0)
     with pytest.raises(ValueError, match="geometry: 'curve' needs"):
         lifetime(dataclasses.replace(REF_A, geometry="curve"), 10.0)
 
