@@ -41,7 +41,8 @@ class CupParameters:
     def __post_init__(self) -> None:
         _check(self.r0_m > 0, f"r0_m: top-plate radius must be > 0 m, got {self.r0_m}")
         _check(self.r1_m > self.r0_m, f"r1_m: rim radius must exceed r0 = {self.r0_m} m, got {self.r1_m}")
-        _check(0 < self.alpha_deg < 90, f"alpha_deg: cone angle must be in (0, 90) degrees, got {self.alpha_deg}")
+        _check(0 < self.alpha_deg < 90,
+               f"alpha_deg: cone angle must be in (0, 90) degrees, got {self.alpha_deg}")
         _check(self.r0_m < self.r_start_m < self.r1_m,
                f"r_start_m: start radius must be in ({self.r0_m}, {self.r1_m}) m, got {self.r_start_m}")
         _check(self.l0_m > 0 and self.l1_m > 0,

@@ -96,7 +96,8 @@ def interpolated_leak_rate(gas: Gas, p_a, p_b, u_c, Ly_over_Lx):
 def leak_rate_function(gas: Gas, p_a, p_b, u_c):
     """Square-unit leak rate f(p, p_a, p_b) of eq (23), molecules per second."""
     lam = average_mean_free_path(gas, p_a, p_b)
-    return (p_a * p_a - p_b * p_b) / (24.0 * gas.kT_J * gas.viscosity_Pa_s) * (u_c ** 3 + XI * lam * u_c * u_c)
+    diffusive = (p_a * p_a - p_b * p_b) / (24.0 * gas.kT_J * gas.viscosity_Pa_s)
+    return diffusive * (u_c ** 3 + XI * lam * u_c * u_c)
 
 
 def ballistic_share(gas: Gas, p_a, p_b, u_c):

@@ -253,7 +253,8 @@ class _Core:
         F, Fh = self.spring(h)
         pb = N0 * self.kT / V
         A = math.pi * r * r
-        return A * (self.pa - pb) - kappa * F, 2 * math.pi * r * rp * (self.pa - pb) + A * pb * Vp / V - kappa * Fh
+        F_hold = A * (self.pa - pb) - kappa * F
+        return F_hold, 2 * math.pi * r * rp * (self.pa - pb) + A * pb * Vp / V - kappa * Fh
 
     def state(self, h: float, N: float, kappa: float, E: float, F1: float):
         """(Ndot, p_b, p, u_c, ballistic share, r, rp, l, V, Vp, F, Fh) at a point, eqs (6), (9), (23)."""
@@ -586,7 +587,8 @@ def _result(core: _Core, F1, t_life, reason, msg, Fmax, N0, ts, ys, hs, steps) -
     a = np.array(rows, dtype=float).T
     for arr in a:
         arr.flags.writeable = False
-    return LifetimeResult(force_N=F1, lifetime_s=float(t_life), reason=reason, message=msg, fluid=core.m.fluid,
+    return LifetimeResult(force_N=F1, lifetime_s=float(t_life), reason=reason, message=msg,
+                          fluid=core.m.fluid,
                           largest_force_N=float(Fmax), N0=float(N0), t_s=a[0], r_m=a[1], h_m=a[2],
                           p_b_Pa=a[3], p_Pa=a[4], u_c_m=a[5], N=a[6], N_dot_per_s=a[7], phi_s=a[8],
                           ballistic_share_t=a[9], force_residual=a[10], steps=steps)

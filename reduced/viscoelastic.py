@@ -76,7 +76,8 @@ class RelaxationModulus:
         """E_eff(t) [Pa] (float or array)."""
         if np.ndim(t_s) == 0:
             return self.modulus_and_log_slope(float(t_s))[0]
-        return np.array([self.modulus_and_log_slope(float(v))[0] for v in np.ravel(t_s)]).reshape(np.shape(t_s))
+        values = [self.modulus_and_log_slope(float(v))[0] for v in np.ravel(t_s)]
+        return np.array(values).reshape(np.shape(t_s))
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike) -> RelaxationModulus:

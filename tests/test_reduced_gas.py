@@ -22,7 +22,8 @@ def test_eta_lambda_vbar_are_consistent_through_eq12():
         # n lambda does not depend on the density
         assert n * lam == pytest.approx(AIR.number_density(PA) * AIR.mean_free_path_m(PA), rel=1e-13)
     # eq (11) by hand for air at 20 C: sqrt(8 kT / (pi m)) = 462.9 m/s (4 digits of the constants)
-    assert AIR.mean_speed_m_s == pytest.approx(math.sqrt(8 * K_B * 293.15 / (math.pi * 28.97 * 1.6605e-27)), rel=1e-4)
+    by_hand = math.sqrt(8 * K_B * 293.15 / (math.pi * 28.97 * 1.6605e-27))
+    assert AIR.mean_speed_m_s == pytest.approx(by_hand, rel=1e-4)
     # "the mean free path of a gas molecule at atmospheric pressure is of order 100 nm" (Sec. 2)
     assert 80e-9 < AIR.mean_free_path_m(PA) < 120e-9
 

@@ -138,7 +138,8 @@ def test_default_relaxation_goes_through_the_papers_two_values_and_has_a_plateau
 def test_measurement_contact_time_cup_A_is_13_s():
     # l(12 mm) = 2.4 mm (eq 5), rdot = 0.12 mm/s / tan 33 deg = 0.1848 mm/s (eq 3)
     assert CUP_A.contact_width(12e-3) == pytest.approx(2.4e-3, rel=1e-12)
-    assert measurement_contact_time(CUP_A) == pytest.approx(2.4 / (0.12 / math.tan(math.radians(33))), rel=1e-12)
+    rdot_mm_s = 0.12 / math.tan(math.radians(33))
+    assert measurement_contact_time(CUP_A) == pytest.approx(2.4 / rdot_mm_s, rel=1e-12)
     assert measurement_contact_time(CUP_A) == pytest.approx(12.99, abs=0.01)
 
 

@@ -55,7 +55,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="what fills the cavity and leaks in: air (ideal gas, eqs 8, 19) or water "
                         "(incompressible, eq 24; p_b from the force balance, may be negative) (default: air)")
     p.add_argument("--liquid-viscosity-Pa-s", dest="liquid_viscosity", type=float, default=1.002e-3,
-                   help="viscosity of the liquid in Pa s for --fluid water (default: 1.002e-3, water at 20 C)")
+                   help="viscosity of the liquid in Pa s for --fluid water "
+                        "(default: 1.002e-3, water at 20 C)")
     p.add_argument("--T-K", dest="T_K", type=float, default=293.15, help="temperature in K (default: 293.15)")
     p.add_argument("--p-a-Pa", dest="p_a_Pa", type=float, default=1e5,
                    help="ambient pressure in Pa (default: 1e5)")
