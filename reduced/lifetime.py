@@ -512,10 +512,10 @@ def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifetime
         hdot = -(G_N * Ndot + G_phi) / D
         return Ndot, 1.0 - a * hdot, D
 
-    def rhs(t, y):      # y = (N - N0, phi)
+    def rhs(t, y):      # y = (N - N0, phi); beyond the branch's end continued with the end values
         N, phi = N0 + y[0], max(y[1], 0.0)
-        h, kappa, dk, E, _, _ = solve(N, phi)
-        Ndot, phidot, _ = derivatives(h, N, phi, kappa, dk, E)
+        h, kappa, dk, E, N_top, _ = solve(N, phi)
+        Ndot, phidot, _ = derivatives(h, min(N, N_top), phi, kappa, dk, E)
         return [Ndot, phidot]
 
     D0 = abs(derivatives(h0, N0, 0.0, *core.modulus(0.0))[2])
@@ -526,8 +526,8 @@ def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifetime
 
     def dynamic_fold(t, y):       # D -> 0: rdot diverges
         phi = max(y[1], 0.0)
-        h, kappa, dk, E, _, _ = solve(N0 + y[0], phi)
-        return _DYNAMIC_FOLD - abs(derivatives(h, N0 + y[0], phi, kappa, dk, E)[2]) / D0
+        h, kappa, dk, E, N_top, _ = solve(N0 + y[0], phi)
+        return _DYNAMIC_FOLD - abs(derivatives(h, min(N0 + y[0], N_top), phi, kappa, dk, E)[2]) / D0
 
     Ndot0 = rhs(0.0, [0.0, 0.0])[0]
     if Ndot0 <= 0.0:
