@@ -54,13 +54,18 @@ class Gas:
         """v = (8 kT / (pi m))^(1/2), eq (11)."""
         return math.sqrt(8.0 * self.kT_J / (math.pi * self.mass_kg))
 
+    @cached_property
+    def n_lambda_per_m2(self) -> float:
+        """n lambda = 3 eta / (m v), independent of the density (eq 12)."""
+        return 3.0 * self.viscosity_Pa_s / (self.mass_kg * self.mean_speed_m_s)
+
     def number_density(self, p_Pa):
         """n = p / kT [1/m^3] (ideal gas)."""
         return p_Pa / self.kT_J
 
     def mean_free_path_m(self, p_Pa):
         """lambda = 3 eta / (m n v) from eta = m n v lambda / 3, eq (12)."""
-        return 3.0 * self.viscosity_Pa_s / (self.mass_kg * self.number_density(p_Pa) * self.mean_speed_m_s)
+        return self.n_lambda_per_m2 / self.number_density(p_Pa)
 
 
 #: air at 20 deg C
@@ -80,9 +85,10 @@ def ballistic_leak_rate(gas: Gas, p_a, p_b, u_c, Ly_over_Lx):
 def average_mean_free_path(gas: Gas, p_a, p_b):
     """<lambda> = (n_a lambda_a + n_b lambda_b) / (2 (n_a + n_b)), eq (20).
 
-    n lambda is independent of density (eq 12), so <lambda> = lambda_a p_a / (p_a + p_b).
+    n lambda is independent of density (eq 12), so <lambda> = n lambda / (n_a + n_b)
+    = lambda_a p_a / (p_a + p_b).
     """
-    return gas.mean_free_path_m(p_a) * p_a / (p_a + p_b)
+    return gas.n_lambda_per_m2 * gas.kT_J / (p_a + p_b)
 
 
 def interpolated_leak_rate(gas: Gas, p_a, p_b, u_c, Ly_over_Lx):

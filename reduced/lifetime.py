@@ -75,7 +75,7 @@ _GRID = 1200          # h samples for locating folds (refined by brentq)
 _DYNAMIC_FOLD = 1e-4  # |D| / |D(0)| at which the relaxed dynamics is declared singular
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class LeakageModel:
     """Everything a lifetime depends on except the pull force F1.
 
