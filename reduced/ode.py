@@ -73,6 +73,8 @@ def dopri5(fun: Callable[[float, list], list], t0: float, y0: Sequence[float], t
         h0 = 0.01 * (abs(y[0]) + atol[0]) / max(abs(f[0]), 1e-300)
     h = min(max(h0, 1e-300), t_end - t)
     steps = rejected = 0
+    just_rejected = False        # no growth right after a rejection (Hairer's facmax = 1)
+    h_prev = err_prev = None     # last accepted step, for the predictive controller
     while t < t_end:
         if steps + rejected >= max_steps:
             raise IntegrationError(f"integrator: {max_steps} steps reached at t = {t:.6g} s "
@@ -91,10 +93,12 @@ def dopri5(fun: Callable[[float, list], list], t0: float, y0: Sequence[float], t
         if not math.isfinite(err):
             rejected += 1
             h *= 0.25
+            just_rejected = True
             continue
         if err > 1.0:
             rejected += 1
             h *= max(0.2, 0.9 * err ** -0.2)
+            just_rejected = True
             continue
         steps += 1
         t_new = t + h
@@ -126,7 +130,15 @@ def dopri5(fun: Callable[[float, list], list], t0: float, y0: Sequence[float], t
         ts.append(t)
         ys.append(list(y))
         fs.append(list(f))
-        h *= min(5.0, 0.9 * max(err, 1e-10) ** -0.2)
+        # step control: the classical factor, made cautious by Gustafsson's predictive factor when
+        # the error grows from step to step (solutions that steepen towards detachment)
+        err = max(err, 1e-10)
+        fac = 0.9 * err ** -0.2
+        if err_prev is not None:
+            fac = min(fac, fac * (h / h_prev) * (err_prev / err) ** 0.2)
+        h_prev, err_prev = h, err
+        h *= min(1.0 if just_rejected else 5.0, max(0.2, fac))
+        just_rejected = False
     return OdeSolution(ts, ys, fs, None, steps, rejected, dense_steps)
 
 
