@@ -111,3 +111,13 @@ def test_water_json(capsys):
     _, out_air, _ = _run(capsys, "lifetime", "--force", "10", "--json")
     # "the much higher viscosity of water than of air results in a longer failure time" (Sec. 5.4)
     assert row["lifetime_s"] > 10 * json.loads(out_air)[0]["lifetime_s"]
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--cup", "Z"], "cup: unknown cup 'Z'"),
+    (["--uc-table", "/nonexistent/uc.csv"], "uc-table: no such file"),
+])
+def test_example_bad_input_exits_2_without_output(capsys, tmp_path, argv, message):
+    code, _, err = _run(capsys, "example", "--out", str(tmp_path / "ex"), *argv)
+    assert code == 2 and err.count("\n") == 1 and message in err
+    assert list(tmp_path.iterdir()) == []

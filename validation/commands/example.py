@@ -24,7 +24,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (written atomically)")
     p.add_argument("--cup", default="A", metavar="A|B", help="Table 1 cup preset (default: A)")
     p.add_argument("--uc-table", default=None, metavar="FILE.csv",
-                   help="critical gap table, columns p_over_E,u_c_m (default: the illustrative table)")
+                   help="critical gap table, columns p_over_E,u_c_m (u_c in m) "
+                        "(default: the illustrative table)")
 
 
 def lifetime_vs_force(model, forces_N=FORCES_N, progress=None):
