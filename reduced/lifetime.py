@@ -18,7 +18,7 @@ Equilibrium branch. At fixed kappa and F1 the gas content in equilibrium is expl
     N_eq(h) = V(h) [p_a - (kappa F0(h) + F1) / (pi r(h)^2)] / kT,
 
 and stable equilibria are where N_eq increases with h (G_h < 0). h is found from N by a safeguarded
-Newton iteration on that branch, to ~1e-14 relative, at every evaluation ("projection"): the force
+Newton iteration on that branch, to 1e-13 relative, at every evaluation ("projection"): the force
 balance then holds at every output to round-off. The branch ends where N_eq has its first local
 maximum (the fold: no equilibrium holds more gas) or where r = r1.
 
