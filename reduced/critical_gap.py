@@ -1,0 +1,146 @@
+"""The critical gap u_c(p/E): the surface separation at the critical constrictions (Sec. 4, 5.1).
+
+The reduced model takes u_c as any callable `u_c(p_over_E) -> metres`. `UcTable` is the standard
+one: a table `p_over_E,u_c_m` (as Fig. 1pressureMPa.2loguc shows it), interpolated linearly in
+log-log and extrapolated linearly in log-log beyond both ends.
+
+u_c = 0 is legal and means a sealed interface (the contact area percolates): no leak. Zeros may
+only form a trailing block (once sealed, a higher pressure stays sealed). Between the last open
+row and the first sealed row u_c falls linearly in p/E to 0 (no log of zero is taken); beyond
+the first sealed row it stays 0.
+
+`illustrative_uc_table()` is a stand-in until Persson-theory tables exist: a power law through the
+paper's 0.68 um at p/E = 0.025 (the 1.89 um rms sandblasted PMMA at 1 atm, E = 4 MPa). It is an
+input for examples, not a result and never a test oracle. `python -m reduced.critical_gap`
+regenerates `reduced/data/uc_illustrative.csv` from it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from bisect import bisect_right
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["UcTable", "illustrative_uc_table", "ILLUSTRATIVE_UC_CSV"]
+
+ILLUSTRATIVE_UC_CSV = Path(__file__).parent / "data" / "uc_illustrative.csv"
+_HEADER = "p_over_E,u_c_m"
+
+
+@dataclass(frozen=True, eq=False)
+class UcTable:
+    """u_c(p/E) from a table, log-log interpolation and extrapolation; trailing zeros = sealed."""
+
+    p_over_E: np.ndarray
+    u_c_m: np.ndarray
+    provenance: str = ""
+    _log_p: list = field(init=False, repr=False, compare=False)
+    _log_u: list = field(init=False, repr=False, compare=False)
+    _seal: float = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        p = np.array(self.p_over_E, dtype=float).reshape(-1)
+        u = np.array(self.u_c_m, dtype=float).reshape(-1)
+        if p.size != u.size:
+            raise ValueError(f"u_c_m: {u.size} values for {p.size} pressures")
+        if p.size < 2:
+            raise ValueError(f"p_over_E: a u_c table needs at least 2 rows, got {p.size}")
+        if not (np.all(np.isfinite(p)) and np.all(p > 0) and np.all(np.diff(p) > 0)):
+            raise ValueError("p_over_E: must be finite, > 0 and strictly increasing")
+        if not (np.all(np.isfinite(u)) and np.all(u >= 0)):
+            raise ValueError("u_c_m: must be finite and >= 0 (0 = sealed)")
+        open_rows = int(np.count_nonzero(u > 0))
+        if np.any(u[:open_rows] <= 0):
+            raise ValueError("u_c_m: a sealed (0) row may only be followed by sealed rows")
+        if open_rows < 2:
+            raise ValueError("u_c_m: need at least 2 open (u_c > 0) rows to interpolate in log-log")
+        p.flags.writeable = False
+        u.flags.writeable = False
+        object.__setattr__(self, "p_over_E", p)
+        object.__setattr__(self, "u_c_m", u)
+        object.__setattr__(self, "_log_p", [math.log(v) for v in p[:open_rows]])
+        object.__setattr__(self, "_log_u", [math.log(v) for v in u[:open_rows]])
+        object.__setattr__(self, "_seal", float(p[open_rows]) if open_rows < p.size else math.inf)
+
+    @property
+    def sealing_p_over_E(self) -> float:
+        """Smallest tabulated p/E that is sealed (inf if none)."""
+        return self._seal
+
+    def __call__(self, p_over_E):
+        """u_c [m] at p/E (float -> float, array -> array)."""
+        if np.ndim(p_over_E) == 0:
+            return self.scalar(float(p_over_E))
+        return np.array([self.scalar(float(v)) for v in np.ravel(p_over_E)]).reshape(np.shape(p_over_E))
+
+    def scalar(self, x: float) -> float:
+        if not x > 0:
+            raise ValueError(f"p_over_E: contact pressure over modulus must be > 0, got {x}")
+        lp, lu, seal = self._log_p, self._log_u, self._seal
+        n = len(lp)
+        if seal < math.inf and x > self.p_over_E[n - 1]:
+            if x >= seal:
+                return 0.0
+            # between the last open row and the first sealed row: linear in p/E down to 0
+            p_last = float(self.p_over_E[n - 1])
+            return float(self.u_c_m[n - 1]) * (seal - x) / (seal - p_last)
+        lx = math.log(x)
+        i = min(max(bisect_right(lp, lx) - 1, 0), n - 2)
+        slope = (lu[i + 1] - lu[i]) / (lp[i + 1] - lp[i])
+        return math.exp(lu[i] + slope * (lx - lp[i]))
+
+    # --------------------------------------------------------------------- IO
+    @classmethod
+    def from_csv(cls, path: str | os.PathLike) -> UcTable:
+        path = Path(path)
+        if not path.is_file():
+            raise ValueError(f"uc-table: no such file '{path}'")
+        lines = [ln.strip() for ln in path.read_text().splitlines()]
+        body = [ln for ln in lines if ln and not ln.startswith("#")]
+        if not body or [c.strip() for c in body[0].split(",")] != _HEADER.split(","):
+            raise ValueError(f"uc-table: '{path}' must start with the header '{_HEADER}'")
+        try:
+            data = np.array([[float(v) for v in ln.split(",")] for ln in body[1:]], dtype=float)
+        except ValueError as exc:
+            raise ValueError(f"uc-table: '{path}' has a non-numeric entry ({exc})") from None
+        if data.ndim != 2 or data.shape[1] != 2:
+            raise ValueError(f"uc-table: '{path}' needs two columns per row, {_HEADER}")
+        comments = " ".join(ln[1:].strip() for ln in lines if ln.startswith("#"))
+        return cls(data[:, 0], data[:, 1], provenance=comments or f"csv:{path.name}")
+
+    def to_csv(self, path: str | os.PathLike) -> Path:
+        """Write the table atomically, provenance as '#' comment lines."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".{path.name}.tmp")
+        with open(tmp, "w") as f:
+            for line in self.provenance.splitlines():
+                f.write(f"# {line}\n")
+            f.write(_HEADER + "\n")
+            for p, u in zip(self.p_over_E, self.u_c_m):
+                f.write(f"{p:.10g},{u:.10g}\n")
+        os.replace(tmp, path)
+        return path
+
+
+def illustrative_uc_table(u_ref_m: float = 0.68e-6, p_ref_over_E: float = 0.025,
+                          exponent: float = 1.0, p_min: float = 1e-4, p_max: float = 0.3,
+                          rows: int = 25) -> UcTable:
+    """ILLUSTRATIVE u_c = u_ref (p/E / p_ref)^(-exponent), tabulated log-spaced (not Persson theory)."""
+    p = np.geomspace(p_min, p_max, rows)
+    u = u_ref_m * (p / p_ref_over_E) ** (-exponent)
+    provenance = (f"ILLUSTRATIVE u_c table, not a rough-contact result: power law "
+                  f"u_c = {u_ref_m:g} m * (p/E / {p_ref_over_E:g})^(-{exponent:g}),\n"
+                  f"through the paper's u_c = 0.68 um at 1 atm (p/E = 0.025, E = 4 MPa) for the "
+                  f"1.89 um rms sandblasted PMMA (Sec. 5.1).\n"
+                  f"Generated by reduced.critical_gap.illustrative_uc_table(); "
+                  f"regenerate with `python -m reduced.critical_gap`.")
+    return UcTable(p, u, provenance=provenance)
+
+
+if __name__ == "__main__":
+    print(illustrative_uc_table().to_csv(ILLUSTRATIVE_UC_CSV))

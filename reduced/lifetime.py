@@ -1,0 +1,645 @@
+"""Lifetime of a suction cup: the leakage dynamics of Sec. 3 (eqs 3-10) with the flow of Sec. 4.
+
+State and equations. The gas content N of the cavity and (with relaxation) the contact-time state
+phi evolve in time; the cup height h is algebraic, fixed by the force balance
+
+    G(h, N, phi) = kappa(phi) F0(h) + F1 - pi r(h)^2 (p_a - N kT / V(h)) = 0        (7), (8)
+
+with kappa = E_eff(phi) / E_eff(phi0) (Sec. 3), kappa = 1 in reference mode. Then
+
+    dN/dt   = (2 pi r / l) f(p, p_a, p_b),  p = kappa F0 / (2 pi r l) + beta (p_a - p_b)   (9), (23), (6)
+    dphi/dt = 1 - rdot phi / l,   rdot = r'(h) hdot                                       (10)
+
+and hdot follows from differentiating G = 0 (implicit function theorem); phi_dot contains rdot, so
+(hdot, phi_dot) solve a 2x2 linear system, singular where D = G_h - (r' phi / l) G_phi = 0.
+
+Equilibrium branch. At fixed kappa and F1 the gas content in equilibrium is explicit in h,
+
+    N_eq(h) = V(h) [p_a - (kappa F0(h) + F1) / (pi r(h)^2)] / kT,
+
+and stable equilibria are where N_eq increases with h (G_h < 0). h is found from N by a safeguarded
+Newton iteration on that branch, to 1e-13 relative, at every evaluation ("projection"): the force
+balance then holds at every output to round-off. The branch ends where N_eq has its first local
+maximum (the fold: no equilibrium holds more gas) or where r = r1.
+
+Start. At r_start with F1 = 0 the force balance fixes the trapped gas N0. F1 is then applied at
+t = 0 with N0 fixed; h follows the equilibrium continuously from r_start (continuation in F1). The
+holding force at fixed N0, F_hold(h) = pi r^2 (p_a - N0 kT/V) - kappa F0, must rise to F1 before its
+first local maximum: that maximum (or its value at r1) is the largest force the cup can hold;
+at or above it the cup detaches at t = 0.
+
+End (reason): "reached_r1", "fold" (static fold, or with relaxation the dynamic singularity D -> 0
+where rdot diverges), "over_force" (t = 0), "sealed" (u_c = 0 somewhere on the way: the leak rate
+vanishes, the lifetime is infinite) or "horizon" (still holding at t_max).
+
+With relaxation, phi(0) = 0 and E_eff is held at its first sample for shorter times, so the spring
+starts at kappa0 = E_eff(phi=0)/E_eff(phi0) (1.25 for cup A with the default law); N0 is fixed with it.
+
+Liquid (fluid='water'): the cavity is full of an incompressible liquid; its volume V(h) is the
+content, p_b follows from eq (7), the inflow is eq (24). F1 leaves h at h_start (p_b drops by
+F1 / (pi r^2), possibly below zero: tension; no cavitation model) and the cup detaches at r1.
+
+Reference mode (`reference_model`): Appendix A stiffness (x0 = r0, x1 = r1, d0 = 2 mm, d1 = 0,
+E = 4 MPa), no relaxation (kappa = 1, E = 4 MPa for p/E), air at 293.15 K (eta = 1.81e-5 Pa s,
+m = 28.97 u), p_a = 1e5 Pa, lambda_a from eq (12) at p_a, u_c from the given table, rigid-cone
+geometry eqs (3)-(5), start and detachment as above. There the state is one-dimensional and
+`lifetime_by_quadrature` gives the lifetime independently as t = int dN_eq/dh / Ndot dh.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from reduced.appendix_a import appendix_a_curve
+from reduced.cup import CupParameters
+from reduced.fast_curve import CurveRangeError, ScalarPchip
+from reduced.gas import (AIR, WATER_VISCOSITY_PA_S, Gas, ballistic_share, interpolated_leak_rate,
+                         liquid_volume_rate)
+from reduced.geometry import geometry_source
+from reduced.ode import dopri5
+from reduced.stiffness_curve import StiffnessCurve
+from reduced.viscoelastic import RelaxationModulus, measurement_contact_time
+
+__all__ = ["LeakageModel", "LifetimeResult", "reference_model", "lifetime", "lifetime_sweep",
+           "lifetime_by_quadrature", "largest_holdable_force", "REASONS"]
+
+REASONS = ("reached_r1", "fold", "over_force", "sealed", "horizon")
+_GRID = 1200          # h samples for locating folds (refined by brentq)
+_DYNAMIC_FOLD = 1e-4  # |D| / |D(0)| at which the relaxed dynamics is declared singular
+
+
+@dataclass(frozen=True, eq=False)
+class LeakageModel:
+    """Everything a lifetime depends on except the pull force F1.
+
+    cup: geometry and Table 1 parameters. stiffness: F0 over u = h1 - h (any `StiffnessCurve`; with
+    the cone geometry h1 is the cup's, eq 3, with the curve geometry the curve's).
+    u_c: critical gap [m] as a function of p/E (e.g. a `UcTable`). gas, p_a_Pa: the gas and the
+    ambient pressure. relaxation: E_eff(t), or None for no relaxation (then kappa = 1 and E_Pa is the
+    modulus in p/E). phi0_s: contact time of the stiffness measurement (default: eq 10 steady state
+    at the paper's 0.12 mm/s, see `measurement_contact_time`). geometry: 'cone' (eqs 3-5) or 'curve'
+    (r, V, l from the stiffness curve). fluid: 'air' (the gas leaks in, eqs 8, 19) or 'water' (the
+    cavity is full of an incompressible liquid that flows in by eq 24; its "content" is the liquid
+    volume, p_b follows from the force balance and may become negative, i.e. tension, Sec. 6).
+    """
+
+    cup: CupParameters
+    stiffness: StiffnessCurve
+    u_c: Callable[[float], float]
+    gas: Gas = AIR
+    p_a_Pa: float = 1e5
+    E_Pa: float = 4e6
+    relaxation: RelaxationModulus | None = None
+    phi0_s: float | None = None
+    geometry: str = "cone"
+    fluid: str = "air"
+    liquid_viscosity_Pa_s: float = WATER_VISCOSITY_PA_S
+    label: str = field(default="", compare=False)
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.p_a_Pa) and self.p_a_Pa > 0):
+            raise ValueError(f"p_a_Pa: ambient pressure must be > 0 Pa, got {self.p_a_Pa}")
+        if not (math.isfinite(self.E_Pa) and self.E_Pa > 0):
+            raise ValueError(f"E_Pa: modulus must be > 0 Pa, got {self.E_Pa}")
+        if self.phi0_s is not None and not self.phi0_s > 0:
+            raise ValueError(f"phi0_s: measurement contact time must be > 0 s, got {self.phi0_s}")
+        if self.geometry not in ("cone", "curve"):
+            raise ValueError(f"geometry: unknown source '{self.geometry}', allowed: cone, curve")
+        if self.fluid not in ("air", "water"):
+            raise ValueError(f"fluid: unknown fluid '{self.fluid}', allowed: air, water")
+        if self.fluid == "water" and self.relaxation is not None:
+            raise ValueError("fluid: the water-filled cavity is implemented without relaxation only")
+        if not (math.isfinite(self.liquid_viscosity_Pa_s) and self.liquid_viscosity_Pa_s > 0):
+            raise ValueError(f"liquid_viscosity_Pa_s: must be > 0, got {self.liquid_viscosity_Pa_s}")
+
+    @property
+    def reference(self) -> bool:
+        return self.relaxation is None
+
+    @cached_property
+    def _core(self) -> _Core:
+        return _Core(self)
+
+
+def reference_model(cup: CupParameters, u_c: Callable[[float], float]) -> LeakageModel:
+    """The reference-mode model of the issue (module docstring) for `cup` and `u_c`."""
+    return LeakageModel(cup=cup, stiffness=appendix_a_curve(cup, E_Pa=4e6, d0_m=2e-3), u_c=u_c,
+                        gas=Gas(T_K=293.15, molecular_mass_u=28.97, viscosity_Pa_s=1.81e-5),
+                        p_a_Pa=1e5, E_Pa=4e6, relaxation=None, geometry="cone", label="reference")
+
+
+@dataclass(frozen=True, eq=False)
+class LifetimeResult:
+    """Lifetime and trajectories (SI). lifetime_s is inf when sealed or beyond the horizon."""
+
+    force_N: float
+    lifetime_s: float
+    reason: str
+    message: str
+    largest_force_N: float
+    N0: float
+    t_s: np.ndarray
+    r_m: np.ndarray
+    h_m: np.ndarray
+    p_b_Pa: np.ndarray
+    p_Pa: np.ndarray
+    u_c_m: np.ndarray
+    N: np.ndarray
+    N_dot_per_s: np.ndarray
+    phi_s: np.ndarray
+    ballistic_share_t: np.ndarray
+    force_residual: np.ndarray
+    steps: int = 0
+    fluid: str = "air"
+
+    @property
+    def sealed(self) -> bool:
+        return self.reason == "sealed"
+
+    @property
+    def ballistic_share(self) -> float:
+        """Share of the leaked molecules that went through eq (19)'s ballistic term."""
+        if self.t_s.size < 2:
+            return float(self.ballistic_share_t[0])
+        total = _trapezoid(self.N_dot_per_s, self.t_s)
+        if total <= 0:
+            return float(self.ballistic_share_t[0])
+        return float(_trapezoid(self.ballistic_share_t * self.N_dot_per_s, self.t_s) / total)
+
+    def summary(self) -> dict:
+        """JSON-ready summary (lifetime_s null when infinite)."""
+        return {"force_N": self.force_N,
+                "lifetime_s": self.lifetime_s if math.isfinite(self.lifetime_s) else None,
+                "reason": self.reason, "sealed": self.sealed,
+                "ballistic_share": self.ballistic_share,
+                "largest_force_N": self.largest_force_N if math.isfinite(self.largest_force_N) else None,
+                "r_final_mm": 1e3 * float(self.r_m[-1]), "p_b_final_Pa": float(self.p_b_Pa[-1]),
+                "steps": self.steps, "message": self.message}
+
+    def trajectory_columns(self) -> dict[str, np.ndarray]:
+        """Trajectory arrays under CSV column names that carry their units."""
+        return {"t_s": self.t_s, "r_mm": 1e3 * self.r_m, "h_mm": 1e3 * self.h_m,
+                "p_b_Pa": self.p_b_Pa, "p_Pa": self.p_Pa, "u_c_nm": 1e9 * self.u_c_m,
+                **({"N": self.N, "N_dot_per_s": self.N_dot_per_s} if self.fluid == "air" else
+                   {"V_liquid_mm3": 1e9 * self.N, "V_dot_mm3_per_s": 1e9 * self.N_dot_per_s}),
+                "phi_s": self.phi_s, "ballistic_share": self.ballistic_share_t}
+
+
+def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+
+
+# ----------------------------------------------------------------------------- the physics
+class _Core:
+    """Scalar evaluation of eqs (3)-(10), (23) for one model, plus the h grid for folds."""
+
+    def __init__(self, m: LeakageModel):
+        self.m = m
+        self.geo = geometry_source(m.geometry, m.cup, m.stiffness)
+        self.h1 = self.geo.h_ref_m             # F0 is taken at u = h1 - h
+        self.F0 = ScalarPchip(m.stiffness.u_m, m.stiffness.F0_N, "stiffness curve (u)")
+        self.gas = m.gas
+        self.liquid = m.fluid == "water"
+        self.kT = m.gas.kT_J
+        self.pa = m.p_a_Pa
+        self.beta = m.cup.beta
+        self.uc = getattr(m.u_c, "scalar", m.u_c)
+        self.relax = m.relaxation
+        if self.relax is not None:
+            self.phi0 = m.phi0_s if m.phi0_s is not None else measurement_contact_time(m.cup)
+            self.E_ref = self.relax.modulus_and_log_slope(self.phi0)[0]
+        u_lo, u_hi = self.F0.lo, self.F0.hi
+        self.h_lo = max(self.h1 - u_hi, self.geo.h_min_m, 1e-3 * self.h1)
+        self.h_hi = min(self.geo.h_detach_m, self.h1 - u_lo)
+
+    # kappa(phi), dkappa/dphi and the modulus for p/E
+    def modulus(self, phi: float) -> tuple[float, float, float]:
+        if self.relax is None:
+            return 1.0, 0.0, self.m.E_Pa
+        E, slope = self.relax.modulus_and_log_slope(phi)
+        dk = slope * E / (phi * self.E_ref) if slope != 0.0 else 0.0
+        return E / self.E_ref, dk, E
+
+    def spring(self, h: float) -> tuple[float, float]:
+        """F0(h) and dF0/dh."""
+        F, dF_du = self.F0.value_and_slope(self.h1 - h)
+        return F, -dF_du
+
+    def n_eq(self, h: float, kappa: float, F1: float) -> tuple[float, float]:
+        """N_eq(h) and dN_eq/dh on the equilibrium branch (eqs 3, 4, 7, 8).
+
+        For a liquid-filled cavity the content is the liquid volume: V(h) and dV/dh (eq 4).
+        """
+        r, rp, V, Vp, _ = self.geo.at(h)
+        if self.liquid:
+            return V, Vp
+        F, Fh = self.spring(h)
+        A = math.pi * r * r
+        X = (kappa * F + F1) / A
+        N = V * (self.pa - X) / self.kT
+        dN = (Vp * (self.pa - X) - V * (kappa * Fh / A - 2.0 * X * rp / r)) / self.kT
+        return N, dN
+
+    def holding_force(self, h: float, N0: float, kappa: float) -> tuple[float, float]:
+        """F_hold(h) = pi r^2 (p_a - N0 kT/V) - kappa F0 and its h-derivative."""
+        r, rp, V, Vp, _ = self.geo.at(h)
+        F, Fh = self.spring(h)
+        pb = N0 * self.kT / V
+        A = math.pi * r * r
+        F_hold = A * (self.pa - pb) - kappa * F
+        return F_hold, 2 * math.pi * r * rp * (self.pa - pb) + A * pb * Vp / V - kappa * Fh
+
+    def state(self, h: float, N: float, kappa: float, E: float, F1: float):
+        """(Ndot, p_b, p, u_c, ballistic share, r, rp, l, V, Vp, F, Fh) at a point, eqs (6), (9), (23)."""
+        r, rp, V, Vp, l = self.geo.at(h)
+        F, Fh = self.spring(h)
+        pa = self.pa
+        if self.liquid:          # p_b from the force balance (7); volume flow eq (24)
+            pb = pa - (kappa * F + F1) / (math.pi * r * r)
+        else:                    # p_b from the ideal gas (8); molecule flow eqs (9), (19)
+            pb = N * self.kT / V
+        p = kappa * F / (2.0 * math.pi * r * l) + self.beta * (pa - pb)
+        uc = self.uc(p / E)
+        if self.liquid:
+            return (liquid_volume_rate(self.m.liquid_viscosity_Pa_s, pa, pb, uc, 2.0 * math.pi * r / l),
+                    pb, p, uc, 0.0, r, rp, l, V, Vp, F, Fh)
+        Ndot = interpolated_leak_rate(self.gas, pa, pb, uc, 2.0 * math.pi * r / l)
+        share = ballistic_share(self.gas, pa, pb, uc)
+        return Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh
+
+    # ------------------------------------------------------------------ the h grid
+    def spring_array(self, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        F, dF_du = self.F0.values_and_slopes(self.h1 - h)
+        return F, -dF_du
+
+    @cached_property
+    def grid(self):
+        """h samples and the pieces of dN_eq/dh = (S0 - kappa S1 - F1 S2) / kT on them."""
+        h = np.linspace(self.h_lo, self.h_hi, _GRID)
+        r, rp, V, Vp, _ = self.geo.at_array(h)
+        F, Fh = self.spring_array(h)
+        A = math.pi * r * r
+        S = np.array([Vp * self.pa,
+                      Vp * F / A + V * Fh / A - 2.0 * V * F * rp / (r * A),
+                      Vp / A - 2.0 * V * rp / (r * A)])
+        return h, S
+
+    def branch_end(self, h_from: float, kappa: float, F1: float) -> tuple[float, str]:
+        """First local maximum of N_eq above h_from (the fold), else the detachment height (r = r1).
+
+        The sign of dN_eq/dh is scanned on the grid and the fold refined by brentq. A liquid-filled
+        cavity has no fold (V(h) increases). Raises `CurveRangeError` if the stiffness curve ends
+        below the detachment height, since the cup would then leave the curve.
+        """
+        if not self.liquid:
+            if self.n_eq(h_from, kappa, F1)[1] <= 0.0:
+                return h_from, "fold"
+            h, S = self.grid
+            i0 = int(np.searchsorted(h, h_from, side="right"))
+            bad = np.flatnonzero(S[0, i0:] - kappa * S[1, i0:] - F1 * S[2, i0:] <= 0.0)
+            if bad.size:
+                j = i0 + int(bad[0])
+                a = h_from if j == i0 else float(h[j - 1])
+                hf = brentq(lambda x: self.n_eq(x, kappa, F1)[1], a, float(h[j]),
+                            xtol=1e-15 * self.h1, rtol=1e-14)
+                return hf, "fold"
+        if self.h_hi < self.geo.h_detach_m * (1 - 1e-12):
+            raise CurveRangeError(
+                f"stiffness curve: the cup moves towards r1 (u = 0) but the curve starts at "
+                f"u = {1e3 * (self.h1 - self.h_hi):.4g} mm; extend it to u = 0")
+        return self.h_hi, "reached_r1"
+
+    def branch_root(self, N: float, kappa: float, F1: float, h_guess: float, lo: float,
+                    hi: float) -> tuple[float, float]:
+        """(h, dN_eq/dh) with N_eq(h) = N to 1e-13 relative, h in [lo, hi] where N_eq increases.
+
+        Safeguarded Newton: a Newton step that leaves the bracket is replaced by bisection.
+        """
+        h = min(max(h_guess, lo), hi)
+        tol_N = 1e-13 * abs(N)
+        for _ in range(100):
+            f, df = self.n_eq(h, kappa, F1)
+            f -= N
+            if abs(f) <= tol_N:
+                return h, df
+            if f > 0.0:
+                hi = h
+            else:
+                lo = h
+            h_new = h - f / df if df > 0.0 else lo - 1.0
+            if lo < h_new < hi and abs(h_new - h) < 1e-7 * hi:
+                return h_new, df       # converged quadratically: the next residual is ~1e-14
+            if not (lo < h_new < hi):
+                h_new = 0.5 * (lo + hi)
+            if hi - lo <= 4e-16 * hi:
+                return h_new, df
+            h = h_new
+        raise RuntimeError(f"force balance: no convergence for N = {N:.6g} in h = [{lo:.6g}, {hi:.6g}] m")
+
+    # ------------------------------------------------------------------ the start
+    def start(self):
+        """(h_start, N0, kappa0, F_max, h_max): the trapped gas and the largest holdable force."""
+        kappa0 = self.modulus(0.0)[0]
+        hs = self.geo.h_start_m
+        if not self.h_lo <= hs <= self.h_hi:
+            raise CurveRangeError(f"stiffness curve: r_start needs h = {1e3 * hs:.6g} mm, outside the "
+                                  f"curve's range [{1e3 * self.h_lo:.6g}, {1e3 * self.h_hi:.6g}] mm")
+        N0 = self.n_eq(hs, kappa0, 0.0)[0]
+        if self.liquid:   # incompressible: h stays at h_start when F1 is applied; p_b takes it all
+            return hs, N0, kappa0, math.inf, hs
+        if N0 <= 0:
+            raise ValueError(f"r_start_m: the stiffness force at r_start exceeds the full vacuum force "
+                             f"(no gas can be trapped); check the stiffness curve or r_start")
+        h, _ = self.grid
+        hh = np.concatenate(([hs], h[h > hs]))
+        r, rp, V, Vp, _ = self.geo.at_array(hh)
+        F, Fh = self.spring_array(hh)
+        pb = N0 * self.kT / V           # d/dh of F_hold, as in holding_force, on the grid
+        slope = 2 * math.pi * r * rp * (self.pa - pb) + math.pi * r * r * pb * Vp / V - kappa0 * Fh
+        bad = np.flatnonzero(slope <= 0.0)
+        if bad.size == 0:
+            hm = self.h_hi
+        elif bad[0] == 0:
+            hm = hs
+        else:
+            j = int(bad[0])
+            hm = brentq(lambda x: self.holding_force(x, N0, kappa0)[1], float(hh[j - 1]), float(hh[j]),
+                        xtol=1e-15 * self.h1)
+        return hs, N0, kappa0, self.holding_force(hm, N0, kappa0)[0], hm
+
+    @cached_property
+    def initial(self):
+        return self.start()
+
+
+def largest_holdable_force(model: LeakageModel) -> float:
+    """The largest F1 [N] the freshly pressed cup holds at t = 0 (the first maximum of F_hold)."""
+    return float(model._core.initial[3])
+
+
+# ----------------------------------------------------------------------------- lifetime
+def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol: float = 1e-6,
+             refine: int = 1, progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
+    """Lifetime [s] of the cup under the pull force F1 = force_N, with trajectories.
+
+    Integrates N (and phi with relaxation) by an adaptive Dormand-Prince pair with terminal events;
+    h is solved from the force balance at every evaluation. The trajectories hold the accepted
+    steps, or `refine` points per step from the solver's 4th-order dense output (each projected
+    onto the force balance). Raises ValueError for bad input and `CurveRangeError` (a ValueError)
+    if the state leaves the stiffness curve.
+    """
+    F1 = float(force_N)
+    if not (math.isfinite(F1) and F1 > 0):
+        # F1 = 0 ends only asymptotically at r1, where the contact pressure p -> 0
+        raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
+    if not (t_max_s > 0 and 0 < rtol < 1e-2):
+        raise ValueError(f"t_max_s, rtol: need t_max_s > 0 and 0 < rtol < 0.01, got {t_max_s}, {rtol}")
+    if not (isinstance(refine, int) and 1 <= refine <= 1000):
+        raise ValueError(f"refine: output points per step must be an integer in [1, 1000], got {refine}")
+    core = model._core
+    hs, N0, kappa0, Fmax, hm = core.initial
+    if F1 >= Fmax:
+        msg = (f"F1 = {F1:g} N is at or above the largest force the cup can hold at t = 0, "
+               f"{Fmax:.4g} N: it detaches at once")
+        return _result(core, F1, 0.0, "over_force", msg, Fmax, N0, [0.0], [[N0, 0.0]], [hs], 0)
+    h0 = hs if core.liquid else brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
+                                       xtol=1e-15 * core.h1, rtol=1e-15)
+    run = _run_reference if model.reference else _run_relaxed
+    result = run(core, F1, N0, h0, Fmax, t_max_s, rtol, refine)
+    if progress:
+        progress(1.0, f"F1 = {F1:g} N: {result.reason}")
+    return result
+
+
+def _outputs(sol, refine: int) -> tuple[list, list]:
+    """Output times and states: the accepted steps, refined by the dense output if asked."""
+    if refine == 1 or not sol.dense:
+        return list(sol.t), [list(y) for y in sol.y]
+    ts, ys = [sol.t[0]], [list(sol.y[0])]
+    for i, dense in enumerate(sol.dense):
+        t0, t1 = sol.t[i], sol.t[i + 1]
+        for j in range(1, refine):
+            tj = t0 + (t1 - t0) * j / refine
+            ts.append(tj)
+            ys.append(dense(tj))
+        ts.append(t1)
+        ys.append(list(sol.y[i + 1]))
+    return ts, ys
+
+
+def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> LifetimeResult:
+    h_end, reason = core.branch_end(h0, 1.0, F1)
+    N_end = core.n_eq(h_end, 1.0, F1)[0]
+    E = core.m.E_Pa
+    # sealed anywhere on the branch? (u_c = 0 makes Ndot vanish; it is never crossed in finite time)
+    sealed_at = _sealed_on_branch(core, h0, h_end, F1)
+    if sealed_at is not None:
+        return _result(core, F1, math.inf, "sealed",
+                       f"u_c = 0 at h = {1e3 * sealed_at:.4g} mm on the way: the interface seals, no "
+                       f"further leak", Fmax, N0, [0.0], [[N0, 0.0]], [h0], 0)
+    last = [h0, N0, core.n_eq(h0, 1.0, F1)[1]]     # last root, its N and dN_eq/dh: a predictor
+
+    def h_of(N: float) -> float:
+        if N >= N_end:
+            return h_end
+        guess = last[0] + (N - last[1]) / last[2] if last[2] > 0 else last[0]
+        h, slope = core.branch_root(N, 1.0, F1, guess, h0, h_end)
+        last[:] = h, N, slope
+        return h
+
+    Ndot_end = core.state(h_end, N_end, 1.0, E, F1)[0]
+
+    # The integrated variable is the leaked content Q = N - N0, so that the error control is
+    # relative to what leaks (N itself hardly changes at large F1).
+    def rhs(t, y):     # beyond the end of the branch: continued with the end value (event there)
+        N = N0 + y[0]
+        return [core.state(h_of(N), N, 1.0, E, F1)[0] if N < N_end else Ndot_end]
+
+    Ndot0 = rhs(0.0, [0.0])[0]
+    Q_end = N_end - N0
+    # At a fold h(N) ~ h_f - sqrt(N_f - N), so Ndot(N) has a square-root singularity at the end,
+    # where the embedded error estimate is optimistic (measured: lifetime errors up to ~100 rtol
+    # there, ~1 rtol otherwise). Fold endings are therefore integrated at rtol / 10.
+    if reason == "fold":
+        rtol = 0.1 * rtol
+    sol = dopri5(rhs, 0.0, [0.0], t_max, rtol, [rtol * Q_end], events=[lambda t, y: y[0] - Q_end],
+                 h0=1e-2 * Q_end / Ndot0 if Ndot0 > 0 else None, dense_output=refine > 1)
+    ts, ys = _outputs(sol, refine)
+    ys = [[N0 + y[0], 0.0] for y in ys]
+    if sol.event is not None:
+        ys[-1][0] = N_end      # the event is N = N_end; only its time is interpolated
+    last[:] = h0, N0, core.n_eq(h0, 1.0, F1)[1]
+    hs = [h_of(y[0]) for y in ys]
+    if sol.event is None:
+        return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s",
+                       Fmax, N0, ts, ys, hs, sol.steps)
+    return _result(core, F1, ts[-1], reason, _end_message(reason, ts[-1]), Fmax, N0, ts, ys,
+                   hs, sol.steps)
+
+
+def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> LifetimeResult:
+    last = {"h": h0}
+
+    def solve(N: float, phi: float):
+        kappa, dk, E = core.modulus(phi)
+        lo = last["h"]
+        step = 1e-4 * core.h1
+        while core.n_eq(lo, kappa, F1)[0] > N:      # step down to bracket the root
+            lo = max(lo - step, core.h_lo)
+            step *= 2.0
+            if lo <= core.h_lo:
+                if core.n_eq(lo, kappa, F1)[0] > N:
+                    raise CurveRangeError(f"state: the cup height fell below {1e3 * core.h_lo:.4g} mm, "
+                                          f"the lower end of the stiffness curve / geometry")
+                break
+        top, why = core.branch_end(lo, kappa, F1)
+        N_top = core.n_eq(top, kappa, F1)[0]
+        h = top if N >= N_top else core.branch_root(N, kappa, F1, last["h"], lo, top)[0]
+        last["h"] = h
+        return h, kappa, dk, E, N_top, why
+
+    def derivatives(h, N, phi, kappa, dk, E):
+        Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh = core.state(h, N, kappa, E, F1)
+        pa, kT = core.pa, core.kT
+        A = math.pi * r * r
+        G_h = kappa * Fh - 2 * math.pi * r * rp * (pa - pb) - A * pb * Vp / V
+        G_N = A * kT / V
+        G_phi = dk * F
+        a = rp * phi / l
+        D = G_h - a * G_phi
+        hdot = -(G_N * Ndot + G_phi) / D
+        return Ndot, 1.0 - a * hdot, D
+
+    def rhs(t, y):      # y = (N - N0, phi); beyond the branch's end continued with the end values
+        N, phi = N0 + y[0], max(y[1], 0.0)
+        h, kappa, dk, E, N_top, _ = solve(N, phi)
+        Ndot, phidot, _ = derivatives(h, min(N, N_top), phi, kappa, dk, E)
+        return [Ndot, phidot]
+
+    D0 = abs(derivatives(h0, N0, 0.0, *core.modulus(0.0))[2])
+
+    def end_event(t, y):          # N reaches the top of the branch (fold or r1)
+        h, kappa, dk, E, N_top, _ = solve(N0 + y[0], max(y[1], 0.0))
+        return N0 + y[0] - N_top
+
+    def dynamic_fold(t, y):       # D -> 0: rdot diverges
+        phi = max(y[1], 0.0)
+        h, kappa, dk, E, N_top, _ = solve(N0 + y[0], phi)
+        return _DYNAMIC_FOLD - abs(derivatives(h, min(N0 + y[0], N_top), phi, kappa, dk, E)[2]) / D0
+
+    Ndot0 = rhs(0.0, [0.0, 0.0])[0]
+    if Ndot0 <= 0.0:
+        return _result(core, F1, math.inf, "sealed", "u_c = 0 at t = 0: the interface is sealed",
+                       Fmax, N0, [0.0], [[N0, 0.0]], [h0], 0)
+    h_top0, _ = core.branch_end(h0, core.modulus(0.0)[0], F1)
+    Q_scale = core.n_eq(h_top0, core.modulus(0.0)[0], F1)[0] - N0   # leak to the static end at t = 0
+    sol = dopri5(rhs, 0.0, [0.0, 0.0], t_max, rtol, [rtol * Q_scale, 1e-6],
+                 events=[end_event, dynamic_fold], h0=1e-3 * Q_scale / Ndot0, dense_output=refine > 1)
+    ts, sol_y = _outputs(sol, refine)
+    sol_y = [[N0 + y[0], y[1]] for y in sol_y]
+    if sol.event == 0:       # the event is N = N_top(phi); only its time is interpolated
+        sol_y[-1][0] = solve(sol_y[-1][0], max(sol_y[-1][1], 0.0))[4]
+    last["h"] = h0
+    hs = []
+    for y in sol_y:
+        last["h"] = hs[-1] if hs else h0
+        hs.append(solve(y[0], max(y[1], 0.0))[0])
+    if sol.event is None:
+        return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s",
+                       Fmax, N0, ts, sol_y, hs, sol.steps)
+    last["h"] = hs[-1]
+    reason = solve(sol_y[-1][0], max(sol_y[-1][1], 0.0))[5] if sol.event == 0 else "fold"
+    msg = _end_message(reason, ts[-1])
+    if sol.event == 1:
+        msg += " (dynamic: D = G_h - (r' phi / l) G_phi -> 0, rdot diverges in eq 10)"
+    return _result(core, F1, ts[-1], reason, msg, Fmax, N0, ts, sol_y, hs, sol.steps)
+
+
+def _sealed_on_branch(core: _Core, h0: float, h_end: float, F1: float) -> float | None:
+    """First h on [h0, h_end] (checked on the fold-search grid) where u_c = 0, or None."""
+    if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf:
+        return None        # a table without sealed rows never seals
+    h, _ = core.grid
+    for x in [h0] + [float(x) for x in h[(h > h0) & (h < h_end)]] + [h_end]:
+        N = core.n_eq(x, 1.0, F1)[0]
+        if core.state(x, N, 1.0, core.m.E_Pa, F1)[3] <= 0.0:
+            return x
+    return None
+
+
+def _end_message(reason: str, t: float) -> str:
+    what = {"reached_r1": "the contact radius reached r1", "fold": "the force balance lost its "
+            "equilibrium (fold)"}[reason]
+    return f"detached at t = {t:.6g} s: {what}"
+
+
+def _result(core: _Core, F1, t_life, reason, msg, Fmax, N0, ts, ys, hs, steps) -> LifetimeResult:
+    rows = []
+    for t, y, h in zip(ts, ys, hs):
+        N, phi = y[0], max(y[1], 0.0)
+        kappa, _, E = core.modulus(phi)
+        Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh = core.state(h, N, kappa, E, F1)
+        G = kappa * F + F1 - math.pi * r * r * (core.pa - pb)
+        scale = abs(kappa * F) + F1 + math.pi * r * r * core.pa
+        rows.append((t, r, h, pb, p, uc, N, Ndot, phi, share, abs(G) / scale))
+    a = np.array(rows, dtype=float).T
+    for arr in a:
+        arr.flags.writeable = False
+    return LifetimeResult(force_N=F1, lifetime_s=float(t_life), reason=reason, message=msg,
+                          fluid=core.m.fluid,
+                          largest_force_N=float(Fmax), N0=float(N0), t_s=a[0], r_m=a[1], h_m=a[2],
+                          p_b_Pa=a[3], p_Pa=a[4], u_c_m=a[5], N=a[6], N_dot_per_s=a[7], phi_s=a[8],
+                          ballistic_share_t=a[9], force_residual=a[10], steps=steps)
+
+
+def lifetime_sweep(model: LeakageModel, forces_N, progress=None, **kw) -> list[LifetimeResult]:
+    """`lifetime` for each force (sharing the model's precomputation)."""
+    forces = [float(f) for f in forces_N]
+    out = []
+    for i, F1 in enumerate(forces):
+        out.append(lifetime(model, F1, **kw))
+        if progress:
+            progress((i + 1) / len(forces), f"F1 = {F1:g} N")
+    return out
+
+
+# ----------------------------------------------------------------------------- quadrature
+def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 1e-10) -> float:
+    """Reference-mode lifetime as t = int_{h(0+)}^{h_end} (dN_eq/dh) / Ndot(h) dh (no time stepping).
+
+    An independent evaluation for checking `lifetime`: without relaxation the state is
+    one-dimensional and the time to move along the equilibrium branch is a quadrature.
+    Returns inf if u_c vanishes on the branch and 0 for an over-force.
+    """
+    if not model.reference:
+        raise ValueError("lifetime_by_quadrature: only without relaxation (reference mode)")
+    core = model._core
+    F1 = float(force_N)
+    if not (math.isfinite(F1) and F1 > 0):
+        raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
+    hs, N0, kappa0, Fmax, hm = core.initial
+    if F1 >= Fmax:
+        return 0.0
+    h0 = hs if core.liquid else brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
+                                       xtol=1e-15 * core.h1, rtol=1e-15)
+    h_end, _ = core.branch_end(h0, 1.0, F1)
+
+    def integrand(h: float) -> float:
+        N, dN = core.n_eq(h, 1.0, F1)
+        Ndot = core.state(h, N, 1.0, core.m.E_Pa, F1)[0]
+        return math.inf if Ndot <= 0 else dN / Ndot
+
+    if _sealed_on_branch(core, h0, h_end, F1) is not None:
+        return math.inf
+    # the PCHIP breakpoints are kinks of higher derivatives: hand them to quad
+    knots = sorted(x for x in (core.h1 - u for u in core.F0.x) if h0 < x < h_end)
+    t, err = quad(integrand, h0, h_end, epsabs=0.0, epsrel=epsrel, limit=4 * len(knots) + 200,
+                  points=knots[:: max(1, len(knots) // 100)] or None)
+    return t

@@ -1,0 +1,123 @@
+"""`cupcheck lifetime` and `cupcheck example`: JSON output, trajectory files, bad input."""
+
+import json
+import math
+
+import pytest
+
+from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
+from reduced.cup import CUP_A
+from reduced.lifetime import lifetime_by_quadrature, reference_model
+from validation.cli import main
+
+
+def _run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_json_reference_mode(capsys):
+    code, out, _ = _run(capsys, "lifetime", "--reference-mode", "--cup", "A", "--force", "5", "40",
+                        "200", "--json")
+    assert code == 0
+    rows = json.loads(out)
+    assert [r["force_N"] for r in rows] == [5.0, 40.0, 200.0]
+    model = reference_model(CUP_A, UcTable.from_csv(ILLUSTRATIVE_UC_CSV))
+    for r in rows[:2]:
+        assert set(r) >= {"force_N", "lifetime_s", "reason", "sealed", "ballistic_share"}
+        # reproducible from outside: the same conventions through the library's quadrature
+        assert r["lifetime_s"] == pytest.approx(lifetime_by_quadrature(model, r["force_N"]), rel=1e-4)
+    assert rows[2]["reason"] == "over_force" and rows[2]["lifetime_s"] == 0.0
+
+
+def test_sealed_prints_null_lifetime(capsys, tmp_path):
+    table = tmp_path / "sealed.csv"
+    table.write_text("p_over_E,u_c_m\n1e-4,1e-6\n1e-3,1e-7\n2e-3,0\n")
+    code, out, _ = _run(capsys, "lifetime", "--uc-table", str(table), "--force", "10", "--json")
+    row = json.loads(out)[0]
+    assert code == 0 and row["lifetime_s"] is None and row["sealed"] is True
+    assert "NaN" not in out and "Infinity" not in out
+
+
+def test_out_writes_trajectories_atomically(capsys, tmp_path):
+    out = tmp_path / "run"
+    code, stdout, _ = _run(capsys, "lifetime", "--force", "10", "20", "--relaxation", "default",
+                           "--out", str(out))
+    assert code == 0 and "reached_r1" in stdout
+    files = sorted(p.name for p in out.iterdir())
+    assert files == ["summary.json", "trajectory_F1_10N.csv", "trajectory_F1_20N.csv"]
+    lines = (out / "trajectory_F1_10N.csv").read_text().splitlines()
+    assert lines[1] == "t_s,r_mm,h_mm,p_b_Pa,p_Pa,u_c_nm,N,N_dot_per_s,phi_s,ballistic_share"
+    assert len(lines) > 10
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]   # no temp dirs left
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--force", "-3"], "--force: pull force must be > 0 N"),
+    (["--cup", "C"], "cup: unknown cup 'C'"),
+    (["--uc-table", "/nonexistent/uc.csv"], "uc-table: no such file"),
+    (["--stiffness", "/nonexistent/F0.csv"], "--stiffness: no such file"),
+    (["--relaxation", "/nonexistent/E.csv"], "relaxation: no such file"),
+    (["--reference-mode", "--E-MPa", "3"], "--reference-mode: fixes --E-MPa"),
+    (["--E-MPa", "0"], "--E-MPa: modulus must be > 0 MPa"),
+    (["--fluid", "water", "--relaxation", "default"], "fluid: the water-filled cavity"),
+    (["--reference-mode", "--fluid", "water"], "--reference-mode: fixes --fluid"),
+])
+def test_bad_input_exits_2_with_one_line_and_no_output(capsys, tmp_path, argv, message):
+    out = tmp_path / "out"
+    code, stdout, err = _run(capsys, "lifetime", *argv, "--out", str(out))
+    assert code == 2
+    assert err.count("\n") == 1 and message in err
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_help_names_every_unit(capsys):
+    with pytest.raises(SystemExit):
+        main(["lifetime", "--help"])
+    text = capsys.readouterr().out
+    for unit in ("F1_N", "in MPa", "in mm", "in K", "in Pa", "in s", "u_c in m", "in Pa s"):
+        assert unit in text
+
+
+def test_example_writes_table_and_figure(capsys, tmp_path):
+    code, stdout, _ = _run(capsys, "example", "--out", str(tmp_path / "ex"))
+    assert code == 0
+    lines = (tmp_path / "ex" / "lifetime_vs_force.csv").read_text().splitlines()
+    assert lines[0].startswith("force_N,lifetime_s,reason")
+    assert len(lines) == 17                                   # 5, 10, ..., 80 N
+    lives = [float(l.split(",")[1]) for l in lines[1:]]
+    assert all(math.isfinite(t) and t > 0 for t in lives)
+    png = (tmp_path / "ex" / "lifetime_vs_force.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+
+
+def test_stiffness_csv_is_the_same_mechanism_as_appendix_a(capsys, tmp_path):
+    from reduced.appendix_a import appendix_a_curve
+    path = appendix_a_curve(CUP_A).to_csv(tmp_path / "F0.csv")
+    code, out, _ = _run(capsys, "lifetime", "--stiffness", str(path), "--force", "20", "--json")
+    code_ref, out_ref, _ = _run(capsys, "lifetime", "--reference-mode", "--force", "20", "--json")
+    assert code == code_ref == 0
+    # the CSV holds the same samples to 10 digits: the same lifetime to ~1e-9
+    assert json.loads(out)[0]["lifetime_s"] == pytest.approx(json.loads(out_ref)[0]["lifetime_s"], rel=1e-7)
+    code, _, err = _run(capsys, "lifetime", "--stiffness", str(path), "--geometry", "curve", "--force", "20")
+    assert code == 2 and "geometry: 'curve' needs" in err
+
+
+def test_water_json(capsys):
+    code, out, _ = _run(capsys, "lifetime", "--fluid", "water", "--force", "10", "--json")
+    row = json.loads(out)[0]
+    assert code == 0 and row["reason"] == "reached_r1" and row["largest_force_N"] is None
+    _, out_air, _ = _run(capsys, "lifetime", "--force", "10", "--json")
+    # "the much higher viscosity of water than of air results in a longer failure time" (Sec. 5.4)
+    assert row["lifetime_s"] > 10 * json.loads(out_air)[0]["lifetime_s"]
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--cup", "Z"], "cup: unknown cup 'Z'"),
+    (["--uc-table", "/nonexistent/uc.csv"], "uc-table: no such file"),
+])
+def test_example_bad_input_exits_2_without_output(capsys, tmp_path, argv, message):
+    code, _, err = _run(capsys, "example", "--out", str(tmp_path / "ex"), *argv)
+    assert code == 2 and err.count("\n") == 1 and message in err
+    assert list(tmp_path.iterdir()) == []

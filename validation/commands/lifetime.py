@@ -1,0 +1,183 @@
+"""Lifetime of a suction cup under a pull force: the paper's reduced leakage model (eqs 3-24).
+
+The cup is pressed on to r_start with no pull force (this fixes the trapped gas), the pull force
+F1 is applied at t = 0, and air leaks in through the critical constrictions until the contact
+radius reaches r1 or the force balance loses its equilibrium (fold). Several forces may be given.
+
+--reference-mode fixes every convention so results can be checked from outside: Appendix A
+stiffness (x0 = r0, x1 = r1, d0 = 2 mm, d1 = 0, E = 4 MPa), no relaxation (E = 4 MPa also for
+p/E), air at 293.15 K (eta = 1.81e-5 Pa s, m = 28.97 u), p_a = 1e5 Pa, rigid-cone geometry
+(eqs 3-5), u_c from the table by log-log interpolation.
+
+Without --uc-table the ILLUSTRATIVE u_c table shipped in reduced/data is used (a power law through
+the paper's 0.68 um at p/E = 0.025; not a rough-contact result).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+NAME = "lifetime"
+HELP = "lifetime of a suction cup under pull forces (reduced leakage model, eqs 3-24)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--cup", default="A", metavar="A|B", help="Table 1 cup preset (default: A)")
+    p.add_argument("--force", dest="force_N", type=float, nargs="+", default=[10.0], metavar="F1_N",
+                   help="pull force(s) F1 in N, > 0 (default: 10)")
+    p.add_argument("--stiffness", default="appendix-a", metavar="appendix-a|FILE.csv",
+                   help="stiffness force F0: the Appendix A formula, or a StiffnessCurve CSV "
+                        "(columns u_mm,F0_N[,h_mm,r_c_mm,l_mm,V_mm3]) (default: appendix-a)")
+    p.add_argument("--E-MPa", dest="E_MPa", type=float, default=4.0,
+                   help="Young's modulus in MPa for Appendix A and for p/E without relaxation (default: 4)")
+    p.add_argument("--d0-mm", dest="d0_mm", type=float, default=2.0,
+                   help="Appendix A wall thickness at r0 in mm (d1 = 0) (default: 2)")
+    p.add_argument("--uc-table", default=None, metavar="FILE.csv",
+                   help="critical gap table, columns p_over_E,u_c_m (u_c in m; 0 = sealed) "
+                        "(default: the illustrative table in reduced/data)")
+    p.add_argument("--relaxation", default="none", metavar="none|default|FILE.csv",
+                   help="relaxation modulus E_eff(t): none, the default power law (4.4 MPa at 1 s, "
+                        "1.8 MPa at 3e4 s), or a CSV with columns t_s,E_Pa (default: none)")
+    p.add_argument("--phi0-s", dest="phi0_s", type=float, default=None,
+                   help="contact time of the stiffness measurement in s (default: l/rdot at r_start "
+                        "and 0.12 mm/s plate speed, 13.0 s for cup A)")
+    p.add_argument("--geometry", default="cone", choices=("cone", "curve"),
+                   help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 (cone) or from the "
+                        "stiffness CSV's r_c_mm, V_mm3, l_mm columns (curve) (default: cone)")
+    p.add_argument("--fluid", default="air", choices=("air", "water"),
+                   help="what fills the cavity and leaks in: air (ideal gas, eqs 8, 19) or water "
+                        "(incompressible, eq 24; p_b from the force balance, may be negative) (default: air)")
+    p.add_argument("--liquid-viscosity-Pa-s", dest="liquid_viscosity", type=float, default=1.002e-3,
+                   help="viscosity of the liquid in Pa s for --fluid water "
+                        "(default: 1.002e-3, water at 20 C)")
+    p.add_argument("--T-K", dest="T_K", type=float, default=293.15, help="temperature in K (default: 293.15)")
+    p.add_argument("--p-a-Pa", dest="p_a_Pa", type=float, default=1e5,
+                   help="ambient pressure in Pa (default: 1e5)")
+    p.add_argument("--t-max-s", dest="t_max_s", type=float, default=1e12,
+                   help="time horizon in s; still attached then = 'horizon' (default: 1e12)")
+    p.add_argument("--rtol", type=float, default=1e-6,
+                   help="relative tolerance of the time integration (default: 1e-6)")
+    p.add_argument("--reference-mode", action="store_true",
+                   help="the reference conventions above (Appendix A, E = 4 MPa, no relaxation, "
+                        "cone geometry, air at 293.15 K, p_a = 1e5 Pa)")
+    p.add_argument("--json", action="store_true",
+                   help="print a JSON list, one object per force (force_N, lifetime_s [s, null if "
+                        "infinite], reason, sealed, ballistic_share, ...)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="write trajectory CSVs (one per force, units in the column names) and "
+                        "summary.json to DIR, atomically")
+
+
+def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
+    """The critical gap u_c(p/E) [m] the options ask for (the one place that builds it)."""
+    from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
+    return UcTable.from_csv(args.uc_table if args.uc_table else ILLUSTRATIVE_UC_CSV)
+
+
+def build_model(args: argparse.Namespace):
+    """Validate the options and build the `LeakageModel` (cheap; raises ValueError on bad input)."""
+    from reduced.appendix_a import appendix_a_curve
+    from reduced.cup import cup_by_name
+    from reduced.gas import Gas
+    from reduced.lifetime import LeakageModel, largest_holdable_force, reference_model
+    from reduced.stiffness_curve import StiffnessCurve
+    from reduced.viscoelastic import RelaxationModulus, default_relaxation
+
+    cup = cup_by_name(args.cup)
+    for F in args.force_N:
+        if not (math.isfinite(F) and F > 0):
+            raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
+    if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
+        raise ValueError(f"--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
+    uc = build_uc(args)
+    if args.reference_mode:
+        changed = [opt for opt, val, default in (
+            ("--stiffness", args.stiffness, "appendix-a"), ("--E-MPa", args.E_MPa, 4.0),
+            ("--d0-mm", args.d0_mm, 2.0), ("--relaxation", args.relaxation, "none"),
+            ("--geometry", args.geometry, "cone"), ("--T-K", args.T_K, 293.15),
+            ("--p-a-Pa", args.p_a_Pa, 1e5), ("--phi0-s", args.phi0_s, None),
+            ("--fluid", args.fluid, "air")) if val != default]
+        if changed:
+            raise ValueError(f"--reference-mode: fixes {', '.join(changed)}; drop them")
+        return reference_model(cup, uc)
+    if not (math.isfinite(args.E_MPa) and args.E_MPa > 0):
+        raise ValueError(f"--E-MPa: modulus must be > 0 MPa, got {args.E_MPa:g}")
+    if args.stiffness == "appendix-a":
+        if not (math.isfinite(args.d0_mm) and args.d0_mm > 0):
+            raise ValueError(f"--d0-mm: wall thickness must be > 0 mm, got {args.d0_mm:g}")
+        curve = appendix_a_curve(cup, E_Pa=1e6 * args.E_MPa, d0_m=1e-3 * args.d0_mm)
+    else:
+        curve = StiffnessCurve.from_csv(args.stiffness, h1_m=None if _has_h(args.stiffness) else cup.h1_m)
+    if args.relaxation == "none":
+        relax = None
+    elif args.relaxation == "default":
+        relax = default_relaxation()
+    else:
+        relax = RelaxationModulus.from_csv(args.relaxation)
+    gas = Gas(T_K=args.T_K)
+    model = LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
+                         E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
+                         geometry=args.geometry, fluid=args.fluid,
+                         liquid_viscosity_Pa_s=args.liquid_viscosity)
+    largest_holdable_force(model)   # builds the start state: checks geometry and curve range now
+    return model
+
+
+def _has_h(path: str) -> bool:
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"--stiffness: no such file '{path}'")
+    for line in p.read_text().splitlines():
+        if line.strip() and not line.startswith("#"):
+            return "h_mm" in [c.strip() for c in line.split(",")]
+    return False
+
+
+def write_trajectories(results, out: Path) -> None:
+    """One CSV per force (units in the column names) and summary.json, into an existing dir."""
+    for r in results:
+        cols = r.trajectory_columns()
+        path = out / f"trajectory_F1_{r.force_N:g}N.csv"
+        with open(path, "w") as f:
+            f.write(f"# cupcheck lifetime: F1 = {r.force_N:g} N, reason {r.reason}; {r.message}\n")
+            f.write(",".join(cols) + "\n")
+            np.savetxt(f, np.column_stack(list(cols.values())), delimiter=",", fmt="%.10g")
+    (out / "summary.json").write_text(json.dumps([r.summary() for r in results], indent=2) + "\n")
+
+
+def run(args: argparse.Namespace) -> int:
+    from reduced.lifetime import lifetime_sweep
+    from validation.output import atomic_directory, terminal_progress
+
+    model = build_model(args)
+    if args.uc_table is None and not args.json:
+        print("note: using the ILLUSTRATIVE u_c table (reduced/data/uc_illustrative.csv)", file=sys.stderr)
+    # a reference-mode lifetime takes milliseconds, a relaxed one ~0.1 s: report only long sweeps
+    cost = len(args.force_N) * (1 if model.reference else 30)
+    progress = terminal_progress("lifetime") if cost >= 100 else None
+
+    def compute():
+        return lifetime_sweep(model, args.force_N, progress=progress, t_max_s=args.t_max_s, rtol=args.rtol)
+
+    if args.out:
+        with atomic_directory(args.out) as tmp:
+            results = compute()
+            write_trajectories(results, tmp)
+    else:
+        results = compute()
+    if args.json:
+        print(json.dumps([r.summary() for r in results], indent=2))
+    else:
+        print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'ballistic':>9} {'r_end_mm':>8}")
+        for r in results:
+            life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"
+            print(f"{r.force_N:8.4g} {life:>12} {r.reason:>11} {r.ballistic_share:9.3f} "
+                  f"{1e3 * r.r_m[-1]:8.3f}")
+    return 0
