@@ -11,9 +11,9 @@ area, separation, critical junction), `effective_medium` (Bruggeman leak rate), 
 """
 
 from .line_scan import read_line_scan, spectrum_from_line_scan
-from .persson import GapTable, critical_gap_table
+from .persson import GapTable, critical_gap_table, uc_table
 from .spectrum import PowerSpectrum, read_psd_csv, self_affine
 from .surfaces import load_presets, preset
 
 __all__ = ["GapTable", "PowerSpectrum", "critical_gap_table", "load_presets", "preset",
-           "read_line_scan", "read_psd_csv", "self_affine", "spectrum_from_line_scan"]
+           "read_line_scan", "read_psd_csv", "self_affine", "spectrum_from_line_scan", "uc_table"]

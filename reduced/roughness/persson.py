@@ -310,3 +310,23 @@ def critical_gap_table(spectrum: PowerSpectrum, E_Pa: float, nu: float, p_over_E
     area = contact_area_ratio(mom.m[-1], pstar)
     return GapTable(p_over_E, u_c, u_mean, area, sealed, float(E_Pa), float(nu), method,
                     float(gamma), float(a_c), spectrum.provenance)
+
+
+#: p/E grid of the u_c tables handed to the reduced model: 40 points per decade over [1e-6, 1]
+UC_TABLE_P_OVER_E = np.geomspace(1e-6, 1.0, 241)
+
+
+def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: float = 0.45,
+             a_c: float = 0.42, p_over_E: np.ndarray | None = None):
+    """u_c(p/E) of `spectrum` as the reduced model's `UcTable` (log-log interpolated).
+
+    Without adhesion the theory is linear elastic: u_c depends on p and E only through p/E*, so
+    one table serves every modulus at this Poisson ratio, the relaxed E_eff(phi) included.
+    """
+    from reduced.critical_gap import UcTable
+
+    grid = UC_TABLE_P_OVER_E if p_over_E is None else np.asarray(p_over_E, float)
+    table = critical_gap_table(spectrum, 1e6, nu, grid, method=method, gamma=gamma, a_c=a_c)
+    note = (f"Persson theory ({method}, gamma {gamma:g}, a_c {a_c:g}, nu {nu:g}) of "
+            f"{spectrum.provenance}")
+    return UcTable(table.p_over_E, table.u_c_m, provenance=note)

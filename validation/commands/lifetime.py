@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from validation.commands._surface import add_surface_arguments, has_surface, spectrum_from_args
+
 NAME = "lifetime"
 HELP = "lifetime of a suction cup under pull forces (reduced leakage model, eqs 3-24)"
 
@@ -39,9 +41,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="Young's modulus in MPa for Appendix A and for p/E without relaxation (default: 4)")
     p.add_argument("--d0-mm", dest="d0_mm", type=float, default=2.0,
                    help="Appendix A wall thickness at r0 in mm (d1 = 0) (default: 2)")
-    p.add_argument("--uc-table", default=None, metavar="FILE.csv",
-                   help="critical gap table, columns p_over_E,u_c_m (u_c in m; 0 = sealed) "
-                        "(default: the illustrative table in reduced/data)")
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--uc-table", default=None, metavar="FILE.csv",
+                     help="critical gap table, columns p_over_E,u_c_m (u_c in m; 0 = sealed) "
+                          "(default without a surface: the ILLUSTRATIVE table in reduced/data)")
+    add_surface_arguments(p, src)
+    p.add_argument("--uc-method", default="emt", choices=("emt", "critical-junction"),
+                   help="with a surface: u_c route of Persson theory (default: emt, as in the paper)")
+    p.add_argument("--gamma", type=float, default=0.45,
+                   help="with a surface: Yang-Persson gamma [-] (default: 0.45)")
+    p.add_argument("--a-c", dest="a_c", type=float, default=0.42,
+                   help="with a surface: percolation threshold A/A0 [-] (default: 0.42)")
+    p.add_argument("--nu", type=float, default=0.5,
+                   help="with a surface: Poisson ratio of the cup for E* = E/(1-nu^2) [-] (default: 0.5)")
     p.add_argument("--relaxation", default="none", metavar="none|default|FILE.csv",
                    help="relaxation modulus E_eff(t): none, the default power law (4.4 MPa at 1 s, "
                         "1.8 MPa at 3e4 s), or a CSV with columns t_s,E_Pa (default: none)")
@@ -78,6 +90,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
     """The critical gap u_c(p/E) [m] the options ask for (the one place that builds it)."""
     from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
+    if has_surface(args):
+        from reduced.roughness import uc_table
+        from reduced.roughness.persson import check_gap_parameters, effective_modulus
+        import numpy as np
+        effective_modulus(1e6, args.nu)                                   # validates nu
+        check_gap_parameters(np.array([1.0]), args.uc_method, args.gamma, args.a_c)
+        return uc_table(spectrum_from_args(args), args.nu, method=args.uc_method,
+                        gamma=args.gamma, a_c=args.a_c)
     return UcTable.from_csv(args.uc_table if args.uc_table else ILLUSTRATIVE_UC_CSV)
 
 
@@ -157,7 +177,7 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import atomic_directory, terminal_progress
 
     model = build_model(args)
-    if args.uc_table is None and not args.json:
+    if args.uc_table is None and not has_surface(args) and not args.json:
         print("note: using the ILLUSTRATIVE u_c table (reduced/data/uc_illustrative.csv)", file=sys.stderr)
     # a reference-mode lifetime takes milliseconds, a relaxed one ~0.1 s: report only long sweeps
     cost = len(args.force_N) * (1 if model.reference else 30)

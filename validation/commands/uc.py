@@ -16,10 +16,11 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import os
 import sys
 
 import numpy as np
+
+from validation.commands._surface import add_surface_arguments, has_surface, spectrum_from_args
 
 NAME = "uc"
 HELP = "critical gap u_c(p) of a rough surface (Persson theory; presets, PSD or line scan)"
@@ -28,17 +29,8 @@ KPA = 1e3
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    src = parser.add_mutually_exclusive_group()
-    src.add_argument("--surface", metavar="NAME", help="calibrated preset (see --list-surfaces)")
-    src.add_argument("--psd", metavar="FILE", help="isotropic C(q) CSV, columns q_per_m,C_m4 [1/m, m^4]")
-    src.add_argument("--line-scan", metavar="FILE",
-                     help="line scan CSV, header x_<unit>,z_<unit> (unit m, mm, um or nm)")
+    add_surface_arguments(parser)
     parser.add_argument("--list-surfaces", action="store_true", help="list the presets and exit")
-    parser.add_argument("--psd-convention", default="persson-2d",
-                        choices=("persson-2d", "surfacetopography-2d"),
-                        help="normalisation of --psd: persson-2d (default) or surfacetopography-2d")
-    parser.add_argument("--tip-radius-um", type=float, default=1.0,
-                        help="stylus tip radius for --line-scan [um] (default 1, the paper's)")
     parser.add_argument("--E-MPa", type=float, dest="E_MPa", help="Young's modulus of the cup [MPa]")
     parser.add_argument("--nu", type=float, default=0.5, help="Poisson ratio (default 0.5)")
     parser.add_argument("--p-kPa", type=float, nargs="+", dest="p_kPa", metavar="P",
@@ -74,24 +66,6 @@ def _pressures_Pa(args) -> np.ndarray:
     return p * KPA
 
 
-def _spectrum(args):
-    from reduced.roughness.line_scan import read_line_scan, spectrum_from_line_scan
-    from reduced.roughness.spectrum import read_psd_csv
-    from reduced.roughness.surfaces import preset
-
-    for opt, path in (("--psd", args.psd), ("--line-scan", args.line_scan)):
-        if path is not None and not os.path.isfile(path):
-            raise ValueError(f"{opt}: no such file {path!r}")
-    if args.surface is not None:
-        return preset(args.surface).spectrum()
-    if args.psd is not None:
-        return read_psd_csv(args.psd, args.psd_convention)
-    if not args.tip_radius_um > 0:
-        raise ValueError(f"--tip-radius-um: must be > 0, got {args.tip_radius_um:g}")
-    x, z = read_line_scan(args.line_scan)
-    return spectrum_from_line_scan(x, z, args.tip_radius_um * 1e-6)
-
-
 def _list_surfaces() -> int:
     from reduced.roughness.surfaces import load_presets
 
@@ -109,7 +83,7 @@ def run(args) -> int:
         return _list_surfaces()
     from reduced.roughness.persson import check_gap_parameters, critical_gap_table, effective_modulus
 
-    if args.surface is None and args.psd is None and args.line_scan is None:
+    if not has_surface(args):
         raise ValueError("surface: give one of --surface NAME, --psd FILE, --line-scan FILE")
     if args.E_MPa is None:
         raise ValueError("--E-MPa: Young's modulus is required (e.g. --E-MPa 4)")
@@ -119,7 +93,7 @@ def run(args) -> int:
     check_gap_parameters(p_Pa / E_Pa, args.method, args.gamma, args.a_c)
     if args.out is not None and len(np.unique(p_Pa)) < 2:
         raise ValueError("--out: a u_c table needs at least 2 distinct pressures")
-    spectrum = _spectrum(args)
+    spectrum = spectrum_from_args(args)
 
     table = critical_gap_table(spectrum, E_Pa, args.nu, p_Pa / E_Pa, method=args.method,
                                gamma=args.gamma, a_c=args.a_c)
