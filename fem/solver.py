@@ -10,7 +10,7 @@ converged when
 
 * the active contact set did not change in the last iteration and all constraints hold,
 * the free residual satisfies ||r_f|| <= rtol * max(||reactions||, f_floor), and
-* the energy norm of the last correction |du . r_f| <= etol * (the largest one of the step).
+* the energy norm of the last correction |du . r_f| <= etol * f_ref * max|u| (the work scale).
 
 A line search along the Newton direction (secant on the energy slope s(a) = du . r_f(u + a du))
 is taken when the slope does not drop below 0.8 |s(0)|, or when an element would invert. A step
@@ -42,7 +42,7 @@ class SolverOptions:
     """Tolerances and step control (dimensionless unless suffixed)."""
 
     rtol: float = 1e-6          # residual / reaction
-    etol: float = 1e-12         # energy norm of the correction / that of the first iteration
+    etol: float = 1e-12         # energy norm of the correction / work scale f_ref max|u|
     max_iterations: int = 25
     initial_step: float = 0.01  # first step as a fraction of t_max
     max_step: float = 0.05      # largest step as a fraction of t_max (resolution of the curve)
@@ -149,7 +149,6 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
     fext = f_ext(t)
     u = guess.copy()
     history: list[float] = []
-    e0 = 0.0
     seen = {state.active.tobytes()} if plane is not None else set()
     it = 0
     try:
@@ -183,9 +182,9 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
             raise _StepFailure("singular tangent; likely cause: an unconstrained rigid-body mode "
                                "or a structural instability (buckling)", history)
         energy = abs(du[free] @ res[free])
-        e0 = max(e0, energy)
+        e_ref = f_ref * max(np.max(np.abs(u)), np.max(np.abs(du)), 1e-9 * _size(mech))
         held = np.max(np.abs(du[dofs]), initial=0.0) <= 1e-14 * (1.0 + np.max(np.abs(u)))
-        converged = held and rnorm <= opts.rtol * f_ref and energy <= opts.etol * e0
+        converged = held and rnorm <= opts.rtol * f_ref and energy <= opts.etol * e_ref
         if plane is not None and held and (converged or rnorm <= opts.active_set_rtol * f_ref):
             new = plane.update(state, u, res, u_start)
             if np.any(new.active != state.active):
@@ -233,8 +232,10 @@ def _line_search(mech, u, du, res_free, free, fext, history, exact=False, tries:
                            "cause: the load step is too large for the deformation", history) from None
 
 
+def _size(mech: Mechanics) -> float:
+    return float(np.max(np.ptp(mech.kin.node_coordinates(), axis=1)))
+
+
 def _force_floor(mech: Mechanics) -> float:
     """A force scale below which residuals are round-off: 1e-6 mu L^2 with L the body's size."""
-    X = mech.kin.node_coordinates()
-    L = float(np.max(np.ptp(X, axis=1)))
-    return 1e-6 * mech.material.mu * L**2
+    return 1e-6 * mech.material.mu * _size(mech) ** 2
