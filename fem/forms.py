@@ -144,10 +144,13 @@ class Mechanics:
     # --- the three quantities -------------------------------------------------------------
     def pressure_and_dilatation(self, f: np.ndarray):
         """For the mixed form: Theta = Pi_h J, p = Pi_h U'(Theta) at the points."""
-        theta = self.project(jacobian(f))
-        if np.any(theta <= 0):
+        # project J - 1 rather than J: the projection of the constant 1 carries round-off that
+        # lambda would amplify into a spurious pressure (~1e-6 Pa at nu = 0.49)
+        dtheta = self.project(jacobian(f) - 1.0)
+        if np.any(dtheta <= -1.0):
             raise FloatingPointError("projected dilatation Theta <= 0 (inverted element)")
-        return theta, self.project(self.material.volumetric(theta)[1])
+        theta = 1.0 + dtheta
+        return theta, self.project(self.material.volumetric(theta, np.log1p(dtheta))[1])
 
     def energy(self, u: np.ndarray) -> float:
         """Stored elastic energy Pi(u) [J]."""
@@ -157,7 +160,7 @@ class Mechanics:
             W = m.energy(f)
         else:
             theta, _ = self.pressure_and_dilatation(f)
-            W = m.isochoric(f)[0] + m.volumetric(theta)[0]
+            W = m.isochoric(f)[0] + m.volumetric(theta, np.log1p(theta - 1.0))[0]
         return float(np.sum(W * self.kin.dV))
 
     def stress(self, f: np.ndarray) -> np.ndarray:
@@ -197,7 +200,7 @@ class Mechanics:
         Ke = np.einsum("eqil,eqlj->eij", BA, Bt)
         if m.formulation == "mixed":
             q, Minv = self._p1
-            d2U = m.volumetric(theta)[2]
+            d2U = m.volumetric(theta, np.log1p(theta - 1.0))[2]
             G = np.einsum("aeq,ikeq,keq,eq->eai", q, B, g, dV)   # [nel, 3, 18]
             D = np.einsum("aeq,beq,eq->eab", q, q, d2U * dV)
             C = Minv @ D @ Minv

@@ -64,9 +64,11 @@ class NeoHookean:
         return self.E_Pa * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
 
     # --- the split W = W_iso(f) + U(J) -------------------------------------------------------
-    def volumetric(self, J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """U(J) = lambda/2 (ln J)^2 and its first two derivatives."""
-        lnJ = np.log(J)
+    def volumetric(self, J: np.ndarray, lnJ: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """U(J) = lambda/2 (ln J)^2 and its first two derivatives (lnJ may be passed if known
+        more accurately than log(J), e.g. as log1p(J - 1))."""
+        lnJ = np.log(J) if lnJ is None else lnJ
         return (0.5 * self.lam * lnJ**2, self.lam * lnJ / J, self.lam * (1.0 - lnJ) / J**2)
 
     def isochoric(self, f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
