@@ -258,11 +258,12 @@ def cup_geometry(cup: str = "A", **overrides: Any) -> CupGeometry:
 _FILE_KEYS = ("cup", "name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention", "thickness")
 
 
-def geometry_from_mapping(data: Mapping[str, Any], source: str = "geometry") -> CupGeometry:
+def geometry_from_mapping(data: Mapping[str, Any], source: str = "geometry",
+                          cup: str = "A") -> CupGeometry:
     """A `CupGeometry` from plain data (the parsed geometry file; keys in mm and degrees).
 
-    Keys (all optional except as noted): ``cup`` ("A" or "B": start from that preset, default
-    "A"), ``name``, ``r0_mm``, ``r1_mm``, ``alpha_deg``, ``thickness_convention``
+    Keys (all optional): ``cup`` ("A" or "B": start from that preset; default the argument
+    `cup`), ``name``, ``r0_mm``, ``r1_mm``, ``alpha_deg``, ``thickness_convention``
     ("normal"|"vertical") and ``thickness``, a table ``{"r_mm": [...], "d_mm": [...]}`` (two
     points: the line through them, extrapolated; more: piecewise-linear, covering [r0, r1]).
     """
@@ -280,11 +281,21 @@ def geometry_from_mapping(data: Mapping[str, Any], source: str = "geometry") -> 
     if "thickness" in data:
         overrides["thickness"] = _profile_from_mapping(data["thickness"], source)
     overrides["name"] = str(data.get("name", f"{source}"))
-    return cup_geometry(str(data.get("cup", "A")), **overrides)
+    return cup_geometry(str(data.get("cup", cup)), **overrides)
 
 
-def load_geometry(path: str | Path) -> CupGeometry:
-    """Read a geometry file (``.json`` or ``.toml``; keys as in `geometry_from_mapping`)."""
+def load_geometry(path: str | Path, cup: str = "A") -> CupGeometry:
+    """Read a geometry file (``.json`` or ``.toml``; keys as in `geometry_from_mapping`).
+
+    Example (TOML)::
+
+        cup = "A"                      # preset the other keys modify
+        alpha_deg = 30
+        thickness_convention = "normal"
+        [thickness]                    # 2 points: a line (extrapolated); more: a table
+        r_mm = [5, 12, 19]
+        d_mm = [2.5, 1.2, 0.45]
+    """
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"geometry: no such file '{path}'")
@@ -300,7 +311,7 @@ def load_geometry(path: str | Path) -> CupGeometry:
         raise ValueError(f"geometry: cannot parse '{path}': {exc}".replace("\n", " ")) from None
     if not isinstance(data, Mapping):
         raise ValueError(f"geometry: '{path}' must hold a table of keys")
-    return geometry_from_mapping(data, source=path.name)
+    return geometry_from_mapping(data, source=path.name, cup=cup)
 
 
 def _profile_from_mapping(value: Any, source: str) -> ThicknessProfile:

@@ -221,3 +221,27 @@ def test_an_inverted_element_is_rejected():
     x[:, centre] = x[:, mesh.t[0, 0]]       # drag an element's centre node outside it
     with pytest.raises(ValueError, match="inverted"):
         check_cup_mesh(type(mesh)(x, mesh.t, mesh.boundaries))
+
+
+# ------------------------------------------------------------ meshes/ folder
+REPO = __import__("pathlib").Path(__file__).resolve().parents[1]
+
+
+def test_committed_cup_meshes_are_what_the_script_generates(tmp_path):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("generate", REPO / "meshes" / "generate.py")
+    generate = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(generate)
+    for path in generate.cup_mesh_files(tmp_path):
+        assert path.read_bytes() == (REPO / "meshes" / path.name).read_bytes(), path.name
+        mesh = read_mesh(path)
+        assert len(mesh.boundaries["cavity"]) > 0
+
+
+def test_the_gmsh_drawn_user_design_reads_with_its_physical_curves():
+    # written by Gmsh 4.15 itself (format 4.1, quad9) from meshes/user_lip.geo
+    mesh = read_mesh(REPO / "meshes" / "user_lip.msh")
+    assert isinstance(mesh, MeshQuad2)
+    assert all(len(mesh.boundaries[name]) > 0 for name in BOUNDARY_NAMES)
+    r, z = mesh.doflocs[:, boundary_path(mesh, "cavity")]
+    assert (r[0], z[0]) == pytest.approx((5 * MM, 7 * MM)) and (r[-1], z[-1]) == pytest.approx((19 * MM, 0.0))
