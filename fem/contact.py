@@ -125,11 +125,21 @@ class RigidPlane:
         return r_int[2 * self.nodes + 1]
 
     def update(self, state: ContactState, u: np.ndarray, r_int: np.ndarray,
-               u_start: np.ndarray) -> ContactState:
+               u_start: np.ndarray, stiffness: np.ndarray | None = None) -> ContactState:
         """One primal-dual active-set update (module docstring). u_start: last converged state,
-        used to locate the touchdown point of newly active nodes for the sticking law."""
+        used to locate the touchdown point of newly active nodes for the sticking law.
+
+        With `stiffness` (the tangent's diagonal), only the single worst violation changes: the
+        largest of the penetration -g and the tensile reaction over the dof stiffness, -lambda/k."""
         g, lam = self.gap(u), self.reactions(r_int)
         active = np.where(state.active, lam >= 0.0, g < 0.0)
+        if stiffness is not None:
+            k = stiffness[2 * self.nodes + 1]
+            violation = np.where(state.active, -lam / k, -g)
+            active = state.active.copy()
+            worst = int(np.argmax(violation))
+            if violation[worst] > 0:
+                active[worst] = not active[worst]
         stick = state.u_r_stick.copy()
         new = active & ~state.active
         if np.any(new):

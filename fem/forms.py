@@ -42,13 +42,13 @@ __all__ = ["Mechanics", "internal_force_form", "tangent_form", "energy_form"]
 # --------------------------------------------------------------------------------------------
 def _f(w_u, R):
     """5-vector f = (F_rR, F_rZ, F_zR, F_zZ, F_tt) of a vector field at the points."""
-    g, v = w_u.grad, w_u.value
+    g, v = w_u.grad, np.asarray(w_u)
     return np.stack([1.0 + g[0, 0], g[0, 1], g[1, 0], 1.0 + g[1, 1], 1.0 + v[0] / R])
 
 
 def _df(v, R):
     """Variation dF[v] as a 5-vector."""
-    g, val = v.grad, v.value
+    g, val = v.grad, np.asarray(v)
     return np.stack([g[0, 0], g[0, 1], g[1, 0], g[1, 1], val[0] / R])
 
 
@@ -125,7 +125,7 @@ class Mechanics:
     @cached_property
     def _p1(self):
         """q[a, e, q] = {1, (R - R_e)/h_e, (Z - Z_e)/h_e} and the inverse Gram matrices M^-1 [nel, 3, 3]."""
-        X = self.kin.basis.global_coordinates().value       # [2, nel, nq]
+        X = np.asarray(self.kin.basis.global_coordinates())       # [2, nel, nq]
         dV = self.kin.dV
         vol = dV.sum(axis=1)
         c = np.einsum("deq,eq->de", X, dV) / vol

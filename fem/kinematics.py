@@ -61,7 +61,7 @@ class Kinematics:
     @cached_property
     def R(self) -> np.ndarray:
         """Reference radius at the quadrature points [nel, nq]."""
-        return self.basis.global_coordinates().value[0]
+        return np.asarray(self.basis.global_coordinates())[0]
 
     @cached_property
     def dV(self) -> np.ndarray:
@@ -73,7 +73,7 @@ class Kinematics:
         """d f_k / d u_i as [18, 5, nel, nq]."""
         out = np.zeros((self.basis.Nbfun, 5) + self.R.shape)
         for i, (phi,) in enumerate(self.basis.basis):
-            grad, value = phi.grad, phi.value
+            grad, value = phi.grad, np.asarray(phi)
             out[i, 0:2] = grad[0]           # F_rR, F_rZ from u_r
             out[i, 2:4] = grad[1]           # F_zR, F_zZ from u_z
             out[i, 4] = value[0] / self.R   # hoop stretch from u_r / R

@@ -10,7 +10,7 @@ converged when
 
 * the active contact set did not change in the last iteration and all constraints hold,
 * the free residual satisfies ||r_f|| <= rtol * max(||reactions||, f_floor), and
-* the energy norm of the last correction |du . r_f| <= etol * (the largest one of the step).
+* the energy norm of the last correction |du . r_f| <= etol * f_ref * max|u| (the work scale).
 
 A line search along the Newton direction (secant on the energy slope s(a) = du . r_f(u + a du))
 is taken when the slope does not drop below 0.8 |s(0)|, or when an element would invert. A step
@@ -42,16 +42,18 @@ class SolverOptions:
     """Tolerances and step control (dimensionless unless suffixed)."""
 
     rtol: float = 1e-6          # residual / reaction
-    etol: float = 1e-12         # energy norm of the correction / that of the first iteration
+    etol: float = 1e-12         # energy norm of the correction / work scale f_ref max|u|
     max_iterations: int = 25
-    initial_step: float = 0.05  # first step as a fraction of t_max
+    initial_step: float = 0.01  # first step as a fraction of t_max
     max_step: float = 0.05      # largest step as a fraction of t_max (resolution of the curve)
     min_step: float = 1e-5      # smallest step as a fraction of t_max before giving up
     growth: float = 1.5         # step growth after an easy step (<= easy_iterations)
     easy_iterations: int = 6
+    active_set_rtol: float = 1e-3   # residual / reaction below which the contact set is revisited
+    max_active_sets: int = 40       # distinct contact sets tried in one step before giving up
 
     def __post_init__(self) -> None:
-        for name in ("rtol", "etol", "initial_step", "max_step", "min_step"):
+        for name in ("rtol", "etol", "initial_step", "max_step", "min_step", "active_set_rtol"):
             v = getattr(self, name)
             if not (0.0 < v <= 1.0):
                 raise ValueError(f"{name}: must be in (0, 1], got {v}")
@@ -106,7 +108,6 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     t, u_prev, t_prev = 0.0, None, None
     dt = options.initial_step * t_max
     steps = iterations = cutbacks = 0
-    last_failure = None
     while t < t_max * (1 - 1e-12):
         t1 = min(t + dt, t_max)
         if t_max - t1 < 0.2 * dt:          # don't leave a sliver at the end
@@ -116,7 +117,6 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             u1, r1, state1, its = _newton(mech, dirichlet, f_ext, plane, state, u0, guess, t1, options)
         except _StepFailure as fail:
             cutbacks += 1
-            last_failure = fail
             iterations += len(fail.history)
             dt *= 0.5
             if dt < options.min_step * t_max:
@@ -135,37 +135,30 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             progress(t / t_max, f"step {steps}: t = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:
             dt = min(dt * options.growth, options.max_step * t_max)
-    del last_failure
     return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, n)
 
 
 def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
-    """Newton iterations of one step; returns (u, r_int, contact state, iterations)."""
+    """Newton iterations of one step; returns (u, r_int, contact state, iterations).
+
+    The contact active set is revisited whenever the iterate is nearly converged for the
+    current set (||r_f|| <= active_set_rtol * f_ref): all violating nodes change at once; if
+    that reproduces a set already tried in this step, only the worst violation changes."""
     n = mech.kin.ndofs
     fixed_dofs, fixed_vals = dirichlet(t)
     fext = f_ext(t)
     u = guess.copy()
     history: list[float] = []
-    e0 = None
-    changes = 0
-    linearization = None
-    for it in range(opts.max_iterations):
-        try:
-            r, K = linearization or mech.linearize(u)
-        except FloatingPointError as err:
-            raise _StepFailure(f"{err} at the predictor/iterate; likely cause: the step is too "
-                               "large for the deformation, or the mesh is too coarse", history)
-        linearization = None
+    seen = {state.active.tobytes()} if plane is not None else set()
+    it = 0
+    try:
+        r, K = mech.linearize(u)
+    except FloatingPointError as err:
+        raise _StepFailure(f"{err} at the predictor; likely cause: the step is too large for "
+                           "the deformation, or the mesh is too coarse", history) from None
+    while True:
         res = r - fext
-        changed = False
         if plane is not None:
-            new = plane.update(state, u, res, u_start)
-            changed = bool(np.any(new.active != state.active))
-            changes += changed
-            state = new
-            if changes > 12:
-                raise _StepFailure("the contact active set keeps changing (nodes chatter between "
-                                   "contact and lift-off); likely cause: too large a step", history)
             cd, cv = plane.constraints(state)
             dofs, vals = np.concatenate([fixed_dofs, cd]), np.concatenate([fixed_vals, cv])
         else:
@@ -174,37 +167,51 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
         free[dofs] = False
         du = np.zeros(n)
         du[dofs] = vals - u[dofs]
-        react = res[dofs]
-        f_ref = max(np.linalg.norm(react), np.linalg.norm(fext), _force_floor(mech))
+        f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext), _force_floor(mech))
         rnorm = np.linalg.norm(res[free])
         history.append(rnorm / f_ref)
         if not np.all(np.isfinite(res)):
             raise _StepFailure("the residual is not finite", history)
         rhs = -res[free] - K[free][:, dofs] @ du[dofs]
-        Kff = K[free][:, free]
         try:
-            du[free] = spla.spsolve(Kff.tocsc(), rhs)
+            du[free] = spla.spsolve(K[free][:, free].tocsc(), rhs)
         except RuntimeError as err:  # singular factor
-            raise _StepFailure(f"singular tangent ({err}); likely cause: an unconstrained rigid-body "
-                               "mode or a structural instability", history)
+            raise _StepFailure(f"singular tangent ({err}); likely cause: an unconstrained "
+                               "rigid-body mode or a structural instability", history) from None
         if not np.all(np.isfinite(du)):
-            raise _StepFailure("singular tangent; likely cause: an unconstrained rigid-body mode or "
-                               "a structural instability (buckling)", history)
+            raise _StepFailure("singular tangent; likely cause: an unconstrained rigid-body mode "
+                               "or a structural instability (buckling)", history)
         energy = abs(du[free] @ res[free])
-        e0 = energy if e0 is None else max(e0, energy)
-        constrained_ok = np.max(np.abs(du[dofs]), initial=0.0) <= 1e-14 * (1 + np.max(np.abs(u)))
-        if (it > 0 and not changed and constrained_ok and rnorm <= opts.rtol * f_ref
-                and energy <= opts.etol * max(e0, 1e-300)):
+        e_ref = f_ref * max(np.max(np.abs(u)), np.max(np.abs(du)), 1e-9 * _size(mech))
+        held = np.max(np.abs(du[dofs]), initial=0.0) <= 1e-14 * (1.0 + np.max(np.abs(u)))
+        converged = held and rnorm <= opts.rtol * f_ref and energy <= opts.etol * e_ref
+        if plane is not None and held and (converged or rnorm <= opts.active_set_rtol * f_ref):
+            new = plane.update(state, u, res, u_start)
+            if np.any(new.active != state.active):
+                if new.active.tobytes() in seen:
+                    new = plane.update(state, u, res, u_start, stiffness=K.diagonal())
+                if new.active.tobytes() in seen or len(seen) > opts.max_active_sets:
+                    raise _StepFailure("the contact active set cycles (nodes chatter between "
+                                       "contact and lift-off); likely cause: too large a step", history)
+                seen.add(new.active.tobytes())
+                state = new
+                continue
+        if converged:
             return u, r, state, it
-        alpha, linearization = _line_search(mech, u, du, res[free], free, fext, history)
+        it += 1
+        if it >= opts.max_iterations:
+            raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely "
+                               "cause: a structural instability (snap-through/buckling) or a "
+                               "too-large step", history)
+        # full steps while constraints are being imposed; line search once they hold
+        alpha, (r, K) = _line_search(mech, u, du, res[free], free, fext, history, exact=not held)
         u = u + alpha * du
-    raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely cause: "
-                       "a structural instability (snap-through/buckling) or a too-large step", history)
 
 
-def _line_search(mech, u, du, res_free, free, fext, history, tries: int = 6):
+def _line_search(mech, u, du, res_free, free, fext, history, exact=False, tries: int = 6):
     """Step length along du: 1 unless an element inverts (halve) or the energy slope
     s(a) = du . r_f(u + a du) changes sign and stays above 0.8 |s(0)| (secant to s = 0).
+    With `exact`, only inversion shortens the step (prescribed jumps in du make s meaningless).
     Returns (alpha, linearization at u + alpha du)."""
     s0 = du[free] @ res_free
     alpha = 1.0
@@ -215,7 +222,7 @@ def _line_search(mech, u, du, res_free, free, fext, history, tries: int = 6):
             alpha *= 0.5
             continue
         s1 = du[free] @ (trial[0] - fext)[free]
-        if s0 == 0.0 or np.sign(s1) == np.sign(s0) or abs(s1) <= 0.8 * abs(s0):
+        if exact or s0 == 0.0 or np.sign(s1) == np.sign(s0) or abs(s1) <= 0.8 * abs(s0):
             return alpha, trial
         alpha *= max(0.1, s0 / (s0 - s1))
     try:
@@ -225,8 +232,10 @@ def _line_search(mech, u, du, res_free, free, fext, history, tries: int = 6):
                            "cause: the load step is too large for the deformation", history) from None
 
 
+def _size(mech: Mechanics) -> float:
+    return float(np.max(np.ptp(mech.kin.node_coordinates(), axis=1)))
+
+
 def _force_floor(mech: Mechanics) -> float:
     """A force scale below which residuals are round-off: 1e-6 mu L^2 with L the body's size."""
-    X = mech.kin.node_coordinates()
-    L = float(np.max(np.ptp(X, axis=1)))
-    return 1e-6 * mech.material.mu * L**2
+    return 1e-6 * mech.material.mu * _size(mech) ** 2
