@@ -96,11 +96,13 @@ class MeshSpec:
         return replace(self, n_along=factor * self.n_along, n_through=factor * self.n_through)
 
 
-#: fidelity levels; each doubles the counts of the previous one (constant refinement ratio 2)
+#: fidelity levels; each doubles the counts of the previous one (constant refinement ratio 2).
+#: Tuned with benchmarks/bench_fem.py: along_grading 0.5 balances the thin rim, where contact
+#: starts, against the thick inner wall, whose contact governs the steep end of F0(u).
 FIDELITIES: dict[str, MeshSpec] = {
-    "coarse": MeshSpec(n_along=16, n_through=2, along_grading=1.0, through_ratio=1.0),
-    "medium": MeshSpec(n_along=32, n_through=4, along_grading=1.0, through_ratio=1.0),
-    "fine": MeshSpec(n_along=64, n_through=8, along_grading=1.0, through_ratio=1.0),
+    "coarse": MeshSpec(n_along=24, n_through=2, along_grading=0.5, through_ratio=1.0),
+    "medium": MeshSpec(n_along=48, n_through=4, along_grading=0.5, through_ratio=1.0),
+    "fine": MeshSpec(n_along=96, n_through=8, along_grading=0.5, through_ratio=1.0),
 }
 
 

@@ -16,11 +16,12 @@ samples; integrals of such profiles are exact (no quadrature error beyond the in
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = ["enclosed_volume", "inner_contact_radius", "pressure_weighted_width",
-           "half_maximum_width", "contact_force"]
+           "half_maximum_width", "contact_force", "Richardson", "richardson"]
 
 
 def enclosed_volume(r_m: np.ndarray, z_m: np.ndarray, in_contact: np.ndarray | None = None) -> float:
@@ -124,6 +125,39 @@ def half_maximum_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = 
     left = r[lo] if lo == 0 else _crossing(r[lo - 1], p[lo - 1], r[lo], p[lo], half)
     right = r[hi] if hi == r.size - 1 else _crossing(r[hi], p[hi], r[hi + 1], p[hi + 1], half)
     return float(right - max(left, r_c))
+
+
+@dataclass(frozen=True)
+class Richardson:
+    """Richardson extrapolation of a quantity from three meshes with a constant refinement ratio.
+
+    order : observed order p (NaN where the three values do not converge monotonically);
+    extrapolated : f_fine + (f_fine - f_medium) / (ratio^p - 1) (f_fine where p is NaN);
+    fine_error : |extrapolated - f_fine| (|f_fine - f_medium| where p is NaN), the estimated
+        discretisation error of the finest mesh.
+    """
+
+    order: np.ndarray
+    extrapolated: np.ndarray
+    fine_error: np.ndarray
+
+
+def richardson(f_coarse: np.ndarray, f_medium: np.ndarray, f_fine: np.ndarray,
+               ratio: float = 2.0) -> Richardson:
+    """Observed order and extrapolated value from meshes of sizes h, h/ratio, h/ratio^2.
+
+    If f_h = f* + C h^p exactly, p = log((f_c - f_m)/(f_m - f_f)) / log(ratio) and f* are
+    recovered to round-off. Works elementwise on arrays (e.g. F0 at common plate displacements).
+    """
+    fc, fm, ff = (np.asarray(f, dtype=float) for f in (f_coarse, f_medium, f_fine))
+    d1, d2 = fc - fm, fm - ff
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = d1 / d2
+        monotone = (q > 1.0) & np.isfinite(q)
+        p = np.where(monotone, np.log(np.where(monotone, q, 2.0)) / math.log(ratio), np.nan)
+        extrapolated = np.where(monotone, ff - d2 / (q - 1.0), ff)   # ratio^p - 1 = q - 1
+    fine_error = np.where(monotone, np.abs(extrapolated - ff), np.abs(d2))
+    return Richardson(order=p, extrapolated=extrapolated, fine_error=fine_error)
 
 
 def _crossing(r0: float, p0: float, r1: float, p1: float, level: float) -> float:

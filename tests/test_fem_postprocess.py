@@ -166,3 +166,19 @@ def test_bad_profiles():
         half_maximum_width(np.array([1.0, 2.0]), np.array([0.0, 0.0]))
     with pytest.raises(ValueError, match="NaN"):
         enclosed_volume(np.array([1.0, np.nan]), np.array([1.0, 0.0]))
+
+
+# ------------------------------------------------------------ Richardson
+def test_richardson_recovers_order_and_limit_of_a_power_law():
+    from fem.postprocess import richardson
+    h = np.array([0.4, 0.2, 0.1])
+    for p, f_star, c in [(2.0, 3.0, 5.0), (3.0, -1.0, -2.0), (1.3, 10.0, 0.7)]:
+        f = f_star + c * h ** p
+        rich = richardson(*f)
+        assert rich.order == pytest.approx(p, rel=1e-10)
+        assert rich.extrapolated == pytest.approx(f_star, rel=1e-10)
+        assert rich.fine_error == pytest.approx(abs(c) * 0.1 ** p, rel=1e-8)
+    # oscillating (non-monotone) values: no order, the finest value, its last change as the error
+    rich = richardson(np.array([1.0]), np.array([1.2]), np.array([1.1]))
+    assert np.isnan(rich.order[0]) and rich.extrapolated[0] == 1.1
+    assert rich.fine_error[0] == pytest.approx(0.1)
