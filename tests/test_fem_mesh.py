@@ -136,7 +136,7 @@ def test_boundary_path_runs_from_the_plate_to_the_rim(mesh_a):
 def test_mesh_spec_validation():
     assert mesh_spec("medium").n_along == 2 * mesh_spec("coarse").n_along
     assert mesh_spec("coarse", n_through=3).n_through == 3
-    for bad in ({"n_along": 0}, {"n_through": 2.5}, {"along_grading": -1}, {"through_ratio": 0},
+    for bad in ({"n_along": 0}, {"n_through": 2.5}, {"along_grading": -2}, {"through_ratio": 0},
                 {"element": "hex"}):
         with pytest.raises(ValueError, match=next(iter(bad))):
             mesh_spec("coarse", **bad)
