@@ -29,7 +29,7 @@ from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import BilinearForm, LinearForm
+from skfem import BilinearForm, LinearForm, MeshQuad2
 
 from .kinematics import IDENTITY, Kinematics
 from .material import NeoHookean, jacobian, jacobian_gradient, jacobian_hessian
@@ -124,14 +124,17 @@ class Mechanics:
     # --- P1disc projection for the mixed formulation ---------------------------------------
     @cached_property
     def _p1(self):
-        """q[a, e, q] = {1, (R - R_e)/h_e, (Z - Z_e)/h_e} and the inverse Gram matrices M^-1 [nel, 3, 3]."""
+        """q[a, e, q] = {1, (R - R_e)/h_e, (Z - Z_e)/h_e} (quads: Q2-P1disc) or {1} (triangles:
+        P2-P0, as P2-P1disc is not inf-sup stable) and the inverse Gram matrices M^-1 [nel, n, n]."""
         X = np.asarray(self.kin.basis.global_coordinates())       # [2, nel, nq]
         dV = self.kin.dV
         vol = dV.sum(axis=1)
         c = np.einsum("deq,eq->de", X, dV) / vol
         h = np.sqrt(self.kin.basis.dx.sum(axis=1))
-        q = np.stack([np.ones_like(dV), (X[0] - c[0][:, None]) / h[:, None],
-                      (X[1] - c[1][:, None]) / h[:, None]])
+        q = [np.ones_like(dV)]
+        if isinstance(self.kin.mesh, MeshQuad2):
+            q += [(X[0] - c[0][:, None]) / h[:, None], (X[1] - c[1][:, None]) / h[:, None]]
+        q = np.stack(q)
         M = np.einsum("aeq,beq,eq->eab", q, q, dV)
         return q, np.linalg.inv(M)
 

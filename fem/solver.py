@@ -149,7 +149,7 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
     fext = f_ext(t)
     u = guess.copy()
     history: list[float] = []
-    seen = {state.active.tobytes()} if plane is not None else set()
+    seen = {state.key()} if plane is not None else set()
     it = 0
     try:
         r, K = mech.linearize(u)
@@ -188,16 +188,18 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
         if plane is not None and held and (converged or rnorm <= opts.active_set_rtol * f_ref):
             new = plane.update(state, u, res, u_start)
             if np.any(new.active != state.active):
-                if new.active.tobytes() in seen:
+                if new.key() in seen and plane.law == "sticking":
+                    new = plane.let_slip(state, new.active != state.active)
+                if new.key() in seen:
                     new = plane.update(state, u, res, u_start, stiffness=K.diagonal())
-                if new.active.tobytes() in seen or len(seen) > opts.max_active_sets:
+                if new.key() in seen or len(seen) > opts.max_active_sets:
                     raise _StepFailure("the contact active set cycles (nodes chatter between "
                                        "contact and lift-off); likely cause: too large a step", history)
-                seen.add(new.active.tobytes())
+                seen.add(new.key())
                 state = new
                 continue
         if converged:
-            return u, r, state, it
+            return u, r, (plane.settle(state, u) if plane is not None else state), it
         it += 1
         if it >= opts.max_iterations:
             raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely "
