@@ -47,7 +47,7 @@ import numpy as np
 from skfem import Mesh
 
 from .contact import PressureProfile, RigidPlane
-from .mesh import boundary_path
+from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
 from .postprocess import (enclosed_volume, half_maximum_width, inner_contact_radius,
                           pressure_weighted_width)
 from .forms import Mechanics
@@ -57,7 +57,6 @@ from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
 __all__ = ["compress_cup", "CupResponse", "cup_height", "REQUIRED_BOUNDARIES"]
 
-REQUIRED_BOUNDARIES = ("top_plate", "cavity")
 
 
 @dataclass(frozen=True, eq=False)
@@ -185,13 +184,10 @@ def _strip(r: np.ndarray, p: np.ndarray) -> tuple[float, float, float]:
 
 
 def _check_mesh(mesh: Mesh) -> None:
-    missing = [b for b in REQUIRED_BOUNDARIES if mesh.boundaries is None or b not in mesh.boundaries]
-    if missing:
-        raise ValueError(f"mesh: boundary tags {missing} are missing; a cup mesh needs "
-                         f"{list(REQUIRED_BOUNDARIES)}")
+    """`fem.mesh.check_cup_mesh` (tags, orientation, r >= 0, z >= 0), and the rim on the plane."""
+    check_cup_mesh(mesh)
     zmin = float(mesh.doflocs[1].min())
-    size = float(np.ptp(mesh.doflocs[1]))
-    if abs(zmin) > 1e-9 * size:
+    if zmin > 1e-9 * float(np.ptp(mesh.doflocs[1])):
         raise ValueError(f"mesh: the rim must rest on the plane z = 0 (lowest z = {zmin:.3g} m)")
 
 

@@ -135,7 +135,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             progress(t / t_max, f"step {steps}: t = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:
             dt = min(dt * options.growth, options.max_step * t_max)
-    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, n)
+    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n))
 
 
 def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
