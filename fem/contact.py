@@ -52,6 +52,12 @@ class ContactState:
 
     active: np.ndarray         # bool [ncand]
     u_r_stick: np.ndarray      # float [ncand], meaningful where active
+    slipping: np.ndarray | None = None   # bool [ncand]: sticking law, node may slide this step
+
+    def key(self) -> bytes:
+        """Identity of the set for cycle detection."""
+        slip = self.slipping if self.slipping is not None else np.zeros_like(self.active)
+        return self.active.tobytes() + slip.tobytes()
 
 
 @dataclass(frozen=True)
@@ -77,6 +83,7 @@ class RigidPlane:
     kin: Kinematics
     facets: np.ndarray            # candidate boundary facets (global facet indices)
     law: ContactLaw = "frictionless"
+    exclude: np.ndarray | None = None   # nodes that are never candidates (e.g. clamped ones)
 
     def __post_init__(self) -> None:
         if self.law not in ("frictionless", "sticking"):
@@ -86,7 +93,10 @@ class RigidPlane:
         # facet nodes: two vertices and the midpoint node (numbered after the vertices)
         fn = np.vstack([mesh.facets[:, self.facets], nv + self.facets[None, :]])
         object.__setattr__(self, "_facet_nodes", fn)
-        object.__setattr__(self, "nodes", np.unique(fn))
+        nodes = np.unique(fn)
+        if self.exclude is not None:
+            nodes = np.setdiff1d(nodes, self.exclude)
+        object.__setattr__(self, "nodes", nodes)
 
     @classmethod
     def on(cls, kin: Kinematics, boundaries: list[str], exclude: list[str] = (),
@@ -94,17 +104,16 @@ class RigidPlane:
         """Candidates: the facets of the named boundaries, minus nodes on the `exclude` boundaries."""
         mesh = kin.mesh
         facets = np.unique(np.concatenate([mesh.boundaries[b] for b in boundaries]))
-        plane = cls(kin, facets, law)
+        excl = None
         if exclude:
             excl = np.unique(np.concatenate(
                 [kin.basis.get_dofs(mesh.boundaries[b]).all() // 2 for b in exclude]))
-            object.__setattr__(plane, "nodes", np.setdiff1d(plane.nodes, excl))
-        return plane
+        return cls(kin, facets, law, excl)
 
     # --- the state -----------------------------------------------------------------------
     def initial_state(self) -> ContactState:
         n = len(self.nodes)
-        return ContactState(np.zeros(n, bool), np.zeros(n))
+        return ContactState(np.zeros(n, bool), np.zeros(n), np.zeros(n, bool))
 
     def gap(self, u: np.ndarray) -> np.ndarray:
         """Signed nodal gap g = Z + u_z [m] (negative: penetration)."""
@@ -116,8 +125,9 @@ class RigidPlane:
         dofs = [2 * self.nodes[a] + 1]
         vals = [-self.kin.node_coordinates()[1, self.nodes[a]]]
         if self.law == "sticking":
-            dofs.append(2 * self.nodes[a])
-            vals.append(state.u_r_stick[a])
+            stuck = np.flatnonzero(state.active & ~state.slipping)
+            dofs.append(2 * self.nodes[stuck])
+            vals.append(state.u_r_stick[stuck])
         return np.concatenate(dofs), np.concatenate(vals)
 
     def reactions(self, r_int: np.ndarray) -> np.ndarray:
@@ -140,14 +150,37 @@ class RigidPlane:
             worst = int(np.argmax(violation))
             if violation[worst] > 0:
                 active[worst] = not active[worst]
+        return self.activate(replace(state, active=active & state.active,
+                                     slipping=state.slipping & active),
+                             active & ~state.active, u, u_start)
+
+    def activate(self, state: ContactState, nodes: np.ndarray, u: np.ndarray,
+                 u_start: np.ndarray) -> ContactState:
+        """Put `nodes` on the plane; newly active ones stick (sticking law) at their touchdown
+        point, interpolated linearly in the step between u_start (gap g0 > 0) and u (gap < 0);
+        a node that was on the plane at the step start (g0 = 0), lifted off during the iteration
+        and lands again, lands where the iterate puts it."""
+        new = nodes & ~state.active
         stick = state.u_r_stick.copy()
-        new = active & ~state.active
         if np.any(new):
-            g0 = np.maximum(self.gap(u_start)[new], 0.0)
-            t = g0 / np.maximum(g0 - g[new], 1e-300)       # fraction of the step at touchdown
+            g, g0 = self.gap(u)[new], self.gap(u_start)[new]
+            t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g, 1e-300), 1.0)
             ur0, ur1 = u_start[2 * self.nodes[new]], u[2 * self.nodes[new]]
             stick[new] = ur0 + np.clip(t, 0.0, 1.0) * (ur1 - ur0)
-        return replace(state, active=active, u_r_stick=stick)
+        return replace(state, active=state.active | nodes, u_r_stick=stick)
+
+    def let_slip(self, state: ContactState, nodes: np.ndarray) -> ContactState:
+        """Sticking law, a node cycling between stuck-with-tension and lift-off-into-penetration
+        within a step: its normal force is zero to within the step, so no friction can hold it
+        (Coulomb with zero normal force); keep it on the plane, free to slide, for this step."""
+        return replace(state, active=state.active | nodes, slipping=state.slipping | nodes)
+
+    def settle(self, state: ContactState, u: np.ndarray) -> ContactState:
+        """End of a converged step: slipping nodes stick where they are now."""
+        if not np.any(state.slipping):
+            return state
+        stick = np.where(state.slipping, u[2 * self.nodes], state.u_r_stick)
+        return replace(state, u_r_stick=stick, slipping=np.zeros_like(state.slipping))
 
     # --- post-processing -----------------------------------------------------------------
     def _positions(self, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:

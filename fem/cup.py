@@ -6,28 +6,32 @@
     resp.F0_N, resp.r_c_m, resp.l_m, resp.V_m3        # per converged step, at resp.u_m
     resp.write_fields("cup.vtu")                        # displacement, Cauchy stress, pressure
 
-The mesh is a scikit-fem ``MeshQuad2`` of the cross-section in metres (x = r, y = z) with the
-boundary tags 'top_plate' (the edge at r0, clamped to the rigid plate), 'cavity' (the lower,
-cavity-facing surface, from the plate down to the rim), 'outer' and 'rim'. The rim's inner corner
-rests on the plane, z = 0, in the undeformed state. h1 is the height of the lowest top-plate node.
+The mesh is a scikit-fem ``MeshQuad2`` (or ``MeshTri2``) of the cross-section in metres (x = r,
+y = z) with the boundary tags 'top_plate' (the edge at r0, clamped to the rigid plate) and 'cavity'
+(the lower, cavity-facing surface, from the plate down to the rim); 'outer' and 'rim' are usual
+(`fem.mesh`) but not needed. The rim's inner corner rests on the plane, z = 0, in the undeformed
+state. h1 is the height of the lowest top-plate node.
 
 Loading (Sec. 5.3): the plate moves down by u (displacement control), h = h1 - u; the top-plate
 nodes follow it rigidly (u_r = 0, u_z = -u). Every boundary node except those on the plate may
 touch the plane (`fem.contact`); the contact zones are whatever the solution makes them.
 
+The pressure profile p(r) is the projected contact pressure at the boundary nodes, sorted by
+deformed radius (0 at nodes not in contact); r_c, l, l_half_max and V come from the pure functions
+of `fem.postprocess` applied to it and to the deformed cavity path.
+
 Per converged step, `CupResponse` holds (all SI):
 
 * ``F0_N``: the reaction on the top plate, the cup spring force F0 (eq. 7); ``F0_contact_N``: the
   integrated contact force 2 pi int p r dr, which equals F0 by equilibrium (a check, both stored);
-* ``r_c_m``: the inner contact radius (eq. 3's r): the deformed radius of the innermost node in
-  contact along the cavity surface (resolution: the local node spacing);
+* ``r_c_m``: the inner contact radius (eq. 3's r), `postprocess.inner_contact_radius`: between
+  the innermost node in contact and its free neighbour, where a square-root edge extrapolates to 0;
 * ``V_m3``: the cavity volume under the plate and inside the cup down to z = 0 (the region of
-  eq. 4), V = pi int r^2 dz along the deformed cavity surface from the inner contact point up to
-  the plate;
-* ``l_m``: the pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr,
-  which is exactly l for a uniform strip of width l (the paper's eq. 6 picture), and an integral of
-  the projected pressure, hence mesh-convergent; ``l_half_max_m``: the width of the contiguous
-  region around the pressure maximum where p >= max p / 2;
+  eq. 4), `postprocess.enclosed_volume` of the deformed cavity path down to its first contact;
+* ``l_m``: the pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
+  (`postprocess.pressure_weighted_width`), exactly l for a uniform strip of width l (the paper's
+  eq. 6 picture) and an integral of the pressure, hence mesh-convergent; ``l_half_max_m``: the width
+  at half maximum of the projected pressure (`postprocess.half_maximum_width`);
 * ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
   elastic energy), ``newton_iterations``, and the pressure profiles ``pressure[i]``.
 """
@@ -43,15 +47,16 @@ import numpy as np
 from skfem import Mesh
 
 from .contact import PressureProfile, RigidPlane
+from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
+from .postprocess import (enclosed_volume, half_maximum_width, inner_contact_radius,
+                          pressure_weighted_width)
 from .forms import Mechanics
 from .kinematics import Kinematics
-from .material import NeoHookean, cauchy_stress
+from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["compress_cup", "CupResponse", "cup_height", "contact_width", "half_max_width",
-           "REQUIRED_BOUNDARIES"]
+__all__ = ["compress_cup", "CupResponse", "cup_height", "REQUIRED_BOUNDARIES"]
 
-REQUIRED_BOUNDARIES = ("top_plate", "cavity", "outer", "rim")
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,9 +126,9 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     kin = Kinematics.of(mesh)
     mech = Mechanics(kin, material)
     top = _boundary_nodes(mesh, "top_plate")
-    plane = RigidPlane.on(kin, ["cavity", "rim", "outer"], exclude=["top_plate"], law=contact)
+    plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top)
     top_dofs = np.concatenate([2 * top, 2 * top + 1])
-    cavity = _CavityCurve.of(mesh, kin)
+    path = boundary_path(mesh, "cavity")
 
     def dirichlet(u):
         return top_dofs, np.concatenate([np.zeros(len(top)), np.full(len(top), -u)])
@@ -134,14 +139,19 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     def on_step(s: StepResult) -> None:
         prof, p_nodes = plane.pressure(s.u, s.contact, s.r_int)
         Fc = float(np.sum(prof.p_gauss_Pa * prof.w_m2))
-        r_c, V = cavity.inner_contact_and_volume(s.u, plane.nodes[s.contact.active])
+        active = plane.nodes[s.contact.active]
+        x = kin.node_coordinates() + np.stack([s.u[0::2], s.u[1::2]])
+        on_path = np.isin(path, active)
+        on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
+        V = enclosed_volume(x[0, path], x[1, path], on_path)
+        r_c, l, l_hm = _strip(x[0, active], p_nodes[active]) if active.size else (x[0, path[-1]], 0.0, 0.0)
         rec["u"].append(s.t)
         rec["F0"].append(-float(np.sum(s.r_int[2 * top + 1])))
         rec["Fc"].append(Fc)
         rec["rc"].append(r_c)
         rec["V"].append(V)
-        rec["l"].append(contact_width(prof, r_c))
-        rec["lhm"].append(half_max_width(prof))
+        rec["l"].append(l)
+        rec["lhm"].append(l_hm)
         rec["pen"].append(plane.largest_penetration(s.u))
         rec["W"].append(mech.energy(s.u))
         rec["its"].append(s.iterations)
@@ -160,55 +170,24 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
         nodal_pressure_Pa=tuple(rec["pn"]))
 
 
-# ------------------------------------------------------------------------------------------
-# Strip widths from a pressure profile (pure functions of the profile)
-# ------------------------------------------------------------------------------------------
-def contact_width(profile: PressureProfile, r_c_m: float) -> float:
-    """Pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA) [m] (0 without contact).
-
-    For a uniform pressure on a strip [r_c, r_c + l] it returns l (to O(l / r_c)); it is an integral
-    of the projected pressure, so it converges with the mesh like the pressure does in L2.
-    """
-    if profile.w_m2.size == 0 or not np.isfinite(r_c_m) or r_c_m <= 0:
-        return 0.0
-    P1 = np.sum(profile.p_gauss_Pa * profile.w_m2)
-    P2 = np.sum(profile.p_gauss_Pa**2 * profile.w_m2)
-    return float(P1**2 / (2.0 * np.pi * r_c_m * P2)) if P2 > 0 else 0.0
+def _strip(r: np.ndarray, p: np.ndarray) -> tuple[float, float, float]:
+    """(r_c, l, l_half_max) of the nodal pressure of the nodes in contact, sorted by radius; with
+    fewer than two loaded nodes (the rim corner alone) r_c is that node's radius and l = 0."""
+    order = np.argsort(r)
+    r, p = r[order], np.maximum(p[order], 0.0)
+    keep = np.concatenate([[True], np.diff(r) > 0])
+    r, p = r[keep], p[keep]
+    if r.size < 2 or np.count_nonzero(p > 0) < 2:
+        return float(r[np.argmax(p)] if np.any(p > 0) else r[0]), 0.0, 0.0
+    r_c = inner_contact_radius(r, p)
+    return r_c, pressure_weighted_width(r, p, r_c), half_maximum_width(r, p, r_c)
 
 
-def half_max_width(profile: PressureProfile) -> float:
-    """Width [m] of the contiguous radial interval around the pressure maximum where p >= max p / 2
-    (crossings located by linear interpolation between sample points); 0 without contact."""
-    r, p = profile.r_m, profile.p_Pa
-    if r.size < 2 or np.max(p) <= 0:
-        return 0.0
-    k = int(np.argmax(p))
-    half = 0.5 * p[k]
-    lo = k
-    while lo > 0 and p[lo - 1] >= half:
-        lo -= 1
-    hi = k
-    while hi < r.size - 1 and p[hi + 1] >= half:
-        hi += 1
-    r_lo, r_hi = r[lo], r[hi]
-    if lo > 0 and p[lo] != p[lo - 1]:
-        r_lo = r[lo - 1] + (half - p[lo - 1]) / (p[lo] - p[lo - 1]) * (r[lo] - r[lo - 1])
-    if hi < r.size - 1 and p[hi] != p[hi + 1]:
-        r_hi = r[hi] + (half - p[hi]) / (p[hi + 1] - p[hi]) * (r[hi + 1] - r[hi])
-    return float(r_hi - r_lo)
-
-
-# ------------------------------------------------------------------------------------------
-# Geometry of the deformed cavity surface
-# ------------------------------------------------------------------------------------------
 def _check_mesh(mesh: Mesh) -> None:
-    missing = [b for b in REQUIRED_BOUNDARIES if mesh.boundaries is None or b not in mesh.boundaries]
-    if missing:
-        raise ValueError(f"mesh: boundary tags {missing} are missing; a cup mesh needs "
-                         f"{list(REQUIRED_BOUNDARIES)}")
+    """`fem.mesh.check_cup_mesh` (tags, orientation, r >= 0, z >= 0), and the rim on the plane."""
+    check_cup_mesh(mesh)
     zmin = float(mesh.doflocs[1].min())
-    size = float(np.ptp(mesh.doflocs[1]))
-    if abs(zmin) > 1e-9 * size:
+    if zmin > 1e-9 * float(np.ptp(mesh.doflocs[1])):
         raise ValueError(f"mesh: the rim must rest on the plane z = 0 (lowest z = {zmin:.3g} m)")
 
 
@@ -216,65 +195,3 @@ def _boundary_nodes(mesh: Mesh, name: str) -> np.ndarray:
     nv = int(mesh.t.max()) + 1
     f = mesh.boundaries[name]
     return np.unique(np.concatenate([mesh.facets[:, f].ravel(), nv + f]))
-
-
-@dataclass(frozen=True)
-class _CavityCurve:
-    """The cavity-facing boundary as an ordered chain of quadratic facets (plate -> rim)."""
-
-    facet_nodes: np.ndarray     # [3, nf]: start vertex, end vertex, midpoint; ordered along the chain
-    X: np.ndarray               # reference node coordinates
-
-    @classmethod
-    def of(cls, mesh: Mesh, kin: Kinematics) -> "_CavityCurve":
-        nv = int(mesh.t.max()) + 1
-        f = mesh.boundaries["cavity"]
-        ends = mesh.facets[:, f]
-        X = kin.node_coordinates()
-        # walk the chain starting at the end that lies on the top plate
-        top = set(_boundary_nodes(mesh, "top_plate").tolist())
-        nbr: dict[int, list[int]] = {}
-        for j, (a, b) in enumerate(ends.T):
-            nbr.setdefault(a, []).append(j)
-            nbr.setdefault(b, []).append(j)
-        starts = [v for v in nbr if len(nbr[v]) == 1 and v in top]
-        if len(starts) != 1:
-            raise ValueError("mesh: the 'cavity' boundary must be one chain of facets starting at "
-                             "the 'top_plate' edge")
-        order, node, used = [], starts[0], set()
-        while True:
-            nxt = [j for j in nbr[node] if j not in used]
-            if not nxt:
-                break
-            j = nxt[0]
-            used.add(j)
-            a, b = ends[:, j]
-            a, b = (a, b) if a == node else (b, a)
-            order.append((a, b, nv + f[j]))
-            node = b
-        return cls(np.array(order).T, X)
-
-    def inner_contact_and_volume(self, u: np.ndarray, active_nodes: np.ndarray) -> tuple[float, float]:
-        """(r_c, V): the first node in contact along the chain from the plate, and the volume
-        pi int r^2 dz from the plate down to it (or to the rim if the cavity has no contact)."""
-        fn = self.facet_nodes
-        x = self.X[:, fn] + np.stack([u[2 * fn], u[2 * fn + 1]])      # [2, 3, nf]
-        on = np.isin(fn[:2], active_nodes)                              # start/end node in contact
-        hit = np.flatnonzero(on[0] | on[1])
-        if hit.size:
-            j = hit[0]
-            last = j - 1 if on[0, j] else j          # facets 0..last lie above the contact point
-            r_c = float(x[0, 0, j] if on[0, j] else x[0, 1, j])
-        else:
-            last = fn.shape[1] - 1
-            r_c = float(x[0, 1, last])
-        s, w = np.polynomial.legendre.leggauss(4)
-        s, w = 0.5 * (s + 1), 0.5 * w
-        N = np.stack([(1 - s) * (1 - 2 * s), s * (2 * s - 1), 4 * s * (1 - s)])
-        dN = np.stack([4 * s - 3, 4 * s - 1, 4 - 8 * s])
-        xs = x[:, :, : last + 1]
-        r = np.einsum("ag,an->gn", N, xs[0])
-        dz = np.einsum("ag,an->gn", dN, xs[1])
-        # the chain runs from the plate down: dz < 0, so V = -pi int r^2 dz along it
-        V = float(-np.pi * np.sum(r**2 * dz * w[:, None]))
-        return r_c, V

@@ -1,6 +1,6 @@
 """Field export: displacement, Cauchy stress and contact pressure of a cup step through meshio.
 
-The cells are the 9-node quadrilaterals of the reference mesh (VTK biquadratic quads), so
+The cells are the 9-node quadrilaterals (or 6-node triangles) of the reference mesh, so
 ParaView's "Warp By Vector" with ``displacement`` shows the deformed cup. Point data:
 ``displacement`` [m] (3 components, u_theta = 0) and ``contact_pressure`` [Pa] (the projected
 pressure of `fem.contact`, 0 off contact). Cell data: the element mean (over the 3x3 Gauss points,
@@ -26,8 +26,8 @@ if TYPE_CHECKING:
 
 __all__ = ["write_fields", "element_cauchy_stress"]
 
-# scikit-fem's Q2 node order per element equals VTK's biquadratic quad order
-# (4 corners counter-clockwise, 4 edge midpoints starting with edge 0-1, centre)
+# scikit-fem's Q2 (P2) node order per element equals VTK's biquadratic quad (quadratic triangle)
+# order: corners, then edge midpoints starting with edge 0-1, then the centre
 
 
 def element_cauchy_stress(mech: Mechanics, u: np.ndarray) -> np.ndarray:
@@ -47,13 +47,14 @@ def write_fields(resp: "CupResponse", path: str | Path, step: int = -1) -> Path:
     kin = Kinematics.of(resp.mesh)
     mech = Mechanics(kin, resp.material)
     u = resp.displacements[step]
-    cells = kin.dofs[0::2].T // 2            # node ids per element, VTK quad9 order
+    cells = kin.dofs[0::2].T // 2            # node ids per element, in VTK's node order
+    kind = "quad9" if cells.shape[1] == 9 else "triangle6"
     disp = np.zeros((kin.mesh.doflocs.shape[1], 3))
     disp[:, 0], disp[:, 1] = u[0::2], u[1::2]
     sig = element_cauchy_stress(mech, u)
     out = meshio.Mesh(
         points=np.column_stack([kin.mesh.doflocs.T, np.zeros(disp.shape[0])]),
-        cells=[("quad9", cells)],
+        cells=[(kind, cells)],
         point_data={"displacement": disp, "contact_pressure": resp.nodal_pressure_Pa[step]},
         cell_data={name: [sig[k]] for k, name in
                    enumerate(("sigma_rr", "sigma_zz", "sigma_tt", "sigma_rz"))},

@@ -11,9 +11,10 @@ f = (F_rR, F_rZ, F_zR, F_zZ, F_tt) we precompute, once per mesh, the strain-disp
 B[i, k, e, q] = d f_k / d u_i for local dof i of element e at quadrature point q, and then
 f = 1 + sum_i B_i u_i. The element kernels in `fem.forms` are contractions of B with the material.
 
-Elements: 9-node biquadratic quadrilaterals (scikit-fem ``ElementQuad2``), isoparametric. Quads
-because the cup's cross-section is a thin, structured strip, where Q2 bends without shear locking
-and maps curved edges exactly; 3x3 Gauss points (``intorder=4``) integrate the stiffness.
+Elements: 9-node biquadratic quadrilaterals (scikit-fem ``ElementQuad2`` on ``MeshQuad2``),
+isoparametric: the cup's cross-section is a thin, structured strip, where Q2 bends without shear
+locking and maps curved edges exactly; 3x3 Gauss points (``intorder=4``) integrate the stiffness.
+6-node triangles (``ElementTriP2`` on ``MeshTri2``) are accepted for users' unstructured meshes.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from skfem import Basis, ElementQuad2, ElementVector, Mesh, MeshQuad2
+from skfem import Basis, ElementQuad2, ElementTriP2, ElementVector, Mesh, MeshQuad2, MeshTri2
 
 __all__ = ["Kinematics", "IDENTITY"]
 
@@ -38,15 +39,16 @@ class Kinematics:
 
     @classmethod
     def of(cls, mesh: Mesh, intorder: int = 4) -> "Kinematics":
-        if not isinstance(mesh, MeshQuad2):
-            raise ValueError(
-                f"mesh: a quadratic quadrilateral mesh (skfem.MeshQuad2) is required, got {type(mesh).__name__}")
+        if not isinstance(mesh, (MeshQuad2, MeshTri2)):
+            raise ValueError("mesh: a quadratic mesh (skfem.MeshQuad2 or MeshTri2) is required, "
+                             f"got {type(mesh).__name__}")
         if np.min(mesh.doflocs[0]) < -1e-12 * np.ptp(mesh.doflocs[0]):
             raise ValueError("mesh: the axisymmetric cross-section must lie in R >= 0 (x = r, y = z)")
-        return cls(Basis(mesh, ElementVector(ElementQuad2()), intorder=intorder))
+        element = ElementQuad2() if isinstance(mesh, MeshQuad2) else ElementTriP2()
+        return cls(Basis(mesh, ElementVector(element), intorder=intorder))
 
     @property
-    def mesh(self) -> MeshQuad2:
+    def mesh(self) -> Mesh:
         return self.basis.mesh
 
     @property
@@ -55,7 +57,7 @@ class Kinematics:
 
     @property
     def dofs(self) -> np.ndarray:
-        """Global dof of local dof i in element e, [18, nel]. Dof 2n + c is component c of node n."""
+        """Global dof of local dof i in element e, [18 or 12, nel]. Dof 2n + c is component c of node n."""
         return self.basis.element_dofs
 
     @cached_property
@@ -70,7 +72,7 @@ class Kinematics:
 
     @cached_property
     def B(self) -> np.ndarray:
-        """d f_k / d u_i as [18, 5, nel, nq]."""
+        """d f_k / d u_i as [ndofs_per_element, 5, nel, nq]."""
         out = np.zeros((self.basis.Nbfun, 5) + self.R.shape)
         for i, (phi,) in enumerate(self.basis.basis):
             grad, value = phi.grad, np.asarray(phi)
