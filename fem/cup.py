@@ -106,7 +106,9 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
                  u_max_m: float | None = None,
                  progress: Callable[[float, str], None] | None = None,
                  **solver_opts: Any) -> CupResponse:
-    """Press the cup from u = 0 to u_max_m (default 0.9 h1) and return its `CupResponse`.
+    """Press the cup from u = 0 to u_max_m (default 0.9 h1, at most h1: there the plate's edge
+    reaches the plane; the steep rise of F0 where the wall is squeezed flat lies just below it)
+    and return its `CupResponse`.
 
     solver_opts: fields of `fem.solver.SolverOptions` (rtol, etol, max_iterations, initial_step,
     max_step, min_step, growth). Raises ValueError for bad input, `fem.solver.ConvergenceError`
@@ -118,9 +120,10 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     if not isinstance(material, NeoHookean):
         raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
     u_max = 0.9 * h1 if u_max_m is None else float(u_max_m)
-    if not (0.0 < u_max <= 1.25 * h1):
-        raise ValueError(f"u_max_m: plate displacement must be in (0, 1.25 h1] = (0, "
-                         f"{1.25 * h1 * 1e3:.4g} mm], got {u_max * 1e3:.4g} mm")
+    if not (0.0 < u_max <= h1):
+        raise ValueError(f"u_max_m: plate displacement must be in (0, h1] = (0, "
+                         f"{h1 * 1e3:.4g} mm] (at u = h1 the plate reaches the plane), "
+                         f"got {u_max * 1e3:.4g} mm")
     options = SolverOptions(**solver_opts)
 
     kin = Kinematics.of(mesh)
