@@ -5,9 +5,8 @@ x(s, t); every Q2 node (vertices, edge midpoints, centres) is placed by the map 
 edges are represented to the element's order. Boundaries are tagged 'left' (s = 0), 'right'
 (s = 1), 'bottom' (t = 0) and 'top' (t = 1) of the parameter square.
 
-The cup meshes of the toolkit are made by `fem.mesh` (graded, tagged 'top_plate', 'cavity',
-'outer', 'rim'); `stand_in_cup_mesh` is a plain cone strip with the same tags, used only by
-the FEM core's own tests so that they do not depend on the mesh generator.
+The cup meshes of the toolkit are made by `fem.mesh`; these blocks serve the verification
+problems of the FEM core (patch tests, Lame's cylinder, Hertz's contact).
 """
 
 from __future__ import annotations
@@ -17,7 +16,7 @@ from collections.abc import Callable
 import numpy as np
 from skfem import MeshQuad1, MeshQuad2
 
-__all__ = ["mapped_block", "graded", "stand_in_cup_mesh"]
+__all__ = ["mapped_block", "graded"]
 
 
 def graded(n: int, ratio: float = 1.0) -> np.ndarray:
@@ -46,22 +45,3 @@ def mapped_block(s: np.ndarray, t: np.ndarray,
     tags = {"left": mid[0] < tol, "right": mid[0] > 1 - tol,
             "bottom": mid[1] < tol, "top": mid[1] > 1 - tol}
     return mesh.with_boundaries({k: np.intersect1d(np.flatnonzero(v), bnd) for k, v in tags.items()})
-
-
-def stand_in_cup_mesh(alpha_deg: float = 33.0, r0_m: float = 5e-3, r1_m: float = 19e-3,
-                      d0_m: float = 2.5e-3, d1_m: float = 0.447e-3, n_along: int = 40,
-                      n_through: int = 2, rim_grading: float = 0.25) -> MeshQuad2:
-    """Cone strip (lower surface from (r0, h1) to (r1, 0), thickness offset along the normal,
-    linear d) tagged 'top_plate' (s = 0), 'rim' (s = 1), 'cavity' (lower) and 'outer' (upper)."""
-    a = np.radians(alpha_deg)
-    h1 = (r1_m - r0_m) * np.tan(a)
-    n = np.array([np.sin(a), np.cos(a)])
-
-    def x(s, t):
-        d = d0_m + s * (d1_m - d0_m)
-        return r0_m + s * (r1_m - r0_m) + t * d * n[0], h1 * (1 - s) + t * d * n[1]
-
-    m = mapped_block(graded(n_along, rim_grading), np.linspace(0, 1, n_through + 1), x)
-    b = m.boundaries
-    return m.with_boundaries({"top_plate": b["left"], "rim": b["right"], "cavity": b["bottom"],
-                              "outer": b["top"]})

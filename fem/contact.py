@@ -150,18 +150,24 @@ class RigidPlane:
             worst = int(np.argmax(violation))
             if violation[worst] > 0:
                 active[worst] = not active[worst]
+        return self.activate(replace(state, active=active & state.active,
+                                     slipping=state.slipping & active),
+                             active & ~state.active, u, u_start)
+
+    def activate(self, state: ContactState, nodes: np.ndarray, u: np.ndarray,
+                 u_start: np.ndarray) -> ContactState:
+        """Put `nodes` on the plane; newly active ones stick (sticking law) at their touchdown
+        point, interpolated linearly in the step between u_start (gap g0 > 0) and u (gap < 0);
+        a node that was on the plane at the step start (g0 = 0), lifted off during the iteration
+        and lands again, lands where the iterate puts it."""
+        new = nodes & ~state.active
         stick = state.u_r_stick.copy()
-        new = active & ~state.active
-        slipping = state.slipping & active
         if np.any(new):
-            # touchdown by linear interpolation in the step; a node that was on the plane at the
-            # step start (g0 = 0), lifted off during the iteration and lands again, lands where
-            # the iterate puts it (t = 1)
-            g0 = self.gap(u_start)[new]
-            t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g[new], 1e-300), 1.0)
+            g, g0 = self.gap(u)[new], self.gap(u_start)[new]
+            t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g, 1e-300), 1.0)
             ur0, ur1 = u_start[2 * self.nodes[new]], u[2 * self.nodes[new]]
             stick[new] = ur0 + np.clip(t, 0.0, 1.0) * (ur1 - ur0)
-        return replace(state, active=active, u_r_stick=stick, slipping=slipping)
+        return replace(state, active=state.active | nodes, u_r_stick=stick)
 
     def let_slip(self, state: ContactState, nodes: np.ndarray) -> ContactState:
         """Sticking law, a node cycling between stuck-with-tension and lift-off-into-penetration

@@ -121,6 +121,17 @@ class Mechanics:
         """Assemble element vectors re[nel, 18]."""
         return np.bincount(self.kin.dofs.T.ravel(), weights=re.ravel(), minlength=self.kin.ndofs)
 
+    @cached_property
+    def _Bt(self) -> np.ndarray:
+        """The B-operator as [nel, nq, 18, 5] (contiguous, for batched products)."""
+        return np.ascontiguousarray(np.transpose(self.kin.B, (2, 3, 0, 1)))
+
+    @cached_property
+    def _BtT(self) -> np.ndarray:
+        """[nel, nq * 5, 18]: Bt with (q, k) stacked, the right factor of K_e."""
+        ne, nq, nb, _ = self._Bt.shape
+        return np.ascontiguousarray(np.transpose(self._Bt, (0, 1, 3, 2)).reshape(ne, nq * 5, nb))
+
     # --- P1disc projection for the mixed formulation ---------------------------------------
     @cached_property
     def _p1(self):
@@ -180,7 +191,7 @@ class Mechanics:
         if np.any(jacobian(f) <= 0):
             raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
         P = self.stress(f)
-        re = np.einsum("ikeq,keq,eq->ei", self.kin.B, P, self.kin.dV)
+        re = np.einsum("eqik,keq->ei", self._Bt, P * self.kin.dV)
         return self._vector(re)
 
     def linearize(self, u: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
@@ -188,7 +199,7 @@ class Mechanics:
         f = self.kin.deformation_gradient(u)
         if np.any(jacobian(f) <= 0):
             raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
-        m, B, dV = self.material, self.kin.B, self.kin.dV
+        m, dV = self.material, self.kin.dV
         if m.formulation == "displacement":
             P, A = m.stress(f), m.tangent(f)
         else:
@@ -197,14 +208,18 @@ class Mechanics:
             g = jacobian_gradient(f)
             P = P + p * g
             A = A + p * jacobian_hessian(f)
-        re = np.einsum("ikeq,keq,eq->ei", B, P, dV)
-        BA = np.einsum("ikeq,kleq,eq->eqil", B, A, dV)          # [nel, nq, 18, 5]
-        Bt = np.transpose(B, (2, 3, 1, 0))                       # [nel, nq, 5, 18]
-        Ke = np.einsum("eqil,eqlj->eij", BA, Bt)
+        Bt = self._Bt                                            # [nel, nq, 18, 5]
+        re = np.einsum("eqik,keq->ei", Bt, P * dV)
+        # K_e = sum_q Bt_q (A_q dV_q) Bt_q^T as batched matrix products
+        AdV = np.transpose(A * dV, (2, 3, 0, 1))                 # [nel, nq, 5, 5]
+        BA = Bt @ AdV                                            # [nel, nq, 18, 5]
+        ne, nq, nb, _ = Bt.shape
+        Ke = BA.transpose(0, 2, 1, 3).reshape(ne, nb, nq * 5) @ self._BtT
         if m.formulation == "mixed":
             q, Minv = self._p1
             d2U = m.volumetric(theta, np.log1p(theta - 1.0))[2]
-            G = np.einsum("aeq,ikeq,keq,eq->eai", q, B, g, dV)   # [nel, 3, 18]
+            dJ = np.einsum("eqik,keq->eqi", self._Bt, g * dV)       # dJ[v] dV at the points
+            G = np.einsum("aeq,eqi->eai", q, dJ)                     # [nel, 3, 18]
             D = np.einsum("aeq,beq,eq->eab", q, q, d2U * dV)
             C = Minv @ D @ Minv
             Ke += np.einsum("eai,eab,ebj->eij", G, C, G)

@@ -135,7 +135,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             progress(t / t_max, f"step {steps}: t = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:
             dt = min(dt * options.growth, options.max_step * t_max)
-    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, n)
+    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n))
 
 
 def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
@@ -172,9 +172,8 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
         history.append(rnorm / f_ref)
         if not np.all(np.isfinite(res)):
             raise _StepFailure("the residual is not finite", history)
-        rhs = -res[free] - K[free][:, dofs] @ du[dofs]
         try:
-            du[free] = spla.spsolve(K[free][:, free].tocsc(), rhs)
+            du = _solve_constrained(K, -res, free, du)
         except RuntimeError as err:  # singular factor
             raise _StepFailure(f"singular tangent ({err}); likely cause: an unconstrained "
                                "rigid-body mode or a structural instability", history) from None
@@ -232,6 +231,20 @@ def _line_search(mech, u, du, res_free, free, fext, history, exact=False, tries:
     except FloatingPointError:
         raise _StepFailure("line search failed: every step length inverts an element; likely "
                            "cause: the load step is too large for the deformation", history) from None
+
+
+def _solve_constrained(K, rhs, free, du_fixed):
+    """Solve K du = rhs on the free dofs with du = du_fixed on the others, by symmetric
+    elimination in place of the rows and columns (the sparsity pattern is kept)."""
+    K = K.copy()
+    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+    fixed = ~free
+    b = rhs - K @ np.where(fixed, du_fixed, 0.0)
+    K.data[fixed[rows] | fixed[K.indices]] = 0.0
+    K.data[fixed[rows] & (rows == K.indices)] = 1.0
+    b[fixed] = du_fixed[fixed]
+    # the pattern is structurally symmetric: a minimum-degree ordering of A^T + A suits it
+    return spla.spsolve(K.tocsc(), b, permc_spec="MMD_AT_PLUS_A")
 
 
 def _size(mech: Mechanics) -> float:
