@@ -55,18 +55,18 @@ def run_validation(out_dir: str | Path, *, quick: bool = False, only: Sequence[s
     memo = memo or RunMemo()
     plan = planned_requests(quick, only)
     report = Report(Path(out_dir))
-    done = {"n": 0}
+    done = {"sections": 0}
     base = progress or (lambda f, m: None)
 
-    def step(fraction: float, message: str) -> None:
-        base(min(done["n"] / max(len(plan) + len(sections), 1), 0.999), message)
+    def step(fraction: float, message: str) -> None:      # runs asked for so far + sections done
+        n = memo.computed + memo.cache_hits + done["sections"]
+        base(min(n / max(len(plan) + len(sections), 1), 0.999), message)
 
     ctx = Context(memo=memo, report=report, quick=quick, progress=step)
     t0 = time.perf_counter()
     for s in sections:
-        before = memo.computed + memo.cache_hits
         s.run(ctx)
-        done["n"] += 1 + (memo.computed + memo.cache_hits - before)
+        done["sections"] += 1
     if scene:
         from validation.crosscheck.scene import deformed_cup_scene
         deformed_cup_scene(ctx)
