@@ -51,6 +51,13 @@ def requests(quick: bool) -> tuple[FemRun, ...]:
                  for c in CONTACTS for f, e in (QUICK_LEVELS if quick else LEVELS))
 
 
+def relative_error(value: float, reference: float) -> float:
+    """|value / reference - 1|; nan where the reference is 0 or not finite (no relative scale)."""
+    if not (math.isfinite(reference) and reference != 0.0):
+        return math.nan
+    return abs(value / reference - 1.0)
+
+
 def _median_time(fn, repeat: int = 5) -> tuple[float, object]:
     times, out = [], None
     for _ in range(repeat):
@@ -102,7 +109,7 @@ def run(ctx: Context) -> None:
         ref, order, how = _reference(rows)
         table = []
         for r in rows:
-            r["errors"] = {q: abs(r[q] / ref[q] - 1.0) for q in QUANTITIES}
+            r["errors"] = {q: relative_error(r[q], ref[q]) for q in QUANTITIES}
             table.append([r["level"], r["wall_s"], r["dofs"]] + [r[q] for q in QUANTITIES]
                          + [r["errors"][q] for q in QUANTITIES])
         table.append([f"reference ({how})", math.nan, 0] + [ref[q] for q in QUANTITIES]
@@ -168,7 +175,8 @@ def _pareto(ctx: Context, all_rows, rrows) -> None:
             a.loglog([r["wall_s"] for r in rows], [max(r["errors"][q], floor) for r in rows], markers[q],
                      label=q, alpha=0.8)
         for r in rows:
-            a.annotate(r["level"].replace("FEM ", ""), (r["wall_s"], max(max(r["errors"].values()), floor)),
+            top = float(np.nanmax([*r["errors"].values(), floor]))
+            a.annotate(r["level"].replace("FEM ", ""), (r["wall_s"], top),
                        fontsize=6, xytext=(3, 3), textcoords="offset points")
         a.loglog([r[1] for r in rrows], [max(r[4], floor) for r in rrows], "x-", color="k",
                  label="lifetime, reduced rtol")
@@ -179,8 +187,9 @@ def _pareto(ctx: Context, all_rows, rrows) -> None:
 
 
 def _recommendation(rows, rrows) -> str:
-    def worst(r):
-        return max(r["errors"][q] for q in QUANTITIES)
+    def worst(r):           # nan errors (no reference scale) are left out, and said so in the table
+        finite = [e for e in r["errors"].values() if math.isfinite(e)]
+        return max(finite) if finite else math.nan
     fem = [r for r in rows if r["level"].startswith("FEM")]
     lines = ["**Recommendation** (from the numbers above; largest error over F0, l and the lifetime; "
              "errors below the reference's own uncertainty are not resolved):"]
