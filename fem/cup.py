@@ -138,42 +138,39 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     def dirichlet(u):
         return top_dofs, np.concatenate([np.zeros(len(top)), np.full(len(top), -u)])
 
-    rec: dict[str, list] = {k: [] for k in (
-        "u", "F0", "Fc", "rc", "V", "l", "lhm", "pen", "W", "its", "p", "disp", "pn")}
+    steps: list[dict[str, Any]] = []
 
     def on_step(s: StepResult) -> None:
-        prof, p_nodes = plane.pressure(s.u, s.contact, s.r_int)
-        Fc = float(np.sum(prof.p_gauss_Pa * prof.w_m2))
-        active = plane.nodes[s.contact.active]
-        x = kin.node_coordinates() + np.stack([s.u[0::2], s.u[1::2]])
-        on_path = np.isin(path, active)
-        on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
-        V = enclosed_volume(x[0, path], x[1, path], on_path)
-        r_c, l_hm = _edge_and_half_width(prof, x[0, path[-1]])
-        l = contact_width(prof, r_c)
-        rec["u"].append(s.t)
-        rec["F0"].append(-float(np.sum(s.r_int[2 * top + 1])))
-        rec["Fc"].append(Fc)
-        rec["rc"].append(r_c)
-        rec["V"].append(V)
-        rec["l"].append(l)
-        rec["lhm"].append(l_hm)
-        rec["pen"].append(plane.largest_penetration(s.u))
-        rec["W"].append(mech.energy(s.u))
-        rec["its"].append(s.iterations)
-        rec["p"].append(prof)
-        rec["disp"].append(s.u)
-        rec["pn"].append(p_nodes)
+        steps.append(_measure(s, mech, plane, top, path))
 
     stats = follow_path(mech, dirichlet, u_max, plane=plane, options=options, on_step=on_step,
                         progress=progress)
-    a = {k: np.asarray(v) for k, v in rec.items() if k not in ("p", "disp", "pn")}
+    col = lambda k: np.array([st[k] for st in steps])       # noqa: E731
     return CupResponse(
-        h1_m=h1, contact=contact, material=material, u_m=a["u"], F0_N=a["F0"],
-        F0_contact_N=a["Fc"], r_c_m=a["rc"], V_m3=a["V"], l_m=a["l"], l_half_max_m=a["lhm"],
-        penetration_m=a["pen"], energy_J=a["W"], newton_iterations=a["its"].astype(int),
-        pressure=tuple(rec["p"]), stats=stats, mesh=mesh, displacements=tuple(rec["disp"]),
-        nodal_pressure_Pa=tuple(rec["pn"]))
+        h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
+        F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l"),
+        l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
+        newton_iterations=col("its").astype(int), pressure=tuple(st["p"] for st in steps),
+        stats=stats,
+        mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
+        nodal_pressure_Pa=tuple(st["p_nodes"] for st in steps))
+
+
+def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
+             path: np.ndarray) -> dict[str, Any]:
+    """The per-step outputs of a converged state (module docstring)."""
+    prof, p_nodes = plane.pressure(s.u, s.contact, s.r_int)
+    active = plane.nodes[s.contact.active]
+    x = mech.kin.node_coordinates() + np.stack([s.u[0::2], s.u[1::2]])
+    on_path = np.isin(path, active)
+    on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
+    r_c, l_hm = _edge_and_half_width(prof, x[0, path[-1]])
+    return {"u": s.t, "F0": -float(np.sum(s.r_int[2 * top + 1])),
+            "Fc": float(np.sum(prof.p_gauss_Pa * prof.w_m2)), "r_c": r_c,
+            "V": enclosed_volume(x[0, path], x[1, path], on_path),
+            "l": contact_width(prof, r_c), "l_hm": l_hm,
+            "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations,
+            "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
 
 
 def contact_width(profile: PressureProfile, r_c_m: float) -> float:
