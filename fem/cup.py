@@ -91,7 +91,7 @@ class CupResponse:
 
     def write_fields(self, path: str | Path, step: int = -1) -> Path:
         """Write displacement, Cauchy stress (element means) and contact pressure of one step as
-        VTU (or any format meshio infers from the suffix, e.g. .xdmf) on the reference mesh."""
+        VTU (or another format meshio infers from the suffix) on the reference mesh."""
         from .fields import write_fields
         return write_fields(self, path, step)
 
