@@ -144,7 +144,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
         steps.append(_measure(s, mech, plane, top, path))
 
     stats = follow_path(mech, dirichlet, u_max, plane=plane, options=options, on_step=on_step,
-                        progress=progress)
+                        progress=progress, name="u [m]")
     col = lambda k: np.array([st[k] for st in steps])       # noqa: E731
     return CupResponse(
         h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
