@@ -1,0 +1,233 @@
+"""Contact with the rigid plane z = 0: a node-based primal-dual active set, no penalty parameter.
+
+Every boundary node that may touch the plane (all boundary nodes except those clamped to the top
+plate) is a candidate. An *active* node is held exactly on the plane, z = Z + u_z = 0, by
+eliminating its vertical dof like a Dirichlet condition; for ``"sticking"`` contact its radial
+displacement is also frozen at the value it had when it touched down. The nodal contact reaction
+lambda_a (the internal force at the eliminated dof, > 0 when the plane pushes) is what the
+constraint costs. Inside Newton (a semi-smooth Newton / primal-dual active-set iteration):
+
+    inactive -> active   if the node penetrates, gap g_a = Z_a + u_z,a < 0,
+    active   -> inactive if its reaction turns tensile, lambda_a < 0 (the node lifts off),
+
+and a load step is converged only when the active set no longer changes. The solution satisfies
+the Signorini conditions g >= 0, lambda >= 0, g lambda = 0 exactly at the nodes, so there is no
+enforcement parameter whose value could change the result. Between nodes the quadratic edge may
+dip below the plane; `largest_penetration` reports the largest such violation.
+
+The contact pressure p is the L2 projection, on the deformed contact boundary (weight 2 pi r ds),
+of the nodal reactions: M p = lambda over the facets touching an active node. With the consistent
+boundary mass matrix, int p 2 pi r ds = sum lambda exactly, i.e. the integrated contact force, and
+its integrals (the strip width) converge; pointwise it oscillates at the contact edge, so the
+pointwise profile is the lumped projection p_a = lambda_a / sum_b M_ab, which is >= 0 and exactly
+0 off contact (for the contact edge and the half-maximum width).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Literal
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .kinematics import Kinematics
+
+__all__ = ["RigidPlane", "ContactState", "PressureProfile"]
+
+ContactLaw = Literal["frictionless", "sticking"]
+
+# 1D quadratic shape functions on s in [0, 1] for facet nodes (vertex 0, vertex 1, midpoint)
+_GAUSS_S, _GAUSS_W = np.polynomial.legendre.leggauss(4)
+_GAUSS_S, _GAUSS_W = 0.5 * (_GAUSS_S + 1.0), 0.5 * _GAUSS_W
+
+
+def _shape(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    N = np.stack([(1 - s) * (1 - 2 * s), s * (2 * s - 1), 4 * s * (1 - s)])
+    dN = np.stack([4 * s - 3, 4 * s - 1, 4 - 8 * s])
+    return N, dN
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """Which candidate nodes are on the plane, and (sticking) their frozen radial displacement."""
+
+    active: np.ndarray         # bool [ncand]
+    u_r_stick: np.ndarray      # float [ncand], meaningful where active
+    slipping: np.ndarray | None = None   # bool [ncand]: sticking law, node may slide this step
+
+    def key(self) -> bytes:
+        """Identity of the set for cycle detection."""
+        slip = self.slipping if self.slipping is not None else np.zeros_like(self.active)
+        return self.active.tobytes() + slip.tobytes()
+
+
+@dataclass(frozen=True)
+class PressureProfile:
+    """Contact pressure along the deformed contact boundary.
+
+    r_m, p_Pa: the nodes of the facets that touch the plane, sorted by deformed radius [m], with
+    the lumped projection p_a = lambda_a / int N_a dA [Pa] (>= 0 by the active-set conditions,
+    0 at the free nodes next to the contact; the pointwise profile, for plots, the contact edge
+    and the half-maximum width). r_gauss_m, p_gauss_Pa, w_m2: the
+    consistent L2 projection at the Gauss points of the contact facets with the weights
+    2 pi r ds [m^2], so that int g(p) dA = sum g(p_gauss) w (for integrals: it oscillates near
+    the contact edge, but its integrals converge in L2).
+    """
+
+    r_m: np.ndarray
+    p_Pa: np.ndarray
+    r_gauss_m: np.ndarray
+    p_gauss_Pa: np.ndarray
+    w_m2: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class RigidPlane:
+    """The rigid plane z = 0 and the boundary facets that may touch it."""
+
+    kin: Kinematics
+    facets: np.ndarray            # candidate boundary facets (global facet indices)
+    law: ContactLaw = "frictionless"
+    exclude: np.ndarray | None = None   # nodes that are never candidates (e.g. clamped ones)
+
+    def __post_init__(self) -> None:
+        if self.law not in ("frictionless", "sticking"):
+            raise ValueError(f"contact: must be 'frictionless' or 'sticking', got {self.law!r}")
+        mesh = self.kin.mesh
+        nv = int(mesh.t.max()) + 1      # number of vertices; Q2 edge nodes follow them
+        # facet nodes: two vertices and the midpoint node (numbered after the vertices)
+        fn = np.vstack([mesh.facets[:, self.facets], nv + self.facets[None, :]])
+        object.__setattr__(self, "_facet_nodes", fn)
+        nodes = np.unique(fn)
+        if self.exclude is not None:
+            nodes = np.setdiff1d(nodes, self.exclude)
+        object.__setattr__(self, "nodes", nodes)
+
+    @classmethod
+    def on(cls, kin: Kinematics, boundaries: list[str], exclude: list[str] = (),
+           law: ContactLaw = "frictionless") -> "RigidPlane":
+        """Candidates: the facets of the named boundaries, minus nodes on the `exclude` boundaries."""
+        mesh = kin.mesh
+        facets = np.unique(np.concatenate([mesh.boundaries[b] for b in boundaries]))
+        excl = None
+        if exclude:
+            excl = np.unique(np.concatenate(
+                [kin.basis.get_dofs(mesh.boundaries[b]).all() // 2 for b in exclude]))
+        return cls(kin, facets, law, excl)
+
+    # --- the state -----------------------------------------------------------------------
+    def initial_state(self) -> ContactState:
+        n = len(self.nodes)
+        return ContactState(np.zeros(n, bool), np.zeros(n), np.zeros(n, bool))
+
+    def gap(self, u: np.ndarray) -> np.ndarray:
+        """Signed nodal gap g = Z + u_z [m] (negative: penetration)."""
+        return self.kin.node_coordinates()[1, self.nodes] + u[2 * self.nodes + 1]
+
+    def constraints(self, state: ContactState) -> tuple[np.ndarray, np.ndarray]:
+        """Dofs held by the active set and their values (z-dofs on the plane; sticking: frozen u_r)."""
+        a = np.flatnonzero(state.active)
+        dofs = [2 * self.nodes[a] + 1]
+        vals = [-self.kin.node_coordinates()[1, self.nodes[a]]]
+        if self.law == "sticking":
+            stuck = np.flatnonzero(state.active & ~state.slipping)
+            dofs.append(2 * self.nodes[stuck])
+            vals.append(state.u_r_stick[stuck])
+        return np.concatenate(dofs), np.concatenate(vals)
+
+    def reactions(self, r_int: np.ndarray) -> np.ndarray:
+        """Nodal normal reactions lambda_a [N] (> 0: the plane pushes up) = internal force at z-dofs."""
+        return r_int[2 * self.nodes + 1]
+
+    def update(self, state: ContactState, u: np.ndarray, r_int: np.ndarray,
+               u_start: np.ndarray, stiffness: np.ndarray | None = None) -> ContactState:
+        """One primal-dual active-set update (module docstring). u_start: last converged state,
+        used to locate the touchdown point of newly active nodes for the sticking law.
+
+        With `stiffness` (the tangent's diagonal), only the single worst violation changes: the
+        largest of the penetration -g and the tensile reaction over the dof stiffness, -lambda/k."""
+        g, lam = self.gap(u), self.reactions(r_int)
+        active = np.where(state.active, lam >= 0.0, g < 0.0)
+        if stiffness is not None:
+            k = stiffness[2 * self.nodes + 1]
+            violation = np.where(state.active, -lam / k, -g)
+            active = state.active.copy()
+            worst = int(np.argmax(violation))
+            if violation[worst] > 0:
+                active[worst] = not active[worst]
+        return self.activate(replace(state, active=active & state.active,
+                                     slipping=state.slipping & active),
+                             active & ~state.active, u, u_start)
+
+    def activate(self, state: ContactState, nodes: np.ndarray, u: np.ndarray,
+                 u_start: np.ndarray) -> ContactState:
+        """Put `nodes` on the plane; newly active ones stick (sticking law) at their touchdown
+        point, interpolated linearly in the step between u_start (gap g0 > 0) and u (gap < 0);
+        a node that was on the plane at the step start (g0 = 0), lifted off during the iteration
+        and lands again, lands where the iterate puts it."""
+        new = nodes & ~state.active
+        stick = state.u_r_stick.copy()
+        if np.any(new):
+            g, g0 = self.gap(u)[new], self.gap(u_start)[new]
+            t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g, 1e-300), 1.0)
+            ur0, ur1 = u_start[2 * self.nodes[new]], u[2 * self.nodes[new]]
+            stick[new] = ur0 + np.clip(t, 0.0, 1.0) * (ur1 - ur0)
+        return replace(state, active=state.active | nodes, u_r_stick=stick)
+
+    def let_slip(self, state: ContactState, nodes: np.ndarray) -> ContactState:
+        """Sticking law, a node cycling between stuck-with-tension and lift-off-into-penetration
+        within a step: its normal force is zero to within the step, so no friction can hold it
+        (Coulomb with zero normal force); keep it on the plane, free to slide, for this step."""
+        return replace(state, active=state.active | nodes, slipping=state.slipping | nodes)
+
+    def settle(self, state: ContactState, u: np.ndarray) -> ContactState:
+        """End of a converged step: slipping nodes stick where they are now."""
+        if not np.any(state.slipping):
+            return state
+        stick = np.where(state.slipping, u[2 * self.nodes], state.u_r_stick)
+        return replace(state, u_r_stick=stick, slipping=np.zeros_like(state.slipping))
+
+    # --- post-processing -----------------------------------------------------------------
+    def _positions(self, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+        return self.kin.node_coordinates()[:, nodes] + np.stack([u[2 * nodes], u[2 * nodes + 1]])
+
+    def largest_penetration(self, u: np.ndarray, samples: int = 9) -> float:
+        """max(0, -z) over the deformed candidate facets, sampled between the nodes [m]."""
+        N, _ = _shape(np.linspace(0.0, 1.0, samples))
+        z = self._positions(u, self._facet_nodes.ravel())[1].reshape(3, -1)
+        return float(max(0.0, -np.min(N.T @ z)))
+
+    def pressure(self, u: np.ndarray, state: ContactState,
+                 r_int: np.ndarray) -> tuple[PressureProfile, np.ndarray]:
+        """Contact pressure from the nodal reactions (module docstring): the profile, and the
+        lumped nodal pressure [Pa] of every mesh node (0 off contact)."""
+        lam_all = np.zeros(self.kin.mesh.doflocs.shape[1])
+        lam_all[self.nodes[state.active]] = self.reactions(r_int)[state.active]
+        fn = self._facet_nodes
+        touching = np.any(np.isin(fn, self.nodes[state.active]), axis=0)
+        fn = fn[:, touching]
+        p_nodes = np.zeros_like(lam_all)
+        if fn.shape[1] == 0:
+            e = np.zeros(0)
+            return PressureProfile(e, e, e, e, e), p_nodes
+        loc, inv = np.unique(fn, return_inverse=True)
+        inv = inv.reshape(fn.shape)
+        x = self._positions(u, fn.ravel()).reshape(2, 3, -1)         # [2, 3, nf]
+        N, dN = _shape(_GAUSS_S)                                      # [3, ng]
+        xg = np.einsum("ag,dan->dgn", N, x)
+        ds = np.linalg.norm(np.einsum("ag,dan->dgn", dN, x), axis=0)  # [ng, nf]
+        w = 2.0 * np.pi * xg[0] * ds * _GAUSS_W[:, None]
+        Me = np.einsum("ag,bg,gn->nab", N, N, w)
+        rows = np.repeat(inv.T, 3, axis=1).ravel()
+        cols = np.tile(inv.T, (1, 3)).ravel()
+        M = sp.csr_matrix((Me.ravel(), (rows, cols)), shape=(len(loc), len(loc)))
+        p = spla.spsolve(M.tocsc(), lam_all[loc])
+        pe = p[inv]                                                   # [3, nf]
+        # lumped projection at the nodes: lambda_a / int N_a dA (>= 0, 0 off contact)
+        p_nodes[loc] = lam_all[loc] / np.asarray(M.sum(axis=1)).ravel()
+        r_loc = self._positions(u, loc)[0]
+        order = np.argsort(r_loc, kind="stable")
+        return (PressureProfile(r_loc[order], p_nodes[loc][order], xg[0].ravel(),
+                                (N.T @ pe).ravel(), w.ravel()), p_nodes)

@@ -1,0 +1,210 @@
+"""The cup job: press the cup's top plate down onto the rigid plane z = 0 and record its response.
+
+    from fem.material import NeoHookean
+    from fem.cup import compress_cup
+    resp = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact="frictionless", u_max_m=5e-3)
+    resp.F0_N, resp.r_c_m, resp.l_m, resp.V_m3        # per converged step, at resp.u_m
+    resp.write_fields("cup.vtu")                        # displacement, Cauchy stress, pressure
+
+The mesh is a scikit-fem ``MeshQuad2`` (or ``MeshTri2``) of the cross-section in metres (x = r,
+y = z) with the boundary tags 'top_plate' (the edge at r0, clamped to the rigid plate) and 'cavity'
+(the lower, cavity-facing surface, from the plate down to the rim); 'outer' and 'rim' are usual
+(`fem.mesh`) but not needed. The rim's inner corner rests on the plane, z = 0, in the undeformed
+state. h1 is the height of the lowest top-plate node.
+
+Loading (Sec. 5.3): the plate moves down by u (displacement control), h = h1 - u; the top-plate
+nodes follow it rigidly (u_r = 0, u_z = -u). Every boundary node except those on the plate may
+touch the plane (`fem.contact`); the contact zones are whatever the solution makes them.
+
+The pressure profile p(r) (`fem.contact.PressureProfile`) holds the lumped nodal pressure of the
+nodes in contact, sorted by deformed radius, and the consistent L2 projection at the boundary
+Gauss points (for integrals). r_c, l_half_max and V come from the pure functions of
+`fem.postprocess`; l uses the same definition as `postprocess.pressure_weighted_width` with the
+integrals over the Gauss points (`contact_width`), because the piecewise-linear nodal profile
+converges much more slowly (a node-spaced peak at the contact edge).
+
+Per converged step, `CupResponse` holds (all SI):
+
+* ``F0_N``: the reaction on the top plate, the cup spring force F0 (eq. 7); ``F0_contact_N``: the
+  integrated contact force 2 pi int p r dr, which equals F0 by equilibrium (a check, both stored);
+* ``r_c_m``: the inner contact radius (eq. 3's r), `postprocess.inner_contact_radius`: between
+  the innermost node in contact and its free neighbour, where a square-root edge extrapolates to 0;
+* ``V_m3``: the cavity volume under the plate and inside the cup down to z = 0 (the region of
+  eq. 4), `postprocess.enclosed_volume` of the deformed cavity path down to its first contact;
+* ``l_m``: the pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
+  (`contact_width`), exactly l for a uniform strip of width l (the paper's eq. 6 picture) and an
+  integral of the pressure, hence mesh-convergent; ``l_half_max_m``: the width at half maximum
+  of the lumped nodal pressure (`postprocess.half_maximum_width`);
+* ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
+  elastic energy), ``newton_iterations``, and the pressure profiles ``pressure[i]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from skfem import Mesh
+
+from .contact import PressureProfile, RigidPlane
+from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
+from .postprocess import enclosed_volume, half_maximum_width, inner_contact_radius
+from .forms import Mechanics
+from .kinematics import Kinematics
+from .material import NeoHookean
+from .solver import SolverOptions, SolverStats, StepResult, follow_path
+
+__all__ = ["compress_cup", "CupResponse", "cup_height", "contact_width", "REQUIRED_BOUNDARIES"]
+
+
+
+@dataclass(frozen=True, eq=False)
+class CupResponse:
+    """The cup's response per converged step (module docstring). Arrays are over steps."""
+
+    h1_m: float
+    contact: str
+    material: NeoHookean
+    u_m: np.ndarray
+    F0_N: np.ndarray
+    F0_contact_N: np.ndarray
+    r_c_m: np.ndarray
+    V_m3: np.ndarray
+    l_m: np.ndarray
+    l_half_max_m: np.ndarray
+    penetration_m: np.ndarray
+    energy_J: np.ndarray
+    newton_iterations: np.ndarray
+    pressure: tuple[PressureProfile, ...]
+    stats: SolverStats
+    mesh: Mesh = field(repr=False)
+    displacements: tuple[np.ndarray, ...] = field(repr=False)
+    nodal_pressure_Pa: tuple[np.ndarray, ...] = field(repr=False)
+
+    @property
+    def h_m(self) -> np.ndarray:
+        """Cup height h = h1 - u [m]."""
+        return self.h1_m - self.u_m
+
+    def write_fields(self, path: str | Path, step: int = -1) -> Path:
+        """Write displacement, Cauchy stress (element means) and contact pressure of one step as
+        VTU (or another format meshio infers from the suffix) on the reference mesh."""
+        from .fields import write_fields
+        return write_fields(self, path, step)
+
+
+def cup_height(mesh: Mesh) -> float:
+    """h1: the height of the lowest top-plate node above the plane z = 0 [m]."""
+    _check_mesh(mesh)
+    kin_nodes = _boundary_nodes(mesh, "top_plate")
+    return float(mesh.doflocs[1, kin_nodes].min())
+
+
+def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
+                 contact: Literal["frictionless", "sticking"] = "frictionless",
+                 u_max_m: float | None = None,
+                 progress: Callable[[float, str], None] | None = None,
+                 **solver_opts: Any) -> CupResponse:
+    """Press the cup from u = 0 to u_max_m (default 0.9 h1, at most h1: there the plate's edge
+    reaches the plane; the steep rise of F0 where the wall is squeezed flat lies just below it)
+    and return its `CupResponse`.
+
+    solver_opts: fields of `fem.solver.SolverOptions` (rtol, etol, max_iterations, initial_step,
+    max_step, min_step, growth). Raises ValueError for bad input, `fem.solver.ConvergenceError`
+    (a RuntimeError) if a step cannot be converged.
+    """
+    h1 = cup_height(mesh)
+    if contact not in ("frictionless", "sticking"):
+        raise ValueError(f"contact: must be 'frictionless' or 'sticking', got {contact!r}")
+    if not isinstance(material, NeoHookean):
+        raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
+    u_max = 0.9 * h1 if u_max_m is None else float(u_max_m)
+    if not (0.0 < u_max <= h1):
+        raise ValueError(f"u_max_m: plate displacement must be in (0, h1] = (0, "
+                         f"{h1 * 1e3:.4g} mm] (at u = h1 the plate reaches the plane), "
+                         f"got {u_max * 1e3:.4g} mm")
+    options = SolverOptions(**solver_opts)
+
+    kin = Kinematics.of(mesh)
+    mech = Mechanics(kin, material)
+    top = _boundary_nodes(mesh, "top_plate")
+    plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top)
+    top_dofs = np.concatenate([2 * top, 2 * top + 1])
+    path = boundary_path(mesh, "cavity")
+
+    def dirichlet(u):
+        return top_dofs, np.concatenate([np.zeros(len(top)), np.full(len(top), -u)])
+
+    steps: list[dict[str, Any]] = []
+
+    def on_step(s: StepResult) -> None:
+        steps.append(_measure(s, mech, plane, top, path))
+
+    stats = follow_path(mech, dirichlet, u_max, plane=plane, options=options, on_step=on_step,
+                        progress=progress, name="u [m]")
+    col = lambda k: np.array([st[k] for st in steps])       # noqa: E731
+    return CupResponse(
+        h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
+        F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l"),
+        l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
+        newton_iterations=col("its").astype(int), pressure=tuple(st["p"] for st in steps),
+        stats=stats,
+        mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
+        nodal_pressure_Pa=tuple(st["p_nodes"] for st in steps))
+
+
+def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
+             path: np.ndarray) -> dict[str, Any]:
+    """The per-step outputs of a converged state (module docstring)."""
+    prof, p_nodes = plane.pressure(s.u, s.contact, s.r_int)
+    active = plane.nodes[s.contact.active]
+    x = mech.kin.node_coordinates() + np.stack([s.u[0::2], s.u[1::2]])
+    on_path = np.isin(path, active)
+    on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
+    r_c, l_hm = _edge_and_half_width(prof, x[0, path[-1]])
+    return {"u": s.t, "F0": -float(np.sum(s.r_int[2 * top + 1])),
+            "Fc": float(np.sum(prof.p_gauss_Pa * prof.w_m2)), "r_c": r_c,
+            "V": enclosed_volume(x[0, path], x[1, path], on_path),
+            "l": contact_width(prof, r_c), "l_hm": l_hm,
+            "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations,
+            "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
+
+
+def contact_width(profile: PressureProfile, r_c_m: float) -> float:
+    """Pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA) [m], dA = 2 pi r dr
+    (the definition of `postprocess.pressure_weighted_width`), with the integrals taken over the
+    consistent L2 projection at the boundary Gauss points (0 without contact)."""
+    if profile.w_m2.size == 0:
+        return 0.0
+    P1 = np.sum(profile.p_gauss_Pa * profile.w_m2)
+    P2 = np.sum(profile.p_gauss_Pa**2 * profile.w_m2)
+    return float(P1**2 / (2.0 * np.pi * r_c_m * P2)) if P2 > 0 else 0.0
+
+
+def _edge_and_half_width(profile: PressureProfile, r_rim: float) -> tuple[float, float]:
+    """(r_c, l_half_max) from the lumped nodal profile; with fewer than two loaded nodes (the
+    rim corner alone, or no contact at u = 0) r_c is that node's (or the rim's) radius, l = 0."""
+    r, p = profile.r_m, profile.p_Pa
+    keep = np.concatenate([[True], np.diff(r) > 0]) if r.size else np.zeros(0, bool)
+    r, p = r[keep], p[keep]
+    if np.count_nonzero(p > 0) < 2:
+        return (float(r[np.argmax(p)]) if r.size else float(r_rim)), 0.0
+    r_c = inner_contact_radius(r, p)
+    return r_c, half_maximum_width(r, p, r_c)
+
+
+def _check_mesh(mesh: Mesh) -> None:
+    """`fem.mesh.check_cup_mesh` (tags, orientation, r >= 0, z >= 0), and the rim on the plane."""
+    check_cup_mesh(mesh)
+    zmin = float(mesh.doflocs[1].min())
+    if zmin > 1e-9 * float(np.ptp(mesh.doflocs[1])):
+        raise ValueError(f"mesh: the rim must rest on the plane z = 0 (lowest z = {zmin:.3g} m)")
+
+
+def _boundary_nodes(mesh: Mesh, name: str) -> np.ndarray:
+    nv = int(mesh.t.max()) + 1
+    f = mesh.boundaries[name]
+    return np.unique(np.concatenate([mesh.facets[:, f].ravel(), nv + f]))

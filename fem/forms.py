@@ -1,0 +1,225 @@
+"""Weak forms of axisymmetric finite-strain hyperelasticity, and their fast element kernels.
+
+The total potential energy of the body (no body forces) is Pi(u) = int_Omega0 W(F(u)) dV with
+dV = 2 pi R dA. Its first and second variations are
+
+    r(u; v)     = int P(F) : dF[v] dV                        (internal force)
+    K(u; v, du) = int dF[v] : A(F) : dF[du] dV               (consistent tangent)
+
+with dF[v] = d f / d u . v (see `fem.kinematics`). The readable scikit-fem forms
+`internal_force_form` and `tangent_form` are the reference; `Mechanics` evaluates the same
+integrals as einsum contractions of the precomputed B-operator (one call per assembly instead of
+18 x 18 form calls per element), and the tests check that both agree.
+
+Mixed (nearly incompressible) formulation, ``material.formulation == "mixed"``: the volumetric
+energy U = lambda/2 (ln J)^2 is evaluated on Theta = Pi_h J, the L2(dV) projection of J onto
+discontinuous linear polynomials {1, R - R_e, Z - Z_e} per element (Q2-P1disc, the three-field
+Hu-Washizu form with condensed pressure p = Pi_h U'(Theta) and dilatation Theta). Then
+
+    r_vol = int p dJ[v] dV,
+    K_vol = int p d2J[v, du] dV + G^T M^-1 D M^-1 G,
+
+with G_a[v] = int q_a dJ[v] dV, M_ab = int q_a q_b dV, D_ab = int U''(Theta) q_a q_b dV per element.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import BilinearForm, LinearForm, MeshQuad2
+
+from .kinematics import Kinematics
+from .material import NeoHookean, jacobian, jacobian_gradient, jacobian_hessian
+
+__all__ = ["Mechanics", "internal_force_form", "tangent_form", "energy_form"]
+
+
+# --------------------------------------------------------------------------------------------
+# Reference weak forms (displacement formulation), plain scikit-fem: they read like the math.
+# --------------------------------------------------------------------------------------------
+def _f(w_u, R):
+    """5-vector f = (F_rR, F_rZ, F_zR, F_zZ, F_tt) of a vector field at the points."""
+    g, v = w_u.grad, np.asarray(w_u)
+    return np.stack([1.0 + g[0, 0], g[0, 1], g[1, 0], 1.0 + g[1, 1], 1.0 + v[0] / R])
+
+
+def _df(v, R):
+    """Variation dF[v] as a 5-vector."""
+    g, val = v.grad, np.asarray(v)
+    return np.stack([g[0, 0], g[0, 1], g[1, 0], g[1, 1], val[0] / R])
+
+
+def internal_force_form(material: NeoHookean) -> LinearForm:
+    """r(u; v) = int P(F(u)) : dF[v] 2 pi R dA, with u passed as ``w['u']``."""
+
+    @LinearForm
+    def internal_force(v, w):
+        R = w.x[0]
+        P = material.stress(_f(w["u"], R))
+        return np.sum(P * _df(v, R), axis=0) * 2.0 * np.pi * R
+
+    return internal_force
+
+
+def tangent_form(material: NeoHookean) -> BilinearForm:
+    """K(u; v, du) = int dF[v] : A(F(u)) : dF[du] 2 pi R dA."""
+
+    @BilinearForm
+    def tangent(du, v, w):
+        R = w.x[0]
+        A = material.tangent(_f(w["u"], R))
+        return np.einsum("k...,kl...,l...->...", _df(v, R), A, _df(du, R)) * 2.0 * np.pi * R
+
+    return tangent
+
+
+def energy_form(material: NeoHookean):
+    """Pi(u) = int W(F(u)) 2 pi R dA as a scikit-fem Functional."""
+    from skfem import Functional
+
+    @Functional
+    def energy(w):
+        R = w.x[0]
+        return material.energy(_f(w["u"], R)) * 2.0 * np.pi * R
+
+    return energy
+
+
+# --------------------------------------------------------------------------------------------
+# Vectorized kernels with a reused sparsity pattern.
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class Mechanics:
+    """Energy, internal force and tangent of one body: kinematics + material."""
+
+    kin: Kinematics
+    material: NeoHookean
+
+    # --- sparsity pattern, computed once ---------------------------------------------------
+    @cached_property
+    def _pattern(self):
+        d = self.kin.dofs                                  # [18, nel]
+        n = self.kin.ndofs
+        rows = np.broadcast_to(d.T[:, :, None], (d.shape[1], d.shape[0], d.shape[0])).ravel()
+        cols = np.broadcast_to(d.T[:, None, :], (d.shape[1], d.shape[0], d.shape[0])).ravel()
+        keys = rows.astype(np.int64) * n + cols
+        uniq, inverse = np.unique(keys, return_inverse=True)
+        indptr = np.searchsorted(uniq // n, np.arange(n + 1))
+        return inverse, (uniq % n).astype(np.int32), indptr.astype(np.int32), len(uniq)
+
+    def _matrix(self, Ke: np.ndarray) -> sp.csr_matrix:
+        inverse, indices, indptr, nnz = self._pattern
+        data = np.bincount(inverse, weights=Ke.ravel(), minlength=nnz)
+        n = self.kin.ndofs
+        return sp.csr_matrix((data, indices, indptr), shape=(n, n))
+
+    def _vector(self, re: np.ndarray) -> np.ndarray:
+        """Assemble element vectors re[nel, 18]."""
+        return np.bincount(self.kin.dofs.T.ravel(), weights=re.ravel(), minlength=self.kin.ndofs)
+
+    @cached_property
+    def _Bt(self) -> np.ndarray:
+        """The B-operator as [nel, nq, 18, 5] (contiguous, for batched products)."""
+        return np.ascontiguousarray(np.transpose(self.kin.B, (2, 3, 0, 1)))
+
+    @cached_property
+    def _BtT(self) -> np.ndarray:
+        """[nel, nq * 5, 18]: Bt with (q, k) stacked, the right factor of K_e."""
+        ne, nq, nb, _ = self._Bt.shape
+        return np.ascontiguousarray(np.transpose(self._Bt, (0, 1, 3, 2)).reshape(ne, nq * 5, nb))
+
+    # --- P1disc projection for the mixed formulation ---------------------------------------
+    @cached_property
+    def _p1(self):
+        """q[a, e, q] = {1, (R - R_e)/h_e, (Z - Z_e)/h_e} (quads: Q2-P1disc) or {1} (triangles:
+        P2-P0, as P2-P1disc is not inf-sup stable) and the inverse Gram matrices M^-1 [nel, n, n]."""
+        X = np.asarray(self.kin.basis.global_coordinates())       # [2, nel, nq]
+        dV = self.kin.dV
+        vol = dV.sum(axis=1)
+        c = np.einsum("deq,eq->de", X, dV) / vol
+        h = np.sqrt(self.kin.basis.dx.sum(axis=1))
+        q = [np.ones_like(dV)]
+        if isinstance(self.kin.mesh, MeshQuad2):
+            q += [(X[0] - c[0][:, None]) / h[:, None], (X[1] - c[1][:, None]) / h[:, None]]
+        q = np.stack(q)
+        M = np.einsum("aeq,beq,eq->eab", q, q, dV)
+        return q, np.linalg.inv(M)
+
+    def project(self, values: np.ndarray) -> np.ndarray:
+        """L2(dV) projection of quadrature-point values [nel, nq] onto P1disc, evaluated at the points."""
+        q, Minv = self._p1
+        coef = np.einsum("eab,beq,eq->ea", Minv, q, values * self.kin.dV)
+        return np.einsum("ea,aeq->eq", coef, q)
+
+    # --- the three quantities -------------------------------------------------------------
+    def pressure_and_dilatation(self, f: np.ndarray):
+        """For the mixed form: Theta = Pi_h J, p = Pi_h U'(Theta) at the points."""
+        # project J - 1 rather than J: the projection of the constant 1 carries round-off that
+        # lambda would amplify into a spurious pressure (~1e-6 Pa at nu = 0.49)
+        dtheta = self.project(jacobian(f) - 1.0)
+        if np.any(dtheta <= -1.0):
+            raise FloatingPointError("projected dilatation Theta <= 0 (inverted element)")
+        theta = 1.0 + dtheta
+        return theta, self.project(self.material.volumetric(theta, np.log1p(dtheta))[1])
+
+    def energy(self, u: np.ndarray) -> float:
+        """Stored elastic energy Pi(u) [J]."""
+        f = self.kin.deformation_gradient(u)
+        m = self.material
+        if m.formulation == "displacement":
+            W = m.energy(f)
+        else:
+            theta, _ = self.pressure_and_dilatation(f)
+            W = m.isochoric(f)[0] + m.volumetric(theta, np.log1p(theta - 1.0))[0]
+        return float(np.sum(W * self.kin.dV))
+
+    def stress(self, f: np.ndarray) -> np.ndarray:
+        """First Piola-Kirchhoff stress P [5, nel, nq] (with the condensed pressure if mixed)."""
+        m = self.material
+        if m.formulation == "displacement":
+            return m.stress(f)
+        _, p = self.pressure_and_dilatation(f)
+        return m.isochoric(f)[1] + p * jacobian_gradient(f)
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        """r(u) = dPi/du, the assembled internal force vector [N]."""
+        f = self.kin.deformation_gradient(u)
+        if np.any(jacobian(f) <= 0):
+            raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
+        P = self.stress(f)
+        re = np.einsum("eqik,keq->ei", self._Bt, P * self.kin.dV)
+        return self._vector(re)
+
+    def linearize(self, u: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
+        """Internal force r(u) and consistent tangent K(u) = d2Pi/du2."""
+        f = self.kin.deformation_gradient(u)
+        if np.any(jacobian(f) <= 0):
+            raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
+        m, dV = self.material, self.kin.dV
+        if m.formulation == "displacement":
+            P, A = m.stress(f), m.tangent(f)
+        else:
+            theta, p = self.pressure_and_dilatation(f)
+            _, P, A = m.isochoric(f)
+            g = jacobian_gradient(f)
+            P = P + p * g
+            A = A + p * jacobian_hessian(f)
+        Bt = self._Bt                                            # [nel, nq, 18, 5]
+        re = np.einsum("eqik,keq->ei", Bt, P * dV)
+        # K_e = sum_q Bt_q (A_q dV_q) Bt_q^T as batched matrix products
+        AdV = np.transpose(A * dV, (2, 3, 0, 1))                 # [nel, nq, 5, 5]
+        BA = Bt @ AdV                                            # [nel, nq, 18, 5]
+        ne, nq, nb, _ = Bt.shape
+        Ke = BA.transpose(0, 2, 1, 3).reshape(ne, nb, nq * 5) @ self._BtT
+        if m.formulation == "mixed":
+            q, Minv = self._p1
+            d2U = m.volumetric(theta, np.log1p(theta - 1.0))[2]
+            dJ = np.einsum("eqik,keq->eqi", self._Bt, g * dV)       # dJ[v] dV at the points
+            G = np.einsum("aeq,eqi->eai", q, dJ)                     # [nel, 3, 18]
+            D = np.einsum("aeq,beq,eq->eab", q, q, d2U * dV)
+            C = Minv @ D @ Minv
+            Ke += np.einsum("eai,eab,ebj->eij", G, C, G)
+        return self._vector(re), self._matrix(Ke)

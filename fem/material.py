@@ -1,0 +1,132 @@
+"""The cup material: a compressible neo-Hookean solid, written for the axisymmetric deformation gradient.
+
+Strain energy per unit reference volume (the documented default law)::
+
+    W(F) = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2,     I1 = tr(F^T F),  J = det F,
+
+with the Lame constants from Young's modulus and Poisson's ratio,
+mu = E / (2 (1 + nu)), lambda = E nu / ((1 + nu)(1 - 2 nu)). It reduces to Hooke's law for small strain.
+
+In an axisymmetric, torsion-free deformation F = [[F_rR, F_rZ, 0], [F_zR, F_zZ, 0], [0, 0, F_tt]], so
+F is stored as the 5-vector ``f = (F_rR, F_rZ, F_zR, F_zZ, F_tt)`` (leading axis), and every function
+here works on arrays ``f[5, ...]`` over elements and quadrature points. Splitting
+
+    W = W_iso + U(J),   W_iso = mu/2 (I1 - 3) - mu ln J,   U = lambda/2 (ln J)^2
+
+the first Piola-Kirchhoff stress and its derivative (the material tangent) are
+
+    P = mu f + (dW/dJ) g,                 g = dJ/df = J F^-T in 5-vector form,
+    A = mu 1 + (d2W/dJ2) g (x) g + (dW/dJ) H,    H = d2J/df2 (constant pattern, linear in f).
+
+``formulation="mixed"`` keeps W_iso at the quadrature points but evaluates U on the dilatation J
+projected onto discontinuous linear polynomials per element (Q2-P1disc, a three-field Hu-Washizu
+form condensed per element; see `fem.forms`). It is the same law for every state whose J is linear
+over each element, and it does not lock as nu -> 1/2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+__all__ = ["NeoHookean", "jacobian", "jacobian_gradient", "jacobian_hessian", "cauchy_stress"]
+
+Formulation = Literal["displacement", "mixed"]
+
+
+@dataclass(frozen=True)
+class NeoHookean:
+    """Compressible neo-Hookean material (module docstring), from E [Pa] and nu [-]."""
+
+    E_Pa: float = 4.0e6
+    nu: float = 0.49
+    formulation: Formulation = "displacement"
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.E_Pa) and self.E_Pa > 0):
+            raise ValueError(f"E_Pa: Young's modulus must be > 0 Pa, got {self.E_Pa}")
+        if not (-1.0 < self.nu < 0.5):
+            raise ValueError(f"nu: Poisson's ratio must be in (-1, 0.5), got {self.nu}")
+        if self.formulation not in ("displacement", "mixed"):
+            raise ValueError(
+                f"formulation: must be 'displacement' or 'mixed', got {self.formulation!r}")
+
+    @property
+    def mu(self) -> float:
+        """Shear modulus mu = E / (2 (1 + nu)) [Pa]."""
+        return self.E_Pa / (2.0 * (1.0 + self.nu))
+
+    @property
+    def lam(self) -> float:
+        """First Lame constant lambda = E nu / ((1 + nu)(1 - 2 nu)) [Pa]."""
+        return self.E_Pa * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+
+    # --- the split W = W_iso(f) + U(J) -------------------------------------------------------
+    def volumetric(self, J: np.ndarray, lnJ: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """U(J) = lambda/2 (ln J)^2 and its first two derivatives (lnJ may be passed if known
+        more accurately than log(J), e.g. as log1p(J - 1))."""
+        lnJ = np.log(J) if lnJ is None else lnJ
+        return (0.5 * self.lam * lnJ**2, self.lam * lnJ / J, self.lam * (1.0 - lnJ) / J**2)
+
+    def isochoric(self, f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """W_iso = mu/2 (I1 - 3) - mu ln J: energy, stress P_iso[5, ...], tangent A_iso[5, 5, ...]."""
+        J = jacobian(f)
+        g = jacobian_gradient(f)
+        mu = self.mu
+        I1 = np.sum(f**2, axis=0)
+        W = 0.5 * mu * (I1 - 3.0) - mu * np.log(J)
+        dW, d2W = -mu / J, mu / J**2
+        P = mu * f + dW * g
+        A = d2W * g[:, None] * g[None, :] + dW * jacobian_hessian(f)
+        A[np.arange(5), np.arange(5)] += mu
+        return W, P, A
+
+    def energy(self, f: np.ndarray) -> np.ndarray:
+        """W(F) per unit reference volume [J/m^3] (pointwise, all terms)."""
+        return self.isochoric(f)[0] + self.volumetric(jacobian(f))[0]
+
+    def stress(self, f: np.ndarray) -> np.ndarray:
+        """First Piola-Kirchhoff stress P = dW/dF as a 5-vector [Pa] (pointwise, all terms)."""
+        _, P, _ = self.isochoric(f)
+        return P + self.volumetric(jacobian(f))[1] * jacobian_gradient(f)
+
+    def tangent(self, f: np.ndarray) -> np.ndarray:
+        """Material tangent A = d2W/dF2 as a 5x5 matrix [Pa] (pointwise, all terms)."""
+        _, _, A = self.isochoric(f)
+        J, g = jacobian(f), jacobian_gradient(f)
+        _, dU, d2U = self.volumetric(J)
+        return A + d2U * g[:, None] * g[None, :] + dU * jacobian_hessian(f)
+
+
+def jacobian(f: np.ndarray) -> np.ndarray:
+    """J = det F = (F_rR F_zZ - F_rZ F_zR) F_tt."""
+    return (f[0] * f[3] - f[1] * f[2]) * f[4]
+
+
+def jacobian_gradient(f: np.ndarray) -> np.ndarray:
+    """dJ/df, i.e. the cofactor J F^-T in 5-vector form."""
+    return np.stack([f[3] * f[4], -f[2] * f[4], -f[1] * f[4], f[0] * f[4],
+                     f[0] * f[3] - f[1] * f[2]])
+
+
+def jacobian_hessian(f: np.ndarray) -> np.ndarray:
+    """d2J/df2 [5, 5, ...]: J is trilinear in f, so H is linear in f."""
+    H = np.zeros((5, 5) + f.shape[1:])
+    for (a, b), v in {(0, 3): f[4], (1, 2): -f[4], (0, 4): f[3], (3, 4): f[0],
+                      (1, 4): -f[2], (2, 4): -f[1]}.items():
+        H[a, b] = v
+        H[b, a] = v
+    return H
+
+
+def cauchy_stress(f: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Cauchy stress sigma = P F^T / J as (s_rr, s_zz, s_tt, s_rz) [Pa]."""
+    J = jacobian(f)
+    s_rr = (P[0] * f[0] + P[1] * f[1]) / J
+    s_zz = (P[2] * f[2] + P[3] * f[3]) / J
+    s_rz = (P[0] * f[2] + P[1] * f[3]) / J
+    s_tt = P[4] * f[4] / J
+    return np.stack([s_rr, s_zz, s_tt, s_rz])

@@ -1,0 +1,376 @@
+"""Structured quadratic meshes of the cup's cross-section, boundary tags, and meshio I/O.
+
+Element choice: **9-node quadratic quadrilaterals** (`skfem.MeshQuad2`, element `ElementQuad2`) by
+default; 6-node quadratic triangles (`skfem.MeshTri2`) with ``element="tri"``. Mesh coordinates
+are in metres, x = r (radius) and y = z (height above the substrate plane z = 0).
+
+The mesh is mapped: a tensor grid in the wall coordinates (s, t) in [0, 1]^2 (s along the wall
+from the top plate to the rim, t through the thickness from the cavity face to the outer face)
+is pushed through `CupGeometry.point`. Mid-side nodes sit at the (s, t) midpoints, so they lie
+on the exact curved surface for a non-linear thickness profile, and for a linear one the
+elements are straight-sided with centred mid-side nodes. Grading:
+
+- along the wall the element length is proportional to d(r)^along_grading (1: the elements keep
+  the local thickness-to-length ratio, so they shrink towards the thin rim where contact starts;
+  0: uniform in s);
+- through the thickness the layers grow geometrically from the cavity face (where the contact
+  pressure acts) to the outer face, by the factor through_ratio^(1/n_through) per layer.
+
+Both gradings are smooth maps of a uniform grid, so doubling the counts gives nested vertices
+(what a Richardson convergence study needs).
+
+Boundary tags (skfem named boundaries, ``mesh.boundaries[name]`` = facet indices):
+
+==============  =====================================================================
+``top_plate``   the edge at r0 (s = 0), clamped to the rigid top plate
+``cavity``      the cavity-facing (lower) surface (t = 0)
+``outer``       the outer (upper) surface (t = 1)
+``rim``         the edge at r1 (s = 1)
+==============  =====================================================================
+
+Files: `write_mesh`/`read_mesh` go through meshio (VTU, Gmsh ``.msh`` in format 2.2, anything
+meshio reads) with coordinates in millimetres by default. A file carries its tags as line
+cells (``line`` or ``line3``) named either by Gmsh physical groups (``gmsh:physical`` + the
+group names) or by per-name 0/1 cell-data arrays ``boundary:<name>`` (VTU has no field data).
+A user's own Gmsh cross-section works if it has physical curves named ``top_plate`` and
+``cavity`` (``outer`` and ``rim`` are optional: contact is checked on every boundary facet
+except ``top_plate``) and a 2D physical surface of ``triangle6``, ``quad9``, ``quad8``, or linear
+``triangle``/``quad`` cells (linear cells get straight-sided mid-side nodes).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Literal
+
+import meshio
+import numpy as np
+from scipy.spatial import cKDTree
+from skfem import Mesh, MeshQuad1, MeshQuad2, MeshTri1, MeshTri2
+
+from fem.geometry import CupGeometry
+
+__all__ = ["MeshSpec", "FIDELITIES", "BOUNDARY_NAMES", "REQUIRED_BOUNDARIES", "mesh_spec",
+           "cup_mesh", "check_cup_mesh", "boundary_path", "write_mesh", "read_mesh"]
+
+BOUNDARY_NAMES = ("top_plate", "cavity", "outer", "rim")
+REQUIRED_BOUNDARIES = ("top_plate", "cavity")
+ElementKind = Literal["quad", "tri"]
+_UNITS = {"m": 1.0, "mm": 1e-3}
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """Element counts and grading of a mapped cup mesh (see the module docstring).
+
+    n_along : elements along the wall (>= 1); n_through : elements through the thickness (>= 1);
+    along_grading : element length proportional to d^along_grading, in [0, 2];
+    through_ratio : q of the through-thickness map t = (q^eta - 1)/(q - 1): the layers grow by
+        q^(1/n_through) each from the cavity face outwards, in [1/20, 20];
+    element : "quad" (MeshQuad2) or "tri" (MeshTri2, two triangles per quad).
+    """
+
+    n_along: int
+    n_through: int
+    along_grading: float = 1.0
+    through_ratio: float = 1.0
+    element: ElementKind = "quad"
+
+    def __post_init__(self) -> None:
+        for name in ("n_along", "n_through"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise ValueError(f"{name}: element count must be an integer >= 1, got {value!r}")
+        if not 0.0 <= self.along_grading <= 2.0:
+            raise ValueError(f"along_grading: must be in [0, 2], got {self.along_grading:g}")
+        if not 1 / 20 <= self.through_ratio <= 20:
+            raise ValueError(f"through_ratio: must be in [0.05, 20], got {self.through_ratio:g}")
+        if self.element not in ("quad", "tri"):
+            raise ValueError(f"element: must be 'quad' or 'tri', got {self.element!r}")
+
+    def refined(self, factor: int = 2) -> MeshSpec:
+        """The same grading with `factor` times the element counts (nested vertices)."""
+        return replace(self, n_along=factor * self.n_along, n_through=factor * self.n_through)
+
+
+#: fidelity levels; each doubles the counts of the previous one (constant refinement ratio 2).
+#: Tuned with benchmarks/bench_fem.py: along_grading 0.5 balances the thin rim, where contact
+#: starts, against the thick inner wall, whose contact governs the steep end of F0(u).
+FIDELITIES: dict[str, MeshSpec] = {
+    "coarse": MeshSpec(n_along=24, n_through=2, along_grading=0.5, through_ratio=1.0),
+    "medium": MeshSpec(n_along=48, n_through=4, along_grading=0.5, through_ratio=1.0),
+    "fine": MeshSpec(n_along=96, n_through=8, along_grading=0.5, through_ratio=1.0),
+}
+
+
+def mesh_spec(fidelity: str | MeshSpec = "coarse", **overrides) -> MeshSpec:
+    """The `MeshSpec` of a fidelity level ("coarse", "medium", "fine"), with fields overridden."""
+    if isinstance(fidelity, MeshSpec):
+        return replace(fidelity, **overrides)
+    if fidelity not in FIDELITIES:
+        raise ValueError(f"fidelity: must be one of {', '.join(FIDELITIES)}, got {fidelity!r}")
+    return replace(FIDELITIES[fidelity], **overrides)
+
+
+def cup_mesh(geometry: CupGeometry, fidelity: str | MeshSpec = "coarse", **overrides) -> Mesh:
+    """A structured quadratic mesh of the cup wall in metres, with the four boundary tags."""
+    spec = mesh_spec(fidelity, **overrides)
+    s = _along_wall_nodes(geometry, spec)
+    t = _through_thickness_nodes(spec)
+    linear = (MeshQuad1 if spec.element == "quad" else MeshTri1).init_tensor(s, t)
+    quadratic = (MeshQuad2 if spec.element == "quad" else MeshTri2).from_mesh(_counter_clockwise(linear))
+    eps = 0.25 * min(np.diff(s).min(), np.diff(t).min())
+    tagged = quadratic.with_boundaries({
+        "top_plate": lambda x: x[0] < eps,
+        "cavity": lambda x: x[1] < eps,
+        "outer": lambda x: x[1] > 1 - eps,
+        "rim": lambda x: x[0] > 1 - eps,
+    })
+    return replace(tagged, doflocs=geometry.point(tagged.doflocs[0], tagged.doflocs[1]))
+
+
+def _along_wall_nodes(geometry: CupGeometry, spec: MeshSpec) -> np.ndarray:
+    """s-coordinates equidistributing the density d(s)^-along_grading over n_along elements."""
+    fine = np.linspace(0.0, 1.0, 8193)     # independent of n_along, so refinement nests
+    density = geometry.thickness_at(fine) ** (-spec.along_grading)
+    cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(fine))])
+    s = np.interp(np.linspace(0.0, 1.0, spec.n_along + 1), cumulative / cumulative[-1], fine)
+    s[0], s[-1] = 0.0, 1.0
+    return s
+
+
+def _counter_clockwise(linear: Mesh) -> Mesh:
+    """The linear mesh with every cell's corners counter-clockwise (MeshTri1 sorts them)."""
+    t = linear.t.copy()
+    cw = _signed_areas(linear.p.T, t[:3].T) < 0
+    t[1:, cw] = t[:0:-1, cw]          # reverse 1..n-1: (0, 2, 1) or (0, 3, 2, 1)
+    return type(linear)(linear.p, t, sort_t=False)
+
+
+def _through_thickness_nodes(spec: MeshSpec) -> np.ndarray:
+    """t-coordinates t(eta) = (q^eta - 1)/(q - 1) of a uniform eta grid, q = `through_ratio`.
+
+    Each layer is q^(1/n_through) times thicker than the one below it, so the outermost layer
+    is q^(1 - 1/n_through) times the cavity-facing one (-> q under refinement)."""
+    eta = np.linspace(0.0, 1.0, spec.n_through + 1)
+    q = spec.through_ratio
+    return eta if abs(q - 1.0) < 1e-12 else np.expm1(eta * np.log(q)) / (q - 1.0)
+
+
+# ------------------------------------------------------------------ queries
+def boundary_path(mesh: Mesh, name: str) -> np.ndarray:
+    """Node indices along the tagged boundary `name`, vertices and mid-side nodes interleaved.
+
+    The chain starts at the end shared with ``top_plate`` (for ``cavity``: plate -> rim) or,
+    if there is none, at the end with the larger z. The boundary must be one open chain.
+    """
+    facets = _facets(mesh, name)
+    ends = mesh.facets[:, facets]
+    verts, counts = np.unique(ends, return_counts=True)
+    tips = verts[counts == 1]
+    if len(tips) != 2 or np.any(counts > 2):
+        raise ValueError(f"mesh: boundary '{name}' is not one open chain of edges")
+    plate = set(mesh.facets[:, _facets(mesh, "top_plate")].ravel()) \
+        if name != "top_plate" and "top_plate" in (mesh.boundaries or {}) else set()
+    start = tips[0] if tips[0] in plate else tips[1] if tips[1] in plate \
+        else tips[np.argmax(mesh.doflocs[1, tips])]
+    mid = mesh.dofs.facet_dofs[0] if mesh.dofs.facet_dofs.size else None
+    by_vertex: dict[int, list[int]] = {}
+    for k, f in enumerate(facets):
+        for v in ends[:, k]:
+            by_vertex.setdefault(int(v), []).append(int(f))
+    path, used, v = [int(start)], set(), int(start)
+    for _ in range(len(facets)):
+        f = next(f for f in by_vertex[v] if f not in used)
+        used.add(f)
+        a, b = mesh.facets[:, f]
+        v = int(b if a == v else a)
+        path += ([int(mid[f])] if mid is not None else []) + [v]
+    return np.asarray(path)
+
+
+def _facets(mesh: Mesh, name: str) -> np.ndarray:
+    boundaries = mesh.boundaries or {}
+    if name not in boundaries:
+        raise ValueError(f"mesh: no boundary named '{name}'; the mesh has {sorted(boundaries)}")
+    return np.asarray(boundaries[name])
+
+
+def check_cup_mesh(mesh: Mesh) -> None:
+    """Raise `ValueError` unless `mesh` is a usable cup cross-section.
+
+    Checks: the required tags are present and non-empty, every element has a positive Jacobian
+    at its nodes (no inverted or folded element), no point lies left of the axis r = 0 or below
+    the substrate plane z = 0.
+    """
+    if not isinstance(mesh, (MeshQuad2, MeshTri2)):
+        raise ValueError(f"mesh: must be a quadratic MeshQuad2 or MeshTri2, got {type(mesh).__name__}")
+    for name in REQUIRED_BOUNDARIES:
+        if len(_facets(mesh, name)) == 0:
+            raise ValueError(f"mesh: boundary '{name}' is empty")
+    x = mesh.doflocs
+    extent = float(np.ptp(x, axis=1).max())
+    if x[0].min() < -1e-9 * extent:
+        raise ValueError(f"mesh: points left of the axis (r down to {x[0].min() * 1e3:.4g} mm)")
+    if x[1].min() < -1e-9 * extent:
+        raise ValueError(f"mesh: points below the substrate plane z = 0 (z down to "
+                         f"{x[1].min() * 1e3:.4g} mm); the undeformed cup may only touch it")
+    det = mesh._mapping().detDF(mesh.elem.doflocs.T)
+    if np.any(det <= 0):
+        bad = int(np.argmax(np.any(det <= 0, axis=1)))
+        raise ValueError(f"mesh: element {bad} is inverted or folded (Jacobian <= 0 at a node, "
+                         f"near r = {x[0, mesh.t[0, bad]] * 1e3:.4g} mm, z = {x[1, mesh.t[0, bad]] * 1e3:.4g} mm)")
+
+
+# ---------------------------------------------------------------------- I/O
+_MESHIO_CELL = {MeshQuad2: "quad9", MeshTri2: "triangle6"}
+
+
+def write_mesh(mesh: Mesh, path: str | Path, unit: str = "mm") -> Path:
+    """Write the mesh and its boundary tags through meshio (VTU, Gmsh 2.2 ``.msh``, ...).
+
+    Each tagged boundary facet becomes a ``line3`` cell; the tags are stored as Gmsh physical
+    groups (``.msh``: ``gmsh:physical`` and the group names) or as 0/1 cell-data arrays
+    ``boundary:<name>`` (every other format). Coordinates are written in `unit` ("mm" or "m").
+    """
+    scale = _unit_scale(unit)
+    path = Path(path)
+    names = list((mesh.boundaries or {}).keys())
+    facets = [_facets(mesh, n) for n in names]
+    all_facets = np.concatenate(facets) if facets else np.zeros(0, int)
+    lines = np.column_stack([mesh.facets[:, all_facets].T, mesh.dofs.facet_dofs[0, all_facets]])
+    tag_of_line = np.concatenate([np.full(len(f), k + 1) for k, f in enumerate(facets)]) \
+        if facets else np.zeros(0, int)
+    n_cells = mesh.t.shape[1]
+    surface_tag = len(names) + 1
+    gmsh = path.suffix.lower() == ".msh"
+    if gmsh:     # Gmsh physical groups: a tag per cell and the group names as field data
+        cell_data = {key: [np.full(n_cells, surface_tag), tag_of_line]
+                     for key in ("gmsh:physical", "gmsh:geometrical")}
+        field_data = {name: np.array([k + 1, 1]) for k, name in enumerate(names)}
+        field_data["wall"] = np.array([surface_tag, 2])
+    else:        # formats without field data: one 0/1 indicator array per name
+        cell_data = {f"boundary:{name}": [np.zeros(n_cells, int), (tag_of_line == k + 1).astype(int)]
+                     for k, name in enumerate(names)}
+        field_data = {}
+    out = meshio.Mesh(
+        np.column_stack([mesh.doflocs.T / scale, np.zeros(mesh.doflocs.shape[1])]),
+        [(_MESHIO_CELL[type(mesh)], mesh.dofs.element_dofs.T), ("line3", lines)],
+        cell_data=cell_data, field_data=field_data)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if gmsh:
+        meshio.write(path, out, file_format="gmsh22", binary=False)
+    else:
+        meshio.write(path, out)
+    return path
+
+
+def read_mesh(path: str | Path, unit: str = "mm") -> Mesh:
+    """Read a cup cross-section written by `write_mesh` or drawn in Gmsh (see the module docstring).
+
+    Coordinates are multiplied by the unit's size in metres. Returns a checked `MeshQuad2` or
+    `MeshTri2` in metres whose ``boundaries`` hold every tagged name (the four standard names
+    always, possibly empty for ``outer`` and ``rim``).
+    """
+    scale = _unit_scale(unit)
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"mesh: no such file '{path}'")
+    fmt = {".msh": "gmsh", ".vtu": "vtu", ".vtk": "vtk", ".xdmf": "xdmf"}.get(path.suffix.lower())
+    try:   # meshio prints and may sys.exit() on an unreadable file: keep both inside
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            m = meshio.read(path, file_format=fmt)
+    except (Exception, SystemExit) as exc:
+        raise ValueError(f"mesh: cannot read '{path}': {exc}".replace("\n", " ")) from None
+    mesh = _volume_mesh(m, scale, path)
+    extent = float(np.ptp(mesh.doflocs, axis=1).max())
+    if not 1e-4 <= extent <= 10.0:
+        raise ValueError(f"mesh: '{path}' spans {extent:.3g} m with unit '{unit}'; "
+                         f"give the file's length unit (mm or m)")
+    boundaries = _tagged_boundaries(m, mesh, scale, path)
+    for name in BOUNDARY_NAMES:
+        boundaries.setdefault(name, np.zeros(0, dtype=np.int64))
+    mesh = replace(mesh, _boundaries=boundaries)
+    check_cup_mesh(mesh)
+    return mesh
+
+
+def _unit_scale(unit: str) -> float:
+    if unit not in _UNITS:
+        raise ValueError(f"mesh unit: must be one of {', '.join(_UNITS)}, got {unit!r}")
+    return _UNITS[unit]
+
+
+def _volume_mesh(m: meshio.Mesh, scale: float, path: Path) -> Mesh:
+    kinds = [c.type for c in m.cells if c.type in ("triangle", "triangle6", "quad", "quad8", "quad9")]
+    if len(set(kinds)) != 1:
+        raise ValueError(f"mesh: '{path}' must hold one kind of 2D cell (triangle[6] or quad[8|9]), "
+                         f"found {sorted(set(kinds)) or 'none'}")
+    kind = kinds[0]
+    cells = np.concatenate([c.data for c in m.cells if c.type == kind])
+    if m.points.shape[1] > 2 and np.ptp(m.points[:, 2]) > 1e-9 * np.ptp(m.points[:, :2]):
+        raise ValueError(f"mesh: '{path}' is not planar; draw the (r, z) cross-section in the x-y plane")
+    points = np.asarray(m.points[:, :2], dtype=float) * scale
+    if np.median(_signed_areas(points, cells[:, :3])) < 0:
+        cells = _reverse_orientation(cells, kind)   # drawn clockwise: make it counter-clockwise
+    if kind in ("triangle", "quad"):
+        linear = (MeshTri1 if kind == "triangle" else MeshQuad1)(points.T, cells.T, sort_t=False)
+        return (MeshTri2 if kind == "triangle" else MeshQuad2).from_mesh(linear)
+    if kind == "quad8":   # add the centre node of the serendipity quad
+        centre = -0.25 * points[cells[:, :4]].sum(1) + 0.5 * points[cells[:, 4:8]].sum(1)
+        cells = np.column_stack([cells, len(points) + np.arange(len(cells))])
+        points = np.vstack([points, centre])
+    return (MeshTri2 if kind == "triangle6" else MeshQuad2)(points.T, cells.T)
+
+
+def _signed_areas(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    a, b, c = (points[cells[:, k]] for k in range(3))
+    return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+
+
+def _reverse_orientation(cells: np.ndarray, kind: str) -> np.ndarray:
+    """Cells with their corner order reversed (mid-side nodes follow their edges)."""
+    order = {"triangle": [0, 2, 1], "quad": [0, 3, 2, 1], "triangle6": [0, 2, 1, 5, 4, 3],
+             "quad8": [0, 3, 2, 1, 7, 6, 5, 4], "quad9": [0, 3, 2, 1, 7, 6, 5, 4, 8]}[kind]
+    return cells[:, order]
+
+
+def _tagged_boundaries(m: meshio.Mesh, mesh: Mesh, scale: float, path: Path) -> dict[str, np.ndarray]:
+    """Facet indices of every named boundary in the file, matched by edge midpoint."""
+    vertex_pairs: dict[str, list[np.ndarray]] = {}
+    names_by_tag = {int(v[0]): k for k, v in m.field_data.items() if len(v) >= 2 and int(v[1]) == 1}
+    for i, block in enumerate(m.cells):
+        if block.type not in ("line", "line3"):
+            continue
+        ends = block.data[:, :2]
+        for key, arrays in m.cell_data.items():
+            data = np.asarray(arrays[i]).astype(int)
+            if key == "gmsh:physical":
+                for tag in np.unique(data):
+                    if tag in names_by_tag:
+                        vertex_pairs.setdefault(names_by_tag[tag], []).append(ends[data == tag])
+            elif key.startswith("boundary:"):
+                vertex_pairs.setdefault(key.split(":", 1)[1], []).append(ends[data != 0])
+        for name, sets in m.cell_sets.items():
+            if i < len(sets) and sets[i] is not None and len(sets[i]) and not name.startswith("gmsh:"):
+                vertex_pairs.setdefault(name, []).append(ends[np.asarray(sets[i], int)])
+    if not vertex_pairs:
+        raise ValueError(f"mesh: '{path}' has no named boundary; tag the curves "
+                         f"{', '.join(BOUNDARY_NAMES)} (Gmsh physical groups)")
+    points = np.asarray(m.points[:, :2], dtype=float) * scale
+    facet_mid = 0.5 * (mesh.doflocs[:, mesh.facets[0]] + mesh.doflocs[:, mesh.facets[1]]).T
+    extent = np.ptp(mesh.doflocs, axis=1).max()
+    tree = cKDTree(facet_mid / extent)
+    out: dict[str, np.ndarray] = {}
+    for name, pairs in vertex_pairs.items():
+        ends = np.unique(np.concatenate(pairs), axis=0)
+        mids = 0.5 * (points[ends[:, 0]] + points[ends[:, 1]])
+        dist, idx = tree.query(mids / extent)
+        if np.any(dist > 1e-8):
+            raise ValueError(f"mesh: {int(np.sum(dist > 1e-8))} edge(s) tagged '{name}' in '{path}' "
+                             f"are not edges of the 2D cells")
+        out[name] = np.unique(idx).astype(np.int64)
+    return out

@@ -1,0 +1,191 @@
+"""Geometry of the deformed cup from plain arrays: cavity volume, contact radius, strip widths.
+
+Pure functions of node coordinates and nodal contact pressures (SI units), independent of the
+solver, each checked against closed forms in ``tests/test_fem_postprocess.py``.
+
+- `enclosed_volume`: the cavity volume V of eq. (4), by the divergence theorem on the deformed
+  cavity-facing polyline.
+- `inner_contact_radius`: r_c, the inner edge of the contact (cf. eq. 3).
+- `pressure_weighted_width` and `half_maximum_width`: two mesh-convergent definitions of the
+  contact-strip width l of eqs. (5)-(6).
+
+Pressure profiles p(r) are sampled at increasing radii and taken piecewise-linear between the
+samples; integrals of such profiles are exact (no quadrature error beyond the interpolation).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["enclosed_volume", "inner_contact_radius", "pressure_weighted_width",
+           "half_maximum_width", "contact_force", "Richardson", "richardson"]
+
+
+def enclosed_volume(r_m: np.ndarray, z_m: np.ndarray, in_contact: np.ndarray | None = None) -> float:
+    """Volume of revolution of the cavity [m^3] (the region of eq. 4).
+
+    Parameters
+    ----------
+    r_m, z_m : the deformed cavity-facing surface, ordered from the top-plate edge (index 0) to
+        the rim (shape (n,)), e.g. the nodes of `fem.mesh.boundary_path(mesh, "cavity")`.
+    in_contact : boolean mask of the points touching the plane z = 0; by default the points with
+        z <= 0. The surface is followed down to its first contact point.
+
+    The region is bounded by the plate roof z = z_m[0] from the axis to r_m[0], the surface down
+    to the innermost contact point k, the vertical drop from (r_k, z_k) to z = 0 (zero length
+    unless the point penetrates or hovers), and the plane z = 0 back to the axis. By the
+    divergence theorem (Green's theorem in the meridian plane), V = 2 pi int r dA =
+    pi oint r^2 dz (counter-clockwise), which for straight segments is exactly
+
+        V = (pi / 3) sum_i (z_i - z_{i+1}) (r_i^2 + r_i r_{i+1} + r_{i+1}^2)
+
+    (horizontal and axial segments contribute nothing). An undeformed cone gives the frustum.
+    """
+    r, z = _profile(r_m, z_m)
+    contact = (z <= 0.0) if in_contact is None else np.asarray(in_contact, dtype=bool)
+    if contact.shape != r.shape:
+        raise ValueError(f"in_contact: expected {r.size} flags, got {contact.size}")
+    if not contact.any():
+        raise ValueError("in_contact: the cavity is not closed, no point of the surface touches z = 0")
+    k = int(np.argmax(contact))
+    rr = np.append(r[:k + 1], r[k])
+    zz = np.append(z[:k + 1], 0.0)
+    dz = zz[:-1] - zz[1:]
+    return float(math.pi / 3.0 * np.sum(dz * (rr[:-1] ** 2 + rr[:-1] * rr[1:] + rr[1:] ** 2)))
+
+
+def inner_contact_radius(r_m: np.ndarray, p_Pa: np.ndarray, threshold_Pa: float = 0.0) -> float:
+    """Inner edge r_c [m] of the contact, from nodal pressures at increasing radii.
+
+    Let k be the first sample with p > threshold. If k > 0 the edge lies in (r_{k-1}, r_k]; it is
+    placed where a square-root edge p ~ sqrt(r - r_c), the shape at the edge of a smooth
+    (Hertz-like) contact, through the samples k and k+1 vanishes, i.e. where p^2 extrapolates
+    linearly to zero, clamped to [r_{k-1}, r_k]. A pressure falling away from the edge (p_{k+1}
+    <= p_k) or a contact reaching the first sample gives r_c = r_k.
+    """
+    r, p = _profile(r_m, p_Pa, increasing=True)
+    k = _first_loaded(p, threshold_Pa)
+    if k == 0 or k + 1 >= r.size or p[k + 1] <= p[k]:
+        return float(r[k])
+    q0, q1 = p[k] ** 2, p[k + 1] ** 2
+    edge = r[k] - (r[k + 1] - r[k]) * q0 / (q1 - q0)
+    return float(np.clip(edge, r[k - 1], r[k]))
+
+
+def contact_force(r_m: np.ndarray, p_Pa: np.ndarray) -> float:
+    """Total normal force 2 pi int p r dr [N] of the piecewise-linear pressure profile."""
+    r, p = _profile(r_m, p_Pa, increasing=True)
+    return float(2 * math.pi * _integral_pr(r, p, p * 0 + 1))
+
+
+def pressure_weighted_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = None) -> float:
+    """Strip width l_w = (int p dA)^2 / (2 pi r_c int p^2 dA) [m], dA = 2 pi r dr.
+
+    The width that makes eq. (6), p = F0 / (2 pi r_c l), give the load-weighted mean contact
+    pressure <p> = int p^2 dA / int p dA when F0 = int p dA. For a
+    uniform pressure on r_c < r < r_c + l it is l (1 + l / (2 r_c)), i.e. l for a strip narrow
+    compared with its radius; for a linear fall from the edge to zero over l (a triangle) it is
+    3 l / 4 in that limit. Insensitive to the exact position of the contact edge, so it converges
+    with the mesh. `r_c_m` defaults to `inner_contact_radius`.
+    """
+    r, p = _profile(r_m, p_Pa, increasing=True)
+    if not np.any(p > 0):
+        raise ValueError("p_Pa: no positive contact pressure, the strip width is undefined")
+    r_c = inner_contact_radius(r, p) if r_c_m is None else float(r_c_m)
+    one = np.ones_like(p)
+    first = _integral_pr(r, p, one)      # int p r dr
+    second = _integral_pr(r, p, p)       # int p^2 r dr
+    return float((2 * math.pi * first) ** 2 / (2 * math.pi * r_c * 2 * math.pi * second))
+
+
+def half_maximum_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = None) -> float:
+    """Full width at half maximum [m] of the piecewise-linear pressure profile.
+
+    The interval around the largest pressure on which p >= max(p)/2, its ends found by linear
+    interpolation between samples; the inner end is not taken inside the contact edge r_c
+    (`r_c_m`, default `inner_contact_radius`), so a pressure peaking at the edge gives exactly
+    the half-maximum distance from the edge. A uniform strip of width l gives l, a triangle
+    falling from the edge l/2, a Hertz-like ellipse of half-width a gives sqrt(3) a.
+    """
+    r, p = _profile(r_m, p_Pa, increasing=True)
+    if not np.any(p > 0):
+        raise ValueError("p_Pa: no positive contact pressure, the strip width is undefined")
+    r_c = inner_contact_radius(r, p) if r_c_m is None else float(r_c_m)
+    peak = int(np.argmax(p))
+    half = 0.5 * p[peak]
+    lo = peak
+    while lo > 0 and p[lo - 1] >= half:
+        lo -= 1
+    hi = peak
+    while hi < r.size - 1 and p[hi + 1] >= half:
+        hi += 1
+    left = r[lo] if lo == 0 else _crossing(r[lo - 1], p[lo - 1], r[lo], p[lo], half)
+    right = r[hi] if hi == r.size - 1 else _crossing(r[hi], p[hi], r[hi + 1], p[hi + 1], half)
+    return float(right - max(left, r_c))
+
+
+@dataclass(frozen=True)
+class Richardson:
+    """Richardson extrapolation of a quantity from three meshes with a constant refinement ratio.
+
+    order : observed order p (NaN where the three values do not converge monotonically);
+    extrapolated : f_fine + (f_fine - f_medium) / (ratio^p - 1) (f_fine where p is NaN);
+    fine_error : |extrapolated - f_fine| (|f_fine - f_medium| where p is NaN), the estimated
+        discretisation error of the finest mesh.
+    """
+
+    order: np.ndarray
+    extrapolated: np.ndarray
+    fine_error: np.ndarray
+
+
+def richardson(f_coarse: np.ndarray, f_medium: np.ndarray, f_fine: np.ndarray,
+               ratio: float = 2.0) -> Richardson:
+    """Observed order and extrapolated value from meshes of sizes h, h/ratio, h/ratio^2.
+
+    If f_h = f* + C h^p exactly, p = log((f_c - f_m)/(f_m - f_f)) / log(ratio) and f* are
+    recovered to round-off. Works elementwise on arrays (e.g. F0 at common plate displacements).
+    """
+    fc, fm, ff = (np.asarray(f, dtype=float) for f in (f_coarse, f_medium, f_fine))
+    d1, d2 = fc - fm, fm - ff
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = d1 / d2
+        monotone = (q > 1.0) & np.isfinite(q)
+        p = np.where(monotone, np.log(np.where(monotone, q, 2.0)) / math.log(ratio), np.nan)
+        extrapolated = np.where(monotone, ff - d2 / (q - 1.0), ff)   # ratio^p - 1 = q - 1
+    fine_error = np.where(monotone, np.abs(extrapolated - ff), np.abs(d2))
+    return Richardson(order=p, extrapolated=extrapolated, fine_error=fine_error)
+
+
+def _crossing(r0: float, p0: float, r1: float, p1: float, level: float) -> float:
+    return r0 + (r1 - r0) * (level - p0) / (p1 - p0)
+
+
+def _integral_pr(r: np.ndarray, f: np.ndarray, g: np.ndarray) -> float:
+    """int f g r dr for f, g piecewise linear on the samples: Simpson's rule, exact for cubics."""
+    rm = 0.5 * (r[1:] + r[:-1])
+    fm, gm = 0.5 * (f[1:] + f[:-1]), 0.5 * (g[1:] + g[:-1])
+    h = np.diff(r)
+    ends = f[:-1] * g[:-1] * r[:-1] + f[1:] * g[1:] * r[1:]
+    return float(np.sum(h / 6.0 * (ends + 4.0 * fm * gm * rm)))
+
+
+def _first_loaded(p: np.ndarray, threshold: float) -> int:
+    loaded = p > threshold
+    if not loaded.any():
+        raise ValueError(f"p_Pa: no sample exceeds the contact threshold {threshold:g} Pa")
+    return int(np.argmax(loaded))
+
+
+def _profile(a: np.ndarray, b: np.ndarray, increasing: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    a, b = np.asarray(a, dtype=float).ravel(), np.asarray(b, dtype=float).ravel()
+    if a.size != b.size or a.size < 2:
+        raise ValueError(f"profile: need >= 2 matching samples, got {a.size} and {b.size}")
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        raise ValueError("profile: contains NaN or infinite values")
+    if increasing and np.any(np.diff(a) <= 0):
+        raise ValueError("r_m: radii must be strictly increasing")
+    return a, b

@@ -1,0 +1,184 @@
+"""Post-processing (fem.postprocess) against closed forms: eq. (4), contact edges, strip widths."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from fem.geometry import cup_geometry
+from fem.mesh import boundary_path, cup_mesh
+from fem.postprocess import (contact_force, enclosed_volume, half_maximum_width,
+                             inner_contact_radius, pressure_weighted_width)
+
+MM = 1e-3
+
+
+# ------------------------------------------------------------------ volume
+@pytest.mark.parametrize("cup", ["A", "B"])
+def test_undeformed_cup_encloses_the_frustum(cup):
+    g = cup_geometry(cup)
+    mesh = cup_mesh(g, "coarse")
+    r, z = mesh.doflocs[:, boundary_path(mesh, "cavity")]
+    assert enclosed_volume(r, z) == pytest.approx(g.cavity_volume_m3(), rel=1e-13)
+
+
+@pytest.mark.parametrize("h_over_h1", [1.0, 0.7, 0.3, 0.05])
+def test_rigid_cone_pressed_flat_gives_eq_4(h_over_h1):
+    # the paper's rigid-cone kinematics, eq. (3): the cone keeps its angle, the plate sits at h,
+    # the surface meets z = 0 at r = r0 (1 + h/h0); the part beyond lies flat on the plane
+    g = cup_geometry("A")
+    h0 = g.r0_m * math.tan(g.alpha_rad)
+    h = h_over_h1 * g.h1_m
+    r_contact = g.r0_m * (1 + h / h0)
+    cone_r = np.linspace(g.r0_m, r_contact, 7)
+    flat_r = np.linspace(r_contact, g.r1_m, 5)[1:]
+    r = np.concatenate([cone_r, flat_r])
+    z = np.concatenate([h * (r_contact - cone_r) / (r_contact - g.r0_m), 0 * flat_r])
+    v0 = math.pi * g.r0_m ** 2 * h0 / 3
+    assert enclosed_volume(r, z) == pytest.approx(v0 * ((r_contact / g.r0_m) ** 3 - 1), rel=1e-13)
+
+
+def test_curved_surface_volume_converges_at_second_order():
+    # cavity under the paraboloid z = H (1 - r^2/R^2) for r0 < r < R, with a flat roof inside r0:
+    # V = pi r0^2 z(r0) + 2 pi H [r^2/2 - r^4/(4 R^2)] from r0 to R; the polyline error is O(h^2)
+    r0, R, H = 5 * MM, 19 * MM, 8 * MM
+    exact = math.pi * r0 ** 2 * H * (1 - r0 ** 2 / R ** 2) \
+        + 2 * math.pi * H * ((R ** 2 - r0 ** 2) / 2 - (R ** 4 - r0 ** 4) / (4 * R ** 2))
+    errors = []
+    for n in (8, 16, 32):
+        r = np.linspace(r0, R, n + 1)
+        errors.append(abs(enclosed_volume(r, H * (1 - r ** 2 / R ** 2)) - exact) / exact)
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert orders == pytest.approx([2.0, 2.0], abs=0.05)
+
+
+def test_volume_stops_at_the_first_contact_and_closes_penetration():
+    r = np.array([5.0, 10.0, 15.0, 19.0]) * MM
+    z = np.array([4.0, 0.0, 1.0, 0.0]) * MM          # touches down at r = 10 mm, lifts, rim down
+    inner = math.pi / 3 * 4 * MM * (25 + 50 + 100) * MM ** 2
+    assert enclosed_volume(r, z) == pytest.approx(inner, rel=1e-14)
+    z_pen = z.copy()
+    z_pen[1] = -0.01 * MM                             # penetrating node: the drop back to z = 0
+    mask = np.array([False, True, False, True])
+    expected = math.pi / 3 * (4.01 * MM) * (25 + 50 + 100) * MM ** 2 - math.pi * (10 * MM) ** 2 * 0.01 * MM
+    assert enclosed_volume(r, z_pen, in_contact=mask) == pytest.approx(expected, rel=1e-13)
+    with pytest.raises(ValueError, match="not closed"):
+        enclosed_volume(r, z + 1 * MM)
+
+
+# ---------------------------------------------------------- contact edge
+def test_square_root_edge_is_recovered_exactly():
+    r = np.linspace(10, 12, 21) * MM
+    r_c = 10.537 * MM
+    p = 1e5 * np.sqrt(np.clip(r - r_c, 0, None) / MM)
+    assert inner_contact_radius(r, p) == pytest.approx(r_c, rel=1e-13)
+
+
+def test_hertz_edge_converges_at_second_order():
+    # p = p0 sqrt(1 - x^2/a^2): p^2 is linear at the edge up to O(x^2), so the error is O(h^2)
+    a, rm = 0.8 * MM, 12 * MM
+    errors = []
+    for n in (40, 80, 160):
+        r = np.linspace(10, 14, n + 1) * MM + 0.3 * 4 * MM / n      # edge off the grid
+        p = 2e5 * np.sqrt(np.clip(1 - ((r - rm) / a) ** 2, 0, None))
+        errors.append(abs(inner_contact_radius(r, p) - (rm - a)))
+    assert errors[-1] < 1e-3 * a
+    assert np.all(np.log2(np.array(errors[:-1]) / np.array(errors[1:])) > 1.7)
+
+
+def test_edge_of_a_uniform_or_decreasing_pressure_is_the_first_loaded_sample():
+    r = np.linspace(5, 9, 9) * MM
+    p = np.where(r > 6.2 * MM, 1e5, 0.0)
+    assert inner_contact_radius(r, p) == r[np.argmax(p > 0)]
+    assert inner_contact_radius(r, np.linspace(2, 1, 9)) == r[0]
+    assert inner_contact_radius(r, np.where(r > 6.2 * MM, 1e5, 10.0), threshold_Pa=100) == r[3]
+    with pytest.raises(ValueError, match="threshold"):
+        inner_contact_radius(r, 0 * r)
+
+
+# ------------------------------------------------------------ strip width
+def _uniform(r_c, l, n=11):
+    r = np.linspace(r_c, r_c + l, n)
+    return r, np.full(n, 3e5)
+
+
+def _triangle(r_c, l, n=11):
+    r = np.linspace(r_c, r_c + l, n)
+    return r, 3e5 * (1 - (r - r_c) / l)
+
+
+@pytest.mark.parametrize("r_c,l", [(5 * MM, 4 * MM), (19 * MM, 0.8 * MM)])
+def test_weighted_width_of_uniform_and_triangular_strips(r_c, l):
+    # closed forms with dA = 2 pi r dr:
+    #   uniform:  l (1 + l / (2 r_c));
+    #   triangle: (r_c l/2 + l^2/6)^2 / (r_c (r_c l/3 + l^2/12)) -> 3 l / 4 for l << r_c
+    assert pressure_weighted_width(*_uniform(r_c, l)) == pytest.approx(l * (1 + l / (2 * r_c)), rel=1e-13)
+    tri = (r_c * l / 2 + l * l / 6) ** 2 / (r_c * (r_c * l / 3 + l * l / 12))
+    assert pressure_weighted_width(*_triangle(r_c, l)) == pytest.approx(tri, rel=1e-13)
+    assert pressure_weighted_width(*_triangle(100.0, l)) == pytest.approx(0.75 * l, rel=1e-4)
+
+
+def test_weighted_width_of_a_hertz_strip_matches_quadrature():
+    # elliptical pressure on [rm - a, rm + a]; reference by adaptive quadrature of the closed form
+    a, rm = 1.0 * MM, 12 * MM
+    ell = lambda x: math.sqrt(max(1 - ((x - rm) / a) ** 2, 0.0))
+    first = quad(lambda x: ell(x) * x, rm - a, rm + a, epsabs=0, epsrel=1e-12)[0]
+    second = quad(lambda x: ell(x) ** 2 * x, rm - a, rm + a, epsabs=0, epsrel=1e-12)[0]
+    exact = first ** 2 / ((rm - a) * second)
+    # thin-strip limit 3 pi^2/16 a (1D closed form), times rm/(rm - a) for dividing by r_c = rm - a
+    assert exact == pytest.approx(3 * math.pi ** 2 / 16 * a * rm / (rm - a), rel=(a / rm) ** 2)
+    r = np.linspace(rm - a, rm + a, 401)
+    p = np.sqrt(np.clip(1 - ((r - rm) / a) ** 2, 0, None))
+    # the sqrt edges limit the piecewise-linear integrals to O(h^1.5): 1e-3 at h = a/200
+    assert pressure_weighted_width(r, p, r_c_m=rm - a) == pytest.approx(exact, rel=1e-3)
+
+
+def test_half_maximum_widths():
+    r_c, l = 10 * MM, 2 * MM
+    assert half_maximum_width(*_uniform(r_c, l)) == pytest.approx(l, rel=1e-13)
+    assert half_maximum_width(*_triangle(r_c, l)) == pytest.approx(l / 2, rel=1e-13)
+    # the triangle with unloaded samples inside it: the zero sample does not widen the strip
+    r, p = _triangle(r_c, l)
+    r = np.concatenate([[r_c - 0.5 * MM], r])
+    p = np.concatenate([[0.0], p])
+    assert half_maximum_width(r, p) == pytest.approx(l / 2, rel=1e-13)
+    a, rm = 1.0 * MM, 12 * MM
+    errors = []
+    for n in (100, 200, 400):
+        r = np.linspace(10, 14, n + 1) * MM
+        p = np.sqrt(np.clip(1 - ((r - rm) / a) ** 2, 0, None))
+        errors.append(abs(half_maximum_width(r, p) / (math.sqrt(3) * a) - 1))
+    # linear interpolation at p = 1/2 of a smooth profile (the sampled maximum is exact here)
+    assert errors[-1] < 1e-4
+    assert np.all(np.log2(np.array(errors[:-1]) / np.array(errors[1:])) > 1.8)
+
+
+def test_contact_force_of_a_uniform_annulus():
+    r, p = _uniform(10 * MM, 2 * MM)
+    assert contact_force(r, p) == pytest.approx(3e5 * math.pi * ((12 * MM) ** 2 - (10 * MM) ** 2), rel=1e-13)
+
+
+def test_bad_profiles():
+    with pytest.raises(ValueError, match="increasing"):
+        pressure_weighted_width(np.array([2.0, 1.0]), np.array([1.0, 1.0]))
+    with pytest.raises(ValueError, match="no positive"):
+        half_maximum_width(np.array([1.0, 2.0]), np.array([0.0, 0.0]))
+    with pytest.raises(ValueError, match="NaN"):
+        enclosed_volume(np.array([1.0, np.nan]), np.array([1.0, 0.0]))
+
+
+# ------------------------------------------------------------ Richardson
+def test_richardson_recovers_order_and_limit_of_a_power_law():
+    from fem.postprocess import richardson
+    h = np.array([0.4, 0.2, 0.1])
+    for p, f_star, c in [(2.0, 3.0, 5.0), (3.0, -1.0, -2.0), (1.3, 10.0, 0.7)]:
+        f = f_star + c * h ** p
+        rich = richardson(*f)
+        assert rich.order == pytest.approx(p, rel=1e-10)
+        assert rich.extrapolated == pytest.approx(f_star, rel=1e-10)
+        assert rich.fine_error == pytest.approx(abs(c) * 0.1 ** p, rel=1e-8)
+    # oscillating (non-monotone) values: no order, the finest value, its last change as the error
+    rich = richardson(np.array([1.0]), np.array([1.2]), np.array([1.1]))
+    assert np.isnan(rich.order[0]) and rich.extrapolated[0] == 1.1
+    assert rich.fine_error[0] == pytest.approx(0.1)

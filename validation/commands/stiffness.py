@@ -1,0 +1,146 @@
+"""Compute a cup's stiffness curve F0(h), r_c(h), l(h), V(h) with the axisymmetric finite-strain FEM.
+
+The cup's top plate is pressed onto the rigid plane z = 0 (displacement control, u from 0 to
+--u-max-mm, default 0.9 h1); the wall is a compressible neo-Hookean solid, in frictionless or
+sticking contact with the plane. Writes the hand-off CSV (u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3; l is
+the pressure-weighted strip width) and a JSON sidecar next to it (same name, .json) with the
+provenance, the solver statistics and per-step extras. Both appear together or not at all.
+
+examples:
+  cupcheck stiffness --cup A --contact sticking --out out/cupA_sticking.csv
+  cupcheck stiffness --geometry my_cup.toml --fidelity medium --out my_cup.csv
+  cupcheck stiffness --mesh meshes/user_lip.msh --u-max-mm 3 --out lip.csv
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import sys
+from dataclasses import asdict, replace
+from pathlib import Path
+from typing import Any
+
+NAME = "stiffness"
+HELP = "FEM stiffness curve F0(h), r_c, l, V of cup A, B or your own design (CSV + JSON sidecar)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    g = parser.add_argument_group("cup")
+    g.add_argument("--cup", choices=("A", "B"), default="A",
+                   help="preset of Table 1 / Sec. 5.5 (A: alpha 33 deg, d 2.5 -> 0.3 mm; B: 21 deg, "
+                        "1.5 -> 0.3 mm; r0 5 mm, r1 19 mm); also the base of --geometry (default A)")
+    g.add_argument("--geometry", metavar="FILE", type=Path,
+                   help="geometry file (.toml or .json; keys r0_mm, r1_mm, alpha_deg, "
+                        "thickness_convention, thickness = {r_mm = [...], d_mm = [...]}) overriding --cup")
+    g.add_argument("--thickness-convention", choices=("normal", "vertical"),
+                   help="wall thickness measured along the cavity surface's normal or vertically "
+                        "(default: normal, or the geometry file's)")
+    g.add_argument("--mesh", metavar="FILE", type=Path,
+                   help="your own quadratic cross-section (.msh/.vtu, boundary names top_plate, "
+                        "cavity[, outer, rim]; see meshes/README.md) instead of a generated mesh")
+    g.add_argument("--mesh-unit", choices=("mm", "m"), default="mm",
+                   help="length unit of the coordinates in --mesh (default mm)")
+    m = parser.add_argument_group("material and contact")
+    m.add_argument("--E-MPa", type=float, default=4.0, dest="E_MPa",
+                   help="Young's modulus E [MPa] (default 4)")
+    m.add_argument("--nu", type=float, default=0.49, help="Poisson's ratio [-] (default 0.49)")
+    m.add_argument("--formulation", choices=("displacement", "mixed"), default="displacement",
+                   help="displacement (default) or mixed u-p (nearly incompressible, nu up to 0.4999)")
+    m.add_argument("--contact", choices=("frictionless", "sticking"), default="frictionless",
+                   help="contact with the plane: frictionless, or sticking (a touching point stops "
+                        "sliding) (default frictionless)")
+    r = parser.add_argument_group("run")
+    r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default=None,
+                   help="mesh level of a generated mesh (default coarse; see README)")
+    r.add_argument("--u-max-mm", type=float, default=None, dest="u_max_mm",
+                   help="largest plate displacement u [mm], in (0, 1.25 h1] (default 0.9 h1)")
+    r.add_argument("--fields-out", type=Path, metavar="FILE",
+                   help="also write the last step's fields (displacement, Cauchy stress, contact "
+                        "pressure) as .vtu")
+    r.add_argument("--out", type=Path, required=True, metavar="CSV",
+                   help="the stiffness curve (.csv); the sidecar goes to the same name with .json")
+
+
+def run(args: argparse.Namespace) -> int:
+    job = _prepare(args)                     # every check happens here, before the solve
+    from fem.cup import compress_cup
+    from validation import handoff
+    from validation.output import atomic_file, terminal_progress
+
+    response = compress_cup(job["mesh"], job["material"], contact=args.contact,
+                            u_max_m=job["u_max_m"], progress=terminal_progress("stiffness"))
+    prov = handoff.provenance(response, geometry=job["geometry"], mesh=job["mesh_info"],
+                              fidelity=job["fidelity"])
+    curve = handoff.stiffness_curve(response, prov)
+    with atomic_file(job["sidecar"]) as tmp_json, atomic_file(args.out) as tmp_csv:
+        curve.to_csv(tmp_csv)
+        handoff.write_sidecar(handoff.sidecar(response, prov), tmp_json)
+        if args.fields_out is not None:
+            with atomic_file(args.fields_out) as tmp_fields:
+                response.write_fields(tmp_fields)
+    s = response.stats
+    print(f"cupcheck stiffness: wrote {args.out} and {job['sidecar'].name}: {s.steps} steps, "
+          f"{s.newton_iterations} Newton iterations, {s.dofs} dofs, {s.wall_time_s:.1f} s; "
+          f"F0 = {response.F0_N[-1]:.4g} N at u = {1e3 * response.u_m[-1]:.4g} mm")
+    return 0
+
+
+def _prepare(args: argparse.Namespace) -> dict[str, Any]:
+    """Validate every input and build the mesh and material (cheap); raise ValueError."""
+    from fem.cup import cup_height
+    from fem.geometry import cup_geometry, load_geometry
+    from fem.material import NeoHookean
+    from fem.mesh import FIDELITIES, cup_mesh, read_mesh
+
+    out = Path(args.out)
+    if out.suffix.lower() != ".csv":
+        raise ValueError(f"out: the stiffness curve must be a .csv file, got '{out}'")
+    if out.is_dir():
+        raise ValueError(f"out: '{out}' is a directory; give a .csv file name")
+    if args.fields_out is not None and Path(args.fields_out).suffix.lower() != ".vtu":
+        raise ValueError(f"fields_out: must end in .vtu, got '{args.fields_out}'")
+    material = NeoHookean(E_Pa=_positive(args.E_MPa, "E_MPa", "Young's modulus") * 1e6,
+                          nu=args.nu, formulation=args.formulation)
+    fidelity = args.fidelity or "coarse"
+    if args.mesh is not None:
+        given = [o for o, v in (("--geometry", args.geometry), ("--fidelity", args.fidelity),
+                                ("--thickness-convention", args.thickness_convention)) if v is not None]
+        if given:
+            raise ValueError(f"mesh: a mesh file fixes the geometry and the mesh; drop {', '.join(given)}")
+        mesh = read_mesh(args.mesh, unit=args.mesh_unit)
+        geometry = {"name": f"mesh file {Path(args.mesh).name}"}
+        mesh_info = {"file": str(args.mesh), "unit": args.mesh_unit,
+                     "sha256": hashlib.sha256(Path(args.mesh).read_bytes()).hexdigest()}
+        fidelity = None
+    else:
+        geo = load_geometry(args.geometry, cup=args.cup) if args.geometry is not None \
+            else cup_geometry(args.cup)
+        if args.thickness_convention is not None:
+            geo = replace(geo, thickness_convention=args.thickness_convention)
+        mesh = cup_mesh(geo, fidelity)
+        geometry = geo.describe()
+        mesh_info = {"generated": asdict(FIDELITIES[fidelity])}
+    mesh_info.update(element=type(mesh).__name__, elements=int(mesh.t.shape[1]),
+                     nodes=int(mesh.doflocs.shape[1]))
+    h1 = cup_height(mesh)
+    if args.u_max_mm is None:
+        u_max = 0.9 * h1
+    else:
+        u_max = _positive(args.u_max_mm, "u_max_mm", "plate displacement") * 1e-3
+        if u_max > 1.25 * h1:
+            raise ValueError(f"u_max_mm: plate displacement must be in (0, 1.25 h1] = (0, "
+                             f"{1.25e3 * h1:.4g}] mm, got {args.u_max_mm:g}")
+    return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
+            "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json")}
+
+
+def _positive(value: float, name: str, what: str) -> float:
+    if not (value == value and 0 < value < float("inf")):
+        raise ValueError(f"{name}: {what} must be > 0, got {value:g}")
+    return float(value)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    from validation.cli import main
+    sys.exit(main([NAME, *sys.argv[1:]]))
