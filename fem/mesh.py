@@ -12,7 +12,8 @@ elements are straight-sided with centred mid-side nodes. Grading:
 
 - along the wall the element length is proportional to d(r)^along_grading (1: the elements keep
   the local thickness-to-length ratio, so they shrink towards the thin rim where contact starts;
-  0: uniform in s);
+  0: uniform in s; negative, as in the fidelity levels (-1/2): finer where the wall is thick,
+  which governs the steep end of F0(u));
 - through the thickness the layers grow geometrically from the cavity face (where the contact
   pressure acts) to the outer face, by the factor through_ratio^(1/n_through) per layer.
 
@@ -67,7 +68,7 @@ class MeshSpec:
     """Element counts and grading of a mapped cup mesh (see the module docstring).
 
     n_along : elements along the wall (>= 1); n_through : elements through the thickness (>= 1);
-    along_grading : element length proportional to d^along_grading, in [0, 2];
+    along_grading : element length proportional to d^along_grading, in [-1, 2];
     through_ratio : q of the through-thickness map t = (q^eta - 1)/(q - 1): the layers grow by
         q^(1/n_through) each from the cavity face outwards, in [1/20, 20];
     element : "quad" (MeshQuad2) or "tri" (MeshTri2, two triangles per quad).
@@ -84,8 +85,8 @@ class MeshSpec:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
                 raise ValueError(f"{name}: element count must be an integer >= 1, got {value!r}")
-        if not 0.0 <= self.along_grading <= 2.0:
-            raise ValueError(f"along_grading: must be in [0, 2], got {self.along_grading:g}")
+        if not -1.0 <= self.along_grading <= 2.0:
+            raise ValueError(f"along_grading: must be in [-1, 2], got {self.along_grading:g}")
         if not 1 / 20 <= self.through_ratio <= 20:
             raise ValueError(f"through_ratio: must be in [0.05, 20], got {self.through_ratio:g}")
         if self.element not in ("quad", "tri"):
@@ -97,12 +98,15 @@ class MeshSpec:
 
 
 #: fidelity levels; each doubles the counts of the previous one (constant refinement ratio 2).
-#: Tuned with benchmarks/bench_fem.py: along_grading 0.5 balances the thin rim, where contact
-#: starts, against the thick inner wall, whose contact governs the steep end of F0(u).
+#: Tuned with benchmarks/bench_fem.py on cup A: the error of F0 concentrates at the steep end of
+#: the curve, where the thick inner wall is pressed flat and compressed, so the elements are
+#: graded towards the thick wall (length ~ d^-1/2) and use three layers through the thickness;
+#: a stronger grading (d^-1) made the rim elements so long that the quadratic edges between
+#: contact nodes dipped 10 um into the plane.
 FIDELITIES: dict[str, MeshSpec] = {
-    "coarse": MeshSpec(n_along=24, n_through=2, along_grading=0.5, through_ratio=1.0),
-    "medium": MeshSpec(n_along=48, n_through=4, along_grading=0.5, through_ratio=1.0),
-    "fine": MeshSpec(n_along=96, n_through=8, along_grading=0.5, through_ratio=1.0),
+    "coarse": MeshSpec(n_along=32, n_through=3, along_grading=-0.5, through_ratio=1.0),
+    "medium": MeshSpec(n_along=64, n_through=6, along_grading=-0.5, through_ratio=1.0),
+    "fine": MeshSpec(n_along=128, n_through=12, along_grading=-0.5, through_ratio=1.0),
 }
 
 

@@ -131,7 +131,8 @@ def half_maximum_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = 
 class Richardson:
     """Richardson extrapolation of a quantity from three meshes with a constant refinement ratio.
 
-    order : observed order p (NaN where the three values do not converge monotonically);
+    order : observed order p (NaN where the three values do not converge monotonically with an
+        order inside `order_range`: not in the asymptotic range, so no extrapolation);
     extrapolated : f_fine + (f_fine - f_medium) / (ratio^p - 1) (f_fine where p is NaN);
     fine_error : |extrapolated - f_fine| (|f_fine - f_medium| where p is NaN), the estimated
         discretisation error of the finest mesh.
@@ -143,17 +144,20 @@ class Richardson:
 
 
 def richardson(f_coarse: np.ndarray, f_medium: np.ndarray, f_fine: np.ndarray,
-               ratio: float = 2.0) -> Richardson:
+               ratio: float = 2.0, order_range: tuple[float, float] = (0.5, 6.0)) -> Richardson:
     """Observed order and extrapolated value from meshes of sizes h, h/ratio, h/ratio^2.
 
     If f_h = f* + C h^p exactly, p = log((f_c - f_m)/(f_m - f_f)) / log(ratio) and f* are
-    recovered to round-off. Works elementwise on arrays (e.g. F0 at common plate displacements).
+    recovered to round-off. An observed order outside `order_range` means the values are not in
+    the asymptotic range (a tiny p extrapolates far beyond the data): such samples are not
+    extrapolated (order NaN, the finest value is the reference). Works elementwise on arrays.
     """
     fc, fm, ff = (np.asarray(f, dtype=float) for f in (f_coarse, f_medium, f_fine))
     d1, d2 = fc - fm, fm - ff
+    q_lo, q_hi = ratio ** order_range[0], ratio ** order_range[1]
     with np.errstate(divide="ignore", invalid="ignore"):
         q = d1 / d2
-        monotone = (q > 1.0) & np.isfinite(q)
+        monotone = (q >= q_lo) & (q <= q_hi) & np.isfinite(q)
         p = np.where(monotone, np.log(np.where(monotone, q, 2.0)) / math.log(ratio), np.nan)
         extrapolated = np.where(monotone, ff - d2 / (q - 1.0), ff)   # ratio^p - 1 = q - 1
     fine_error = np.where(monotone, np.abs(extrapolated - ff), np.abs(d2))

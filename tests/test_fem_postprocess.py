@@ -178,7 +178,9 @@ def test_richardson_recovers_order_and_limit_of_a_power_law():
         assert rich.order == pytest.approx(p, rel=1e-10)
         assert rich.extrapolated == pytest.approx(f_star, rel=1e-10)
         assert rich.fine_error == pytest.approx(abs(c) * 0.1 ** p, rel=1e-8)
-    # oscillating (non-monotone) values: no order, the finest value, its last change as the error
-    rich = richardson(np.array([1.0]), np.array([1.2]), np.array([1.1]))
-    assert np.isnan(rich.order[0]) and rich.extrapolated[0] == 1.1
-    assert rich.fine_error[0] == pytest.approx(0.1)
+    # oscillating (non-monotone) values, or an order so small that the extrapolation would
+    # leave the data far behind: no order, the finest value, its last change as the error
+    for f in ([1.0, 1.2, 1.1], [3.0 + 0.1 ** 0.2, 3.0 + 0.05 ** 0.2, 3.0 + 0.025 ** 0.2]):
+        rich = richardson(*np.array(f)[:, None])
+        assert np.isnan(rich.order[0]) and rich.extrapolated[0] == f[2]
+        assert rich.fine_error[0] == pytest.approx(abs(f[2] - f[1]))
