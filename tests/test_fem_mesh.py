@@ -245,3 +245,13 @@ def test_the_gmsh_drawn_user_design_reads_with_its_physical_curves():
     assert all(len(mesh.boundaries[name]) > 0 for name in BOUNDARY_NAMES)
     r, z = mesh.doflocs[:, boundary_path(mesh, "cavity")]
     assert (r[0], z[0]) == pytest.approx((5 * MM, 7 * MM)) and (r[-1], z[-1]) == pytest.approx((19 * MM, 0.0))
+
+
+def test_user_design_meshed_with_quads_and_with_triangles_gives_the_same_force():
+    # two independent unstructured Gmsh meshes of meshes/user_lip.geo (quad9 and triangle6): the
+    # same F0 at u = 1 mm to well within their discretisation error (< 0.5 %)
+    from fem.cup import compress_cup
+    from fem.material import NeoHookean
+    forces = [compress_cup(read_mesh(REPO / "meshes" / name), NeoHookean(), u_max_m=1e-3).F0_N[-1]
+              for name in ("user_lip.msh", "user_lip_tri.msh")]
+    assert forces[1] == pytest.approx(forces[0], rel=5e-3)
