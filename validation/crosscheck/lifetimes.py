@@ -81,8 +81,10 @@ def run(ctx: Context) -> None:
         ctx.progress(0.0, f"lifetimes {label}")
         try:
             results = [lifetime(model, F) for F in forces]
-        except (ValueError, RuntimeError) as exc:       # e.g. the state leaves the FEM curve
-            rep.text(NAME, f"*{label} failed:* {str(exc).splitlines()[0]}")
+        except (ValueError, RuntimeError, ArithmeticError) as exc:   # e.g. leaves the curve, or l = 0
+            rep.text(NAME, f"*{label} failed:* {type(exc).__name__}: {str(exc).splitlines()[0]}"
+                           + (" (eq 6 with a strip width l = 0 from the FEM curve)"
+                              if isinstance(exc, ZeroDivisionError) else ""))
             continue
         series[label] = results
         table[label] = (largest_holdable_force(model), results)
