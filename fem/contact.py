@@ -17,7 +17,10 @@ dip below the plane; `largest_penetration` reports the largest such violation.
 
 The contact pressure p is the L2 projection, on the deformed contact boundary (weight 2 pi r ds),
 of the nodal reactions: M p = lambda over the facets touching an active node. With the consistent
-boundary mass matrix, int p 2 pi r ds = sum lambda exactly, i.e. the integrated contact force.
+boundary mass matrix, int p 2 pi r ds = sum lambda exactly, i.e. the integrated contact force, and
+its integrals (the strip width) converge; pointwise it oscillates at the contact edge, so the
+pointwise profile is the lumped projection p_a = lambda_a / sum_b M_ab, which is >= 0 and exactly
+0 off contact (for the contact edge and the half-maximum width).
 """
 
 from __future__ import annotations
@@ -62,11 +65,15 @@ class ContactState:
 
 @dataclass(frozen=True)
 class PressureProfile:
-    """Contact pressure along the deformed contact boundary, sorted by radius.
+    """Contact pressure along the deformed contact boundary.
 
-    r_m, p_Pa: deformed radius [m] and projected pressure [Pa] at sample points of the contact
-    facets (for plots and the half-maximum width); r_gauss_m, p_gauss_Pa, w_m2: the same at the
-    boundary Gauss points with weights 2 pi r ds [m^2], so that int g(p) dA = sum g(p_gauss) w.
+    r_m, p_Pa: the nodes of the facets that touch the plane, sorted by deformed radius [m], with
+    the lumped projection p_a = lambda_a / int N_a dA [Pa] (>= 0 by the active-set conditions,
+    0 at the free nodes next to the contact; the pointwise profile, for plots, the contact edge
+    and the half-maximum width). r_gauss_m, p_gauss_Pa, w_m2: the
+    consistent L2 projection at the Gauss points of the contact facets with the weights
+    2 pi r ds [m^2], so that int g(p) dA = sum g(p_gauss) w (for integrals: it oscillates near
+    the contact edge, but its integrals converge in L2).
     """
 
     r_m: np.ndarray
@@ -192,10 +199,10 @@ class RigidPlane:
         z = self._positions(u, self._facet_nodes.ravel())[1].reshape(3, -1)
         return float(max(0.0, -np.min(N.T @ z)))
 
-    def pressure(self, u: np.ndarray, state: ContactState, r_int: np.ndarray,
-                 samples: int = 5) -> tuple[PressureProfile, np.ndarray]:
-        """Project the nodal reactions to a pressure field on the deformed contact facets.
-        Returns the profile and the nodal pressure [Pa] of every mesh node (0 off contact)."""
+    def pressure(self, u: np.ndarray, state: ContactState,
+                 r_int: np.ndarray) -> tuple[PressureProfile, np.ndarray]:
+        """Contact pressure from the nodal reactions (module docstring): the profile, and the
+        lumped nodal pressure [Pa] of every mesh node (0 off contact)."""
         lam_all = np.zeros(self.kin.mesh.doflocs.shape[1])
         lam_all[self.nodes[state.active]] = self.reactions(r_int)[state.active]
         fn = self._facet_nodes
@@ -218,11 +225,9 @@ class RigidPlane:
         M = sp.csr_matrix((Me.ravel(), (rows, cols)), shape=(len(loc), len(loc)))
         p = spla.spsolve(M.tocsc(), lam_all[loc])
         pe = p[inv]                                                   # [3, nf]
-        s = np.linspace(0.0, 1.0, samples)
-        Ns, _ = _shape(s)
-        rs = (Ns.T @ x[0]).T.ravel()                                  # [nf*samples]
-        ps = (Ns.T @ pe).T.ravel()
-        order = np.argsort(rs, kind="stable")
-        p_nodes[loc] = p
-        return (PressureProfile(rs[order], ps[order], xg[0].ravel(), (N.T @ pe).ravel(), w.ravel()),
-                p_nodes)
+        # lumped projection at the nodes: lambda_a / int N_a dA (>= 0, 0 off contact)
+        p_nodes[loc] = lam_all[loc] / np.asarray(M.sum(axis=1)).ravel()
+        r_loc = self._positions(u, loc)[0]
+        order = np.argsort(r_loc, kind="stable")
+        return (PressureProfile(r_loc[order], p_nodes[loc][order], xg[0].ravel(),
+                                (N.T @ pe).ravel(), w.ravel()), p_nodes)

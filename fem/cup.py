@@ -16,9 +16,12 @@ Loading (Sec. 5.3): the plate moves down by u (displacement control), h = h1 - u
 nodes follow it rigidly (u_r = 0, u_z = -u). Every boundary node except those on the plate may
 touch the plane (`fem.contact`); the contact zones are whatever the solution makes them.
 
-The pressure profile p(r) is the projected contact pressure at the boundary nodes, sorted by
-deformed radius (0 at nodes not in contact); r_c, l, l_half_max and V come from the pure functions
-of `fem.postprocess` applied to it and to the deformed cavity path.
+The pressure profile p(r) (`fem.contact.PressureProfile`) holds the lumped nodal pressure of the
+nodes in contact, sorted by deformed radius, and the consistent L2 projection at the boundary
+Gauss points (for integrals). r_c, l_half_max and V come from the pure functions of
+`fem.postprocess`; l uses the same definition as `postprocess.pressure_weighted_width` with the
+integrals over the Gauss points (`contact_width`), because the piecewise-linear nodal profile
+converges much more slowly (a node-spaced peak at the contact edge).
 
 Per converged step, `CupResponse` holds (all SI):
 
@@ -29,9 +32,9 @@ Per converged step, `CupResponse` holds (all SI):
 * ``V_m3``: the cavity volume under the plate and inside the cup down to z = 0 (the region of
   eq. 4), `postprocess.enclosed_volume` of the deformed cavity path down to its first contact;
 * ``l_m``: the pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
-  (`postprocess.pressure_weighted_width`), exactly l for a uniform strip of width l (the paper's
-  eq. 6 picture) and an integral of the pressure, hence mesh-convergent; ``l_half_max_m``: the width
-  at half maximum of the projected pressure (`postprocess.half_maximum_width`);
+  (`contact_width`), exactly l for a uniform strip of width l (the paper's eq. 6 picture) and an
+  integral of the pressure, hence mesh-convergent; ``l_half_max_m``: the width at half maximum
+  of the lumped nodal pressure (`postprocess.half_maximum_width`);
 * ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
   elastic energy), ``newton_iterations``, and the pressure profiles ``pressure[i]``.
 """
@@ -48,14 +51,13 @@ from skfem import Mesh
 
 from .contact import PressureProfile, RigidPlane
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
-from .postprocess import (enclosed_volume, half_maximum_width, inner_contact_radius,
-                          pressure_weighted_width)
+from .postprocess import enclosed_volume, half_maximum_width, inner_contact_radius
 from .forms import Mechanics
 from .kinematics import Kinematics
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["compress_cup", "CupResponse", "cup_height", "REQUIRED_BOUNDARIES"]
+__all__ = ["compress_cup", "CupResponse", "cup_height", "contact_width", "REQUIRED_BOUNDARIES"]
 
 
 
@@ -89,7 +91,7 @@ class CupResponse:
 
     def write_fields(self, path: str | Path, step: int = -1) -> Path:
         """Write displacement, Cauchy stress (element means) and contact pressure of one step as
-        VTU (or any format meshio infers from the suffix, e.g. .xdmf) on the reference mesh."""
+        VTU (or another format meshio infers from the suffix) on the reference mesh."""
         from .fields import write_fields
         return write_fields(self, path, step)
 
@@ -106,7 +108,9 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
                  u_max_m: float | None = None,
                  progress: Callable[[float, str], None] | None = None,
                  **solver_opts: Any) -> CupResponse:
-    """Press the cup from u = 0 to u_max_m (default 0.9 h1) and return its `CupResponse`.
+    """Press the cup from u = 0 to u_max_m (default 0.9 h1, at most h1: there the plate's edge
+    reaches the plane; the steep rise of F0 where the wall is squeezed flat lies just below it)
+    and return its `CupResponse`.
 
     solver_opts: fields of `fem.solver.SolverOptions` (rtol, etol, max_iterations, initial_step,
     max_step, min_step, growth). Raises ValueError for bad input, `fem.solver.ConvergenceError`
@@ -118,9 +122,10 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     if not isinstance(material, NeoHookean):
         raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
     u_max = 0.9 * h1 if u_max_m is None else float(u_max_m)
-    if not (0.0 < u_max <= 1.25 * h1):
-        raise ValueError(f"u_max_m: plate displacement must be in (0, 1.25 h1] = (0, "
-                         f"{1.25 * h1 * 1e3:.4g} mm], got {u_max * 1e3:.4g} mm")
+    if not (0.0 < u_max <= h1):
+        raise ValueError(f"u_max_m: plate displacement must be in (0, h1] = (0, "
+                         f"{h1 * 1e3:.4g} mm] (at u = h1 the plate reaches the plane), "
+                         f"got {u_max * 1e3:.4g} mm")
     options = SolverOptions(**solver_opts)
 
     kin = Kinematics.of(mesh)
@@ -133,54 +138,62 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     def dirichlet(u):
         return top_dofs, np.concatenate([np.zeros(len(top)), np.full(len(top), -u)])
 
-    rec: dict[str, list] = {k: [] for k in (
-        "u", "F0", "Fc", "rc", "V", "l", "lhm", "pen", "W", "its", "p", "disp", "pn")}
+    steps: list[dict[str, Any]] = []
 
     def on_step(s: StepResult) -> None:
-        prof, p_nodes = plane.pressure(s.u, s.contact, s.r_int)
-        Fc = float(np.sum(prof.p_gauss_Pa * prof.w_m2))
-        active = plane.nodes[s.contact.active]
-        x = kin.node_coordinates() + np.stack([s.u[0::2], s.u[1::2]])
-        on_path = np.isin(path, active)
-        on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
-        V = enclosed_volume(x[0, path], x[1, path], on_path)
-        r_c, l, l_hm = _strip(x[0, active], p_nodes[active]) if active.size else (x[0, path[-1]], 0.0, 0.0)
-        rec["u"].append(s.t)
-        rec["F0"].append(-float(np.sum(s.r_int[2 * top + 1])))
-        rec["Fc"].append(Fc)
-        rec["rc"].append(r_c)
-        rec["V"].append(V)
-        rec["l"].append(l)
-        rec["lhm"].append(l_hm)
-        rec["pen"].append(plane.largest_penetration(s.u))
-        rec["W"].append(mech.energy(s.u))
-        rec["its"].append(s.iterations)
-        rec["p"].append(prof)
-        rec["disp"].append(s.u)
-        rec["pn"].append(p_nodes)
+        steps.append(_measure(s, mech, plane, top, path))
 
     stats = follow_path(mech, dirichlet, u_max, plane=plane, options=options, on_step=on_step,
-                        progress=progress)
-    a = {k: np.asarray(v) for k, v in rec.items() if k not in ("p", "disp", "pn")}
+                        progress=progress, name="u [m]")
+    col = lambda k: np.array([st[k] for st in steps])       # noqa: E731
     return CupResponse(
-        h1_m=h1, contact=contact, material=material, u_m=a["u"], F0_N=a["F0"],
-        F0_contact_N=a["Fc"], r_c_m=a["rc"], V_m3=a["V"], l_m=a["l"], l_half_max_m=a["lhm"],
-        penetration_m=a["pen"], energy_J=a["W"], newton_iterations=a["its"].astype(int),
-        pressure=tuple(rec["p"]), stats=stats, mesh=mesh, displacements=tuple(rec["disp"]),
-        nodal_pressure_Pa=tuple(rec["pn"]))
+        h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
+        F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l"),
+        l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
+        newton_iterations=col("its").astype(int), pressure=tuple(st["p"] for st in steps),
+        stats=stats,
+        mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
+        nodal_pressure_Pa=tuple(st["p_nodes"] for st in steps))
 
 
-def _strip(r: np.ndarray, p: np.ndarray) -> tuple[float, float, float]:
-    """(r_c, l, l_half_max) of the nodal pressure of the nodes in contact, sorted by radius; with
-    fewer than two loaded nodes (the rim corner alone) r_c is that node's radius and l = 0."""
-    order = np.argsort(r)
-    r, p = r[order], np.maximum(p[order], 0.0)
-    keep = np.concatenate([[True], np.diff(r) > 0])
+def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
+             path: np.ndarray) -> dict[str, Any]:
+    """The per-step outputs of a converged state (module docstring)."""
+    prof, p_nodes = plane.pressure(s.u, s.contact, s.r_int)
+    active = plane.nodes[s.contact.active]
+    x = mech.kin.node_coordinates() + np.stack([s.u[0::2], s.u[1::2]])
+    on_path = np.isin(path, active)
+    on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
+    r_c, l_hm = _edge_and_half_width(prof, x[0, path[-1]])
+    return {"u": s.t, "F0": -float(np.sum(s.r_int[2 * top + 1])),
+            "Fc": float(np.sum(prof.p_gauss_Pa * prof.w_m2)), "r_c": r_c,
+            "V": enclosed_volume(x[0, path], x[1, path], on_path),
+            "l": contact_width(prof, r_c), "l_hm": l_hm,
+            "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations,
+            "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
+
+
+def contact_width(profile: PressureProfile, r_c_m: float) -> float:
+    """Pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA) [m], dA = 2 pi r dr
+    (the definition of `postprocess.pressure_weighted_width`), with the integrals taken over the
+    consistent L2 projection at the boundary Gauss points (0 without contact)."""
+    if profile.w_m2.size == 0:
+        return 0.0
+    P1 = np.sum(profile.p_gauss_Pa * profile.w_m2)
+    P2 = np.sum(profile.p_gauss_Pa**2 * profile.w_m2)
+    return float(P1**2 / (2.0 * np.pi * r_c_m * P2)) if P2 > 0 else 0.0
+
+
+def _edge_and_half_width(profile: PressureProfile, r_rim: float) -> tuple[float, float]:
+    """(r_c, l_half_max) from the lumped nodal profile; with fewer than two loaded nodes (the
+    rim corner alone, or no contact at u = 0) r_c is that node's (or the rim's) radius, l = 0."""
+    r, p = profile.r_m, profile.p_Pa
+    keep = np.concatenate([[True], np.diff(r) > 0]) if r.size else np.zeros(0, bool)
     r, p = r[keep], p[keep]
-    if r.size < 2 or np.count_nonzero(p > 0) < 2:
-        return float(r[np.argmax(p)] if np.any(p > 0) else r[0]), 0.0, 0.0
+    if np.count_nonzero(p > 0) < 2:
+        return (float(r[np.argmax(p)]) if r.size else float(r_rim)), 0.0
     r_c = inner_contact_radius(r, p)
-    return r_c, pressure_weighted_width(r, p, r_c), half_maximum_width(r, p, r_c)
+    return r_c, half_maximum_width(r, p, r_c)
 
 
 def _check_mesh(mesh: Mesh) -> None:

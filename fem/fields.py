@@ -39,7 +39,8 @@ def element_cauchy_stress(mech: Mechanics, u: np.ndarray) -> np.ndarray:
 
 
 def write_fields(resp: "CupResponse", path: str | Path, step: int = -1) -> Path:
-    """Write one step of `resp` to `path` (format from the suffix: .vtu, .xdmf, ...), atomically."""
+    """Write one step of `resp` to `path` (format from the suffix: .vtu, or any other meshio
+    format; meshio's XDMF writer needs h5py, which cupcheck does not depend on), atomically."""
     path = Path(path)
     n_steps = len(resp.u_m)
     if not -n_steps <= step < n_steps:

@@ -24,14 +24,14 @@ with G_a[v] = int q_a dJ[v] dV, M_ab = int q_a q_b dV, D_ab = int U''(Theta) q_a
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
 from skfem import BilinearForm, LinearForm, MeshQuad2
 
-from .kinematics import IDENTITY, Kinematics
+from .kinematics import Kinematics
 from .material import NeoHookean, jacobian, jacobian_gradient, jacobian_hessian
 
 __all__ = ["Mechanics", "internal_force_form", "tangent_form", "energy_form"]
@@ -97,7 +97,6 @@ class Mechanics:
 
     kin: Kinematics
     material: NeoHookean
-    _cache: dict = field(default_factory=dict, repr=False)
 
     # --- sparsity pattern, computed once ---------------------------------------------------
     @cached_property

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse.linalg as spla
@@ -94,9 +94,11 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
                 f_ext: Callable[[float], np.ndarray] | None = None,
                 options: SolverOptions = SolverOptions(),
                 on_step: Callable[[StepResult], None] | None = None,
-                progress: Callable[[float, str], None] | None = None) -> SolverStats:
+                progress: Callable[[float, str], None] | None = None,
+                name: str = "t") -> SolverStats:
     """Follow the equilibrium path from t = 0 to t_max; call `on_step` for every converged step
-    (including t = 0). Raises `ConvergenceError` if a step cannot be converged."""
+    (including t = 0). `name` names t in messages (e.g. "u [m]"). Raises `ConvergenceError` if
+    a step cannot be converged."""
     start = time.perf_counter()
     n = mech.kin.ndofs
     f_ext = f_ext or (lambda t: np.zeros(n))
@@ -121,8 +123,9 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             dt *= 0.5
             if dt < options.min_step * t_max:
                 raise ConvergenceError(
-                    f"load step {steps + 1} from t = {t:.6g} to {t1:.6g} did not converge "
-                    f"(after {cutbacks} cut-backs, step < min_step = {options.min_step:g} t_max): "
+                    f"load step {steps + 1} from {name} = {t:.6g} to {t1:.6g} did not converge "
+                    f"(step halved below min_step = {options.min_step:g} of the range; "
+                    f"{cutbacks} cut-backs in this run): "
                     f"{fail.cause}; residual history {', '.join(f'{h:.3e}' for h in fail.history)}"
                 ) from None
             continue
@@ -132,7 +135,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         if on_step:
             on_step(StepResult(t, u1, r1, state1, its))
         if progress:
-            progress(t / t_max, f"step {steps}: t = {t:.4g}, {its} Newton iterations")
+            progress(t / t_max, f"step {steps}: {name} = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:
             dt = min(dt * options.growth, options.max_step * t_max)
     return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n))
