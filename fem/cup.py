@@ -34,7 +34,10 @@ Per converged step, `CupResponse` holds (all SI):
 * ``l_m``: the pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
   (`contact_width`), exactly l for a uniform strip of width l (the paper's eq. 6 picture) and an
   integral of the pressure, hence mesh-convergent; ``l_half_max_m``: the width at half maximum
-  of the lumped nodal pressure (`postprocess.half_maximum_width`);
+  of the lumped nodal pressure (`postprocess.half_maximum_width`); ``l_median_m``: twice the
+  distance from r_c within which half of the radial line force int p dr acts
+  (`postprocess.median_force_width`: exact for a uniform strip, and, resting on a cumulative
+  integral of p alone, insensitive to the singular pressure at a sharp rim corner);
 * ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
   elastic energy), ``newton_iterations``, and the pressure profiles ``pressure[i]``.
 """
@@ -51,7 +54,7 @@ from skfem import Mesh
 
 from .contact import PressureProfile, RigidPlane
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
-from .postprocess import enclosed_volume, half_maximum_width, inner_contact_radius
+from .postprocess import enclosed_volume, half_maximum_width, inner_contact_radius, median_force_width
 from .forms import Mechanics
 from .kinematics import Kinematics
 from .material import NeoHookean
@@ -75,6 +78,7 @@ class CupResponse:
     V_m3: np.ndarray
     l_m: np.ndarray
     l_half_max_m: np.ndarray
+    l_median_m: np.ndarray
     penetration_m: np.ndarray
     energy_J: np.ndarray
     newton_iterations: np.ndarray
@@ -149,7 +153,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     return CupResponse(
         h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
         F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l"),
-        l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
+        l_half_max_m=col("l_hm"), l_median_m=col("l_med"), penetration_m=col("pen"), energy_J=col("W"),
         newton_iterations=col("its").astype(int), pressure=tuple(st["p"] for st in steps),
         stats=stats,
         mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
@@ -164,11 +168,11 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
     x = mech.kin.node_coordinates() + np.stack([s.u[0::2], s.u[1::2]])
     on_path = np.isin(path, active)
     on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
-    r_c, l_hm = _edge_and_half_width(prof, x[0, path[-1]])
+    r_c, l_hm, l_med = _edge_and_widths(prof, x[0, path[-1]])
     return {"u": s.t, "F0": -float(np.sum(s.r_int[2 * top + 1])),
             "Fc": float(np.sum(prof.p_gauss_Pa * prof.w_m2)), "r_c": r_c,
             "V": enclosed_volume(x[0, path], x[1, path], on_path),
-            "l": contact_width(prof, r_c), "l_hm": l_hm,
+            "l": contact_width(prof, r_c), "l_hm": l_hm, "l_med": l_med,
             "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations,
             "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
 
@@ -184,16 +188,16 @@ def contact_width(profile: PressureProfile, r_c_m: float) -> float:
     return float(P1**2 / (2.0 * np.pi * r_c_m * P2)) if P2 > 0 else 0.0
 
 
-def _edge_and_half_width(profile: PressureProfile, r_rim: float) -> tuple[float, float]:
-    """(r_c, l_half_max) from the lumped nodal profile; with fewer than two loaded nodes (the
-    rim corner alone, or no contact at u = 0) r_c is that node's (or the rim's) radius, l = 0."""
+def _edge_and_widths(profile: PressureProfile, r_rim: float) -> tuple[float, float, float]:
+    """(r_c, l_half_max, l_median) from the lumped nodal profile; with fewer than two loaded nodes
+    (the rim corner alone, or no contact at u = 0) r_c is that node's (or the rim's) radius, l = 0."""
     r, p = profile.r_m, profile.p_Pa
     keep = np.concatenate([[True], np.diff(r) > 0]) if r.size else np.zeros(0, bool)
     r, p = r[keep], p[keep]
     if np.count_nonzero(p > 0) < 2:
-        return (float(r[np.argmax(p)]) if r.size else float(r_rim)), 0.0
+        return (float(r[np.argmax(p)]) if r.size else float(r_rim)), 0.0, 0.0
     r_c = inner_contact_radius(r, p)
-    return r_c, half_maximum_width(r, p, r_c)
+    return r_c, half_maximum_width(r, p, r_c), median_force_width(r, p, r_c)
 
 
 def _check_mesh(mesh: Mesh) -> None:

@@ -127,6 +127,39 @@ def half_maximum_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = 
     return float(right - max(left, r_c))
 
 
+def median_force_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = None) -> float:
+    """Median-force strip width l_m = 2 (r_half - r_c) [m].
+
+    r_half is where the radial line force int_{r_c}^{r} p dr (trapezoid rule on the samples) reaches
+    half of its total: half the load of the strip acts within l_m / 2 of its inner edge. For the
+    paper's uniform strip (eq. 6) it is exactly l; for a triangle falling from the edge to zero
+    over w it is (2 - sqrt 2) w. It rests on a cumulative integral of p only, so a concentrated
+    (even singular) pressure, e.g. at a sharp rim corner, moves it by what it carries and no more:
+    unlike int p^2 in `pressure_weighted_width`, it converges with the mesh. `r_c_m` defaults to
+    `inner_contact_radius`.
+    """
+    r, p = _profile(r_m, p_Pa, increasing=True)
+    if not np.any(p > 0):
+        raise ValueError("p_Pa: no positive contact pressure, the strip width is undefined")
+    r_c = inner_contact_radius(r, p) if r_c_m is None else float(r_c_m)
+    p = np.where(r >= r_c, np.clip(p, 0.0, None), 0.0)
+    cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(r))])
+    half = 0.5 * cumulative[-1]
+    i = int(np.searchsorted(cumulative, half))          # first sample at or past half the load
+    r_half = r[i] if cumulative[i] == half else _crossing_cumulative(r[i - 1], r[i], p[i - 1], p[i],
+                                                                      half - cumulative[i - 1])
+    return float(2.0 * (r_half - r_c))
+
+
+def _crossing_cumulative(r0: float, r1: float, p0: float, p1: float, target: float) -> float:
+    """The x in [r0, r1] where the integral of the linear p from r0 reaches `target`."""
+    h = r1 - r0
+    a, b = 0.5 * (p1 - p0) / h, p0            # int_0^x (p0 + (p1-p0) s/h) ds = b x + a x^2
+    if abs(a) * h < 1e-12 * max(abs(b), 1e-300):
+        return r0 + target / b
+    return r0 + (-b + math.sqrt(max(b * b + 4 * a * target, 0.0))) / (2 * a)
+
+
 @dataclass(frozen=True)
 class Richardson:
     """Richardson extrapolation of a quantity from three meshes with a constant refinement ratio.

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
+import secrets
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -172,9 +172,10 @@ class StiffnessCurve:
         table = np.column_stack(list(cols.values()))
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        # a unique sibling name, created with the normal (umask) permissions, unlike mkstemp's 0600
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
         try:
-            with os.fdopen(fd, "w") as f:
+            with open(tmp, "x") as f:
                 f.write(f"{_PROVENANCE_TAG} {json.dumps(self.provenance, sort_keys=True, default=str)}\n")
                 f.write(",".join(cols) + "\n")
                 np.savetxt(f, table, delimiter=",", fmt="%.10g")

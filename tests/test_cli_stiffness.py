@@ -62,6 +62,7 @@ def test_user_mesh_and_geometry_file(tmp_path):
     (["--E-MPa", "-4"], "E_MPa"),
     (["--nu", "0.5"], "nu"),
     (["--u-max-mm", "50"], "u_max_mm"),
+    (["--u-max-mm", "9.2"], "u_max_mm"),          # just beyond h1 = 9.09 mm of cup A
     (["--u-max-mm", "0"], "u_max_mm"),
     (["--geometry", "missing.toml"], "geometry"),
     (["--mesh", "missing.msh"], "mesh"),

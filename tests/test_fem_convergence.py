@@ -72,29 +72,25 @@ def test_f0_converges_and_the_coarse_default_is_within_one_percent(study):
     # finest level's estimated error is small against F0
     assert np.nanmedian(order) > 1.0
     assert np.max(rich["F0"].fine_error / rich["F0"].extrapolated) < 0.01
-    # the medium level within 1 % of the converged F0 up to 0.8 h1
-    medium_error = np.abs(runs[1]["F0"] / rich["F0"].extrapolated - 1)
-    assert np.max(medium_error[U_F0 <= 0.8 + 1e-9]) < 0.01
-    # the coarse default within 1 % where the curve is smooth (before touchdown, and from 0.35 to
-    # 0.8 h1); near touchdown (0.25-0.3 h1) the coarse wall touches down at a slightly different u
-    # (1.5 % measured, while the reference there is itself uncertain by ~0.6 %), and at the steep
-    # end, where F0 doubles between 0.8 and 0.9 h1, it is 3.4 % off: regression bounds 2 % and 5 %
-    smooth = (U_F0 <= 0.2 + 1e-9) | ((U_F0 >= 0.35 - 1e-9) & (U_F0 <= 0.8 + 1e-9))
-    assert np.max(coarse_error[smooth]) < 0.01
-    assert np.max(coarse_error[U_F0 <= 0.8 + 1e-9]) < 0.02
+    # the coarse default within 1 % of the converged F0 up to 0.8 h1 (0.86 % measured, near 0.8 h1);
+    # at the steep end, where F0 doubles between 0.8 and 0.9 h1, 3.1 % measured: bound 5 %
+    assert np.max(coarse_error[U_F0 <= 0.8 + 1e-9]) < 0.01
     assert coarse_error[-1] < 0.05
+    medium_error = np.abs(runs[1]["F0"] / rich["F0"].extrapolated - 1)
+    assert np.max(medium_error) < 0.015       # 1.1 % measured at 0.9 h1, <= 0.4 % below 0.8 h1
 
 
 @pytest.mark.slow
 def test_contact_radius_converges(study):
     _, rich = study
-    assert np.max(rich["r_c"].fine_error / rich["r_c"].extrapolated) < 0.03
+    # fine level within 0.8 % of the extrapolated r_c (measured); node spacing there ~0.2 mm
+    assert np.max(rich["r_c"].fine_error / rich["r_c"].extrapolated) < 0.02
 
 
 @pytest.mark.slow
 @pytest.mark.xfail(reason="the pressure-weighted width includes the rim-corner contact and the "
-                          "low-pressure tail of the projected pressure; it is not yet within 2 % "
-                          "on the fine mesh (see the benchmark)", strict=False)
+                          "low-pressure tail of the projected pressure; the three levels do not "
+                          "converge monotonically (see the benchmark)", strict=False)
 def test_strip_width_converges_within_two_percent(study):
     _, rich = study
     assert np.max(rich["l"].fine_error / rich["l"].extrapolated) < 0.02

@@ -8,7 +8,7 @@ from scipy.integrate import quad
 
 from fem.geometry import cup_geometry
 from fem.mesh import boundary_path, cup_mesh
-from fem.postprocess import (contact_force, enclosed_volume, half_maximum_width,
+from fem.postprocess import (contact_force, enclosed_volume, half_maximum_width, median_force_width,
                              inner_contact_radius, pressure_weighted_width)
 
 MM = 1e-3
@@ -184,3 +184,30 @@ def test_richardson_recovers_order_and_limit_of_a_power_law():
         rich = richardson(*np.array(f)[:, None])
         assert np.isnan(rich.order[0]) and rich.extrapolated[0] == f[2]
         assert rich.fine_error[0] == pytest.approx(abs(f[2] - f[1]))
+
+
+def test_median_force_width_uniform_strip_is_exact():
+    # samples on the strip's edges: the trapezoid rule is exact
+    r = np.array([10e-3, 10.5e-3, 10.5e-3 + 1e-12, 11.7e-3 - 1e-12, 11.7e-3, 12e-3])
+    p = np.array([0.0, 0.0, 3e4, 3e4, 0.0, 0.0])
+    assert median_force_width(r, p, r_c_m=10.5e-3) == pytest.approx(1.2e-3, rel=1e-6)
+
+
+def test_median_force_width_triangle_closed_form():
+    # p falls linearly from p0 at r_c to 0 at r_c + w: half the area within w (1 - 1/sqrt 2)
+    r_c, w = 8e-3, 2e-3
+    r = np.linspace(r_c, r_c + w, 9)          # trapezoid rule is exact for the linear profile
+    p = 5e4 * (1 - (r - r_c) / w)
+    assert median_force_width(r, p, r_c) == pytest.approx((2 - np.sqrt(2)) * w, rel=1e-12)
+
+
+def test_median_force_width_is_bounded_by_a_concentrated_rim_force():
+    # a uniform strip plus a spike at the far end that carries 10 % of the load: the median
+    # moves by what the spike carries (a finite shift), it does not blow up as the spike narrows
+    r_c, l = 10e-3, 1e-3
+    for spike in (1e-4, 1e-5, 1e-6):
+        r = np.concatenate([np.linspace(r_c, r_c + l, 201), [r_c + l + spike / 2, r_c + l + spike]])
+        p = np.concatenate([np.full(201, 1.0), [0.1 * l / (spike / 2), 0.0]])
+        # half of 1.1 l of load lies at 0.55 l from the edge: l_m -> 1.1 l as the spike narrows,
+        # off by no more than the spike's own width (where its load sits), however high it is
+        assert abs(median_force_width(r, p, r_c) - 1.1 * l) <= 1.5 * spike
