@@ -1,21 +1,32 @@
-"""The end-to-end example: cup A lifetime against the pull force F1 = 5, 10, ..., 80 N.
+"""The main job, end to end: cup A's FEM stiffness -> the reduced model on a calibrated rough surface ->
+the lifetime against the pull force F1 = 5, 10, ..., 80 N.
 
-Reference mode (Appendix A stiffness, E = 4 MPa, no relaxation, air at 293.15 K, p_a = 1e5 Pa)
-with the ILLUSTRATIVE u_c table of reduced/data (a power law through the paper's 0.68 um at
-p/E = 0.025; a stand-in until rough-contact tables exist). Writes to DIR:
+1. FEM (fem.cup.compress_cup): cup A of Table 1 / Sec. 5.5 (alpha 33 deg, wall 2.5 -> 0.3 mm at
+   r = 5 -> 20 mm), compressible neo-Hookean E = 4 MPa, nu = 0.49, pressed onto the plane to 0.9 h1
+   at the default mesh level (coarse), sticking contact by default (Appendix A's no-slip assumption;
+   `cupcheck validate` shows the frictionless curve is ~6x softer at small u).
+2. Rough contact: u_c(p/E) of the calibrated sandblasted PMMA, 1.89 um rms (`pmma-1.89`, Persson
+   theory, EMT, nu = 0.5), the surface of the paper's Figs. for cup A.
+3. Reduced model (Sec. 3-4) in reference conventions (no relaxation, E = 4 MPa in p/E, air at
+   293.15 K, p_a = 1e5 Pa) with F0(h) from step 1 and r, V, l from the cone laws (3)-(5) with
+   Table 1's l0, l1 (--geometry curve takes them from the FEM instead).
+
+Writes to DIR, atomically:
 
   lifetime_vs_force.csv   force_N, lifetime_s, reason, ballistic_share, r_final_mm, p_b_final_Pa
-  lifetime_vs_force.png   the lifetime against F1, and r(t), p_b(t) for every force (cf. Fig. 1time.2r)
+  lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
+  stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import time
 from pathlib import Path
 
 NAME = "example"
-HELP = "cup A lifetime against pull force (reference mode, illustrative u_c): CSV and PNG"
+HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"
 
 FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 
@@ -23,15 +34,52 @@ FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (written atomically)")
     p.add_argument("--cup", default="A", metavar="A|B", help="Table 1 cup preset (default: A)")
-    p.add_argument("--uc-table", default=None, metavar="FILE.csv",
-                   help="critical gap table, columns p_over_E,u_c_m (u_c in m) "
-                        "(default: the illustrative table)")
+    p.add_argument("--contact", default="sticking", choices=("sticking", "frictionless"),
+                   help="FEM contact with the substrate (default: sticking, Appendix A's no slip)")
+    p.add_argument("--fidelity", default="coarse", choices=("coarse", "medium", "fine"),
+                   help="FEM mesh level (default: coarse; see `cupcheck validate` for its error)")
+    p.add_argument("--geometry", default="cone", choices=("cone", "curve"),
+                   help="r, V, l from the cone laws eqs 3-5 (default) or from the FEM curve")
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--surface", default=None, metavar="NAME",
+                     help="calibrated surface preset for u_c(p/E) (default: pmma-1.89)")
+    src.add_argument("--uc-table", default=None, metavar="FILE.csv",
+                     help="critical gap table instead, columns p_over_E,u_c_m (u_c in m)")
 
 
-def lifetime_vs_force(model, forces_N=FORCES_N, progress=None):
-    """The lifetime sweep of the example: a list of `LifetimeResult`, one per force."""
-    from reduced.lifetime import lifetime_sweep
-    return lifetime_sweep(model, forces_N, progress=progress, refine=8)
+def _inputs(args: argparse.Namespace):
+    """Every check before the solve: (cup parameters, u_c table, its label)."""
+    import os
+
+    from reduced.cup import cup_by_name
+
+    cup = cup_by_name(args.cup)
+    if args.uc_table is not None:
+        if not os.path.isfile(args.uc_table):
+            raise ValueError(f"uc-table: no such file {args.uc_table!r}")
+        from reduced.critical_gap import UcTable
+        return cup, UcTable.from_csv(args.uc_table), Path(args.uc_table).name
+    from reduced.roughness import uc_table
+    from reduced.roughness.surfaces import preset
+    name = args.surface or "pmma-1.89"
+    return cup, uc_table(preset(name).spectrum(), 0.5), name
+
+
+def fem_stiffness(cup_name: str, contact: str, fidelity: str, progress=None):
+    """(CupResponse, StiffnessCurve) of the preset cup: the FEM step of the main job."""
+    from fem.cup import compress_cup
+    from fem.geometry import cup_geometry
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh, mesh_spec
+    from validation import handoff
+
+    geometry = cup_geometry(cup_name)
+    mesh = cup_mesh(geometry, fidelity)
+    response = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact=contact,
+                            u_max_m=0.9 * geometry.h1_m, progress=progress)
+    prov = handoff.provenance(response, geometry=geometry.describe(),
+                              mesh={"fidelity": fidelity, **vars(mesh_spec(fidelity))}, fidelity=fidelity)
+    return response, handoff.stiffness_curve(response, prov)
 
 
 def write_table(results, path: Path) -> None:
@@ -45,45 +93,58 @@ def write_table(results, path: Path) -> None:
                     f"{s['r_final_mm']:.6f},{s['p_b_final_Pa']:.6g}\n")
 
 
-def plot(results, path: Path, title: str) -> None:
+def plot(results, baseline, curve, path: Path, title: str) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(1, 3, figsize=(13, 4), constrained_layout=True)
-    finite = [r for r in results if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
-    ax[0].semilogy([r.force_N for r in finite], [r.lifetime_s for r in finite], "o-")
+    from reduced.appendix_a import appendix_a_force
+
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4), constrained_layout=True)
+    for res, label, style in ((results, "FEM-fed", "o-"), (baseline, "Appendix A-fed (d0 2 mm)", "s--")):
+        pts = [(r.force_N, r.lifetime_s) for r in res if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
+        if pts:
+            ax[0].semilogy(*zip(*pts), style, label=label)
     ax[0].set(xlabel="pull force $F_1$ (N)", ylabel="lifetime (s)", title=title)
-    cmap = plt.get_cmap("viridis")
-    for i, r in enumerate(results):
-        c = cmap(i / max(len(results) - 1, 1))
-        ax[1].plot(r.t_s, 1e3 * r.r_m, color=c)
-        ax[2].plot(r.t_s, 1e-3 * r.p_b_Pa, color=c, label=f"{r.force_N:g} N" if i % 3 == 0 else None)
-    ax[1].set(xlabel="time (s)", ylabel="inner contact radius r (mm)")
-    ax[2].set(xlabel="time (s)", ylabel="cavity pressure $p_b$ (kPa)")
-    ax[2].legend(fontsize=7)
-    fig.savefig(path, dpi=120)
+    ax[0].legend(fontsize=8)
+    u = curve.u_m
+    ax[1].plot(1e3 * u, curve.F0_N, label="FEM")
+    alpha = curve.provenance.get("geometry", {}).get("alpha_deg", 33.0)
+    ax[1].plot(1e3 * u, appendix_a_force(u, alpha, 4e6, 2e-3, 5e-3, 19e-3), "--", label="Appendix A")
+    ax[1].set(xlabel="plate displacement u (mm)", ylabel="stiffness force $F_0$ (N)")
+    ax[1].legend(fontsize=8)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
 def run(args: argparse.Namespace) -> int:
-    from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
-    from reduced.cup import cup_by_name
-    from reduced.lifetime import reference_model
-    from validation.output import atomic_directory
+    from dataclasses import replace
 
-    cup = cup_by_name(args.cup)
-    uc = UcTable.from_csv(args.uc_table or ILLUSTRATIVE_UC_CSV)
-    model = reference_model(cup, uc)
+    from reduced.lifetime import lifetime_sweep, reference_model
+    from validation import handoff
+    from validation.output import atomic_directory, terminal_progress
+
+    t0 = time.perf_counter()
+    cup, uc, uc_label = _inputs(args)
     with atomic_directory(args.out) as tmp:
-        results = lifetime_vs_force(model)
+        response, curve = fem_stiffness(cup.name, args.contact, args.fidelity, terminal_progress("FEM"))
+        curve.to_csv(tmp / "stiffness_fem.csv")
+        handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
+        base = reference_model(cup, uc)
+        model = replace(base, stiffness=curve, geometry=args.geometry, label="FEM-fed")
+        results = lifetime_sweep(model, FORCES_N, progress=terminal_progress("lifetime"), refine=4)
+        baseline = lifetime_sweep(base, FORCES_N, refine=1)
         write_table(results, tmp / "lifetime_vs_force.csv")
-        label = "illustrative u_c" if args.uc_table is None else Path(args.uc_table).name
-        plot(results, tmp / "lifetime_vs_force.png", f"cup {cup.name}, reference mode, {label}")
-    print(f"cup {cup.name} lifetime vs pull force (reference mode, "
-          f"{'ILLUSTRATIVE u_c table' if args.uc_table is None else args.uc_table}):")
-    for r in results:
-        life = f"{r.lifetime_s:.4g} s" if math.isfinite(r.lifetime_s) else "inf"
-        print(f"  F1 = {r.force_N:4g} N: {life:>10} ({r.reason})")
-    print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'} and lifetime_vs_force.png")
+        plot(results, baseline, curve, tmp / "lifetime_vs_force.png",
+             f"cup {cup.name}, FEM {args.contact} ({args.fidelity}), {uc_label}")
+    wall = time.perf_counter() - t0
+    slope = float(curve.force(curve.h1_m - 1e-3))
+    print(f"cup {cup.name}: FEM {args.contact} stiffness ({args.fidelity}, {response.stats.steps} steps), "
+          f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
+          f"r, V, l from the {'cone laws (3)-(5)' if args.geometry == 'cone' else 'FEM curve'}")
+    print(f"  {'F1 (N)':>7} {'lifetime (s)':>13} {'Appendix A-fed (s)':>19}  end")
+    for r, b in zip(results, baseline):
+        print(f"  {r.force_N:7g} {r.lifetime_s:13.4g} {b.lifetime_s:19.4g}  {r.reason}")
+    print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv "
+          f"in {wall:.1f} s")
     return 0

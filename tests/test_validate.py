@@ -1,0 +1,132 @@
+"""`cupcheck validate`: the run memo, the quick report end to end, the E scaling, bad input."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from validation.cli import main
+from validation.crosscheck import FemRun, RunMemo, planned_requests, section_names
+from validation.crosscheck.runs import FemResult
+
+
+# ----------------------------------------------------------------------------- the memo
+def _fake_runner(calls):
+    def run(request: FemRun):
+        calls.append(request)
+        if request.alpha_deg == 89.0:
+            raise RuntimeError("no convergence (fake)")
+        u = np.linspace(0, 1e-3, 3)
+        z = np.zeros(3)
+        return FemResult(request=request, h1_m=1e-2, u_m=u, F0_N=u * request.E_Pa, F0_contact_N=u,
+                         r_c_m=z, l_m=z, V_m3=z, energy_J=z, penetration_m=z, wall_s=0.0, steps=2,
+                         newton_iterations=4, dofs=10, outline_r_m=z, outline_z_m=z, outline_p_Pa=z)
+    return run
+
+
+def test_memo_computes_each_request_once():
+    calls = []
+    memo = RunMemo(runner=_fake_runner(calls))
+    a, a_again, b = FemRun(), FemRun(), FemRun(contact="sticking")
+    first = memo.get(a)
+    assert memo.get(a_again) is first and memo.get(b) is not first
+    assert calls == [a, b] and memo.computed == 2
+    bad = FemRun(alpha_deg=89.0)
+    for _ in range(3):                     # a failure is stored and re-raised, never recomputed
+        with pytest.raises(RuntimeError, match="fake"):
+            memo.get(bad)
+    assert calls.count(bad) == 1 and isinstance(memo.outcome(bad), RuntimeError)
+
+
+def test_disk_cache_survives_a_new_memo(tmp_path):
+    calls = []
+    RunMemo(cache_dir=tmp_path, runner=_fake_runner(calls)).get(FemRun(E_Pa=2e6))
+    memo = RunMemo(cache_dir=tmp_path, runner=_fake_runner(calls))
+    res = memo.get(FemRun(E_Pa=2e6))
+    assert len(calls) == 1 and memo.computed == 0 and memo.cache_hits == 1
+    assert res.F0_N[-1] == pytest.approx(2e6 * 1e-3)
+
+
+def test_sections_share_runs_and_subsets_plan_less():
+    quick_all = planned_requests(True)
+    assert len(set(quick_all)) == len(quick_all)
+    # sections 1-4 need the same two cup A runs: planned once
+    shared = planned_requests(True, ["appendix", "cone_laws", "lifetimes", "speed"])
+    assert set(shared) == {FemRun(contact="frictionless"), FemRun(contact="sticking")}
+    assert len(planned_requests(False)) > len(quick_all) > len(planned_requests(True, ["lifetimes"]))
+
+
+# ------------------------------------------------------------------- quick end to end
+@pytest.fixture(scope="module")
+def quick_report(tmp_path_factory):
+    out = tmp_path_factory.mktemp("v") / "report"
+    code = main(["validate", "--quick", "--out", str(out)])
+    assert code == 0
+    return out
+
+
+def test_quick_report_files_and_keys(quick_report):
+    names = {p.name for p in quick_report.iterdir()}
+    for stem in ("appendix_a_ratio", "cone_laws_deviation", "lifetime_by_stiffness_source",
+                 "speed_accuracy_fem_sticking", "speed_accuracy_reduced", "extremes_outcomes"):
+        assert f"{stem}.csv" in names
+    for png in ("appendix_a_ratio.png", "cone_laws.png", "lifetime_by_stiffness_source.png", "pareto.png"):
+        assert (quick_report / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    text = (quick_report / "README.md").read_text()
+    assert "| cup | contact |" in text and "Deformed cup" in text
+    assert ("deformed_cup.png" in names) or ("Scene skipped" in text)
+    summary = json.loads((quick_report / "summary.json").read_text())
+    for key in ("appendix_a_slope_N_per_mm", "fem_slope_frictionless_N_per_mm", "fem_slope_sticking_N_per_mm"):
+        assert math.isfinite(summary[key]) and summary[key] > 0
+    assert summary["quick"] is True and summary["fem_runs_computed"] == summary["fem_runs_planned"]
+
+
+def test_quick_report_numbers(quick_report):
+    s = json.loads((quick_report / "summary.json").read_text())
+    # closed form of Appendix A's small-u slope, cup A, d0 = 2 mm, E = 4 MPa (N/mm)
+    a = math.radians(33.0)
+    closed = math.pi * 4e6 * 2e-3 * (1 - math.cos(a)) ** 2 * math.cos(a) / math.sin(a) ** 2 * 19 / 14 * 1e-3
+    assert s["appendix_a_slope_N_per_mm"] == pytest.approx(closed, rel=1e-12)
+    assert s["appendix_a_slope_N_per_mm"] == pytest.approx(2.51, abs=0.005)     # the paper's 2.5 N/mm
+    # the secant of the parabola F0 = k u (1 - u / (x1 sin a)) at 1 mm
+    assert s["appendix_a_secant_1mm_N_per_mm"] == pytest.approx(closed * (1 - 1 / (19 * math.sin(a))), rel=1e-9)
+    # a no-slip constraint only adds constraints to the frictionless problem: stiffer
+    assert s["fem_slope_sticking_N_per_mm"] > s["fem_slope_frictionless_N_per_mm"]
+    # the table and the summary hold the same numbers
+    rows = (quick_report / "cupA_small_u_stiffness.csv").read_text().splitlines()
+    fric = float(rows[1].split(",")[1])
+    assert fric == pytest.approx(s["fem_slope_frictionless_N_per_mm"], rel=1e-7)
+    outcomes = (quick_report / "extremes_outcomes.csv").read_text()
+    assert "E scaling" in outcomes and outcomes.count(",pass") >= 5
+
+
+# --------------------------------------------------------------------------- scaling
+def test_force_over_modulus_is_independent_of_E():
+    """F0 is proportional to E: the neo-Hookean law has no other stress scale (nu fixed), so with
+    u prescribed the solution u(x) is the same for every E and F0/E differs only by solver error.
+    The Newton tolerance is 1e-6 of the reaction, and the step sequence is the same (scale-free
+    criteria), so 1e-6 of max F0/E bounds it."""
+    from fem.cup import compress_cup
+    from fem.geometry import cup_geometry
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+
+    g = cup_geometry("A")
+    mesh = cup_mesh(g, "coarse")
+    runs = [compress_cup(mesh, NeoHookean(E_Pa=E), u_max_m=0.3 * g.h1_m, max_step=0.1) for E in (1e4, 1e8)]
+    assert np.array_equal(runs[0].u_m, runs[1].u_m)
+    f = [r.F0_N / r.material.E_Pa for r in runs]
+    assert np.max(np.abs(f[0] - f[1])) < 1e-6 * np.max(np.abs(f[1]))
+
+
+# ------------------------------------------------------------------------- bad input
+@pytest.mark.parametrize("argv,message", [
+    (["--only", "nosuch"], "--only: unknown section(s) nosuch"),
+    (["--only", "appendix", "bogus"], "allowed: " + ", ".join(section_names())),
+])
+def test_bad_input_exits_2_without_output(capsys, tmp_path, argv, message):
+    code = main(["validate", "--out", str(tmp_path / "v"), *argv])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and message in err
+    assert list(tmp_path.iterdir()) == []

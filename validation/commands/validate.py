@@ -1,0 +1,65 @@
+"""Cross-check report (issue 5): Appendix A vs FEM, rigid-cone laws vs FEM, the lifetime consequence
+of the stiffness source, the speed-accuracy trade, and the extremes.
+
+Writes to DIR, atomically: README.md (all sections, tables inline), one CSV per table (units in the
+column names), PNG figures, and summary.json with the headline numbers (appendix_a_slope_N_per_mm,
+fem_slope_frictionless_N_per_mm, fem_slope_sticking_N_per_mm, ...). Every FEM run a section needs is
+declared up front and run once; --cache-dir keeps them between calls (keyed by the run and the fem
+sources).
+
+examples:
+  cupcheck validate --quick --out out/validate-quick            # the CI subset, ~1 min
+  cupcheck validate --out validation/report                     # the full report, ~10 min on 2 cores
+  cupcheck validate --only appendix cone_laws --out out/v --cache-dir .cupcheck-cache
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+NAME = "validate"
+HELP = "cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes (CSV, MD, PNG, JSON)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    from validation.crosscheck import section_names
+
+    p.add_argument("--out", required=True, type=Path, metavar="DIR", help="output directory (written atomically)")
+    p.add_argument("--quick", action="store_true",
+                   help="a small representative subset (cup A only, coarse mesh, a few extremes)")
+    p.add_argument("--only", nargs="+", metavar="SECTION",
+                   help=f"run only these sections: {', '.join(section_names())} (default: all)")
+    p.add_argument("--cache-dir", type=Path, metavar="DIR",
+                   help="keep FEM runs on disk between calls (e.g. .cupcheck-cache, gitignored); "
+                        "default: no disk cache")
+    p.add_argument("--no-scene", action="store_true", help="skip the pyvista scene of the deformed cup")
+
+
+def run(args: argparse.Namespace) -> int:
+    import json
+    import os
+
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    from validation.crosscheck import RunMemo, planned_requests, run_validation
+    from validation.output import atomic_directory, terminal_progress
+
+    plan = planned_requests(args.quick, args.only)          # validates --only before any work
+    if args.out.exists() and not args.out.is_dir():
+        raise ValueError(f"--out: {args.out} exists and is not a directory")
+    memo = RunMemo(cache_dir=args.cache_dir)
+    print(f"validate: {len(plan)} FEM runs planned ({'quick' if args.quick else 'full'})")
+    with atomic_directory(args.out) as tmp:
+        report = run_validation(tmp, quick=args.quick, only=args.only, memo=memo, scene=not args.no_scene,
+                                progress=terminal_progress("validate"))
+    s = report.summary
+    keys = ("appendix_a_slope_N_per_mm", "fem_slope_frictionless_N_per_mm", "fem_slope_sticking_N_per_mm")
+    for k in keys:
+        if k in s:
+            print(f"  {k} = {s[k]:.4g}")
+    if "extremes_outcomes" in s:
+        print(f"  extremes: {json.dumps(s['extremes_outcomes'])}")
+    print(f"wrote {args.out}/README.md, {len(report.files)} tables and figures, summary.json "
+          f"({s['fem_runs_computed']} FEM runs computed, {s['fem_runs_from_cache']} from cache, "
+          f"{s['wall_s']:.0f} s)")
+    return 0
