@@ -62,6 +62,15 @@ class CurveGeometry:
             raise ValueError(f"geometry: 'curve' needs the stiffness curve's columns r_c_mm, l_mm, "
                              f"V_mm3; '{curve.provenance.get('source', '?')}' lacks "
                              f"{', '.join(m[:-2] + '_mm' for m in missing)}")
+        if np.any(curve.l_m <= 0):
+            zero_u = 1e3 * curve.u_m[curve.l_m <= 0]
+            where = (f"{zero_u[0]:.4g} mm" if zero_u.size == 1 else
+                     f"{zero_u.size} samples in [{zero_u.min():.4g}, {zero_u.max():.4g}] mm")
+            raise ValueError(
+                f"l_mm: the stiffness curve's strip width is 0 at u = {where} (no contact strip "
+                f"there), but eq (6) needs l > 0 wherever "
+                f"the cup may go, up to detachment at r1; take l from eq (5) (geometry 'cone') or "
+                f"give a curve with l > 0")
         self.cup = cup
         self.h1 = self.h_ref_m = curve.h1_m
         self._r = ScalarPchip(curve.u_m, curve.r_c_m, "stiffness curve (u for r_c)")

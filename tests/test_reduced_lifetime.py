@@ -236,3 +236,17 @@ def test_water_filled_cavity_eq24_against_an_independent_ode():
     assert r.lifetime_s == pytest.approx(sol.t_events[0][0], rel=1e-5)
     with pytest.raises(ValueError, match="fluid"):
         dataclasses.replace(REF_A, fluid="oil")
+
+
+def test_curve_geometry_with_a_vanishing_strip_width_is_an_input_error():
+    # an FEM curve whose strip width is 0 where only the rim corner touches: eq (6) would divide by
+    # zero there, so the model must refuse the curve up front, naming the column
+    u = np.linspace(0.0, 0.8 * CUP_A.h1_m, 40)
+    h = CUP_A.h1_m - u
+    x = 1.0 + h / CUP_A.h0_m
+    l = np.where(u < 0.1 * CUP_A.h1_m, 0.0, CUP_A.l0_m + CUP_A.l_a_m * (1.0 - x))
+    curve = StiffnessCurve(u_m=u, F0_N=2.5e3 * u, h1_m=CUP_A.h1_m, r_c_m=CUP_A.r0_m * x,
+                           l_m=l, V_m3=CUP_A.V0_m3 * (x ** 3 - 1.0))
+    model = dataclasses.replace(REF_A, stiffness=curve, geometry="curve")
+    with pytest.raises(ValueError, match="l_mm: .* strip width is 0"):
+        lifetime(model, 20.0)
