@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from dataclasses import asdict
 from importlib import metadata
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -55,7 +55,18 @@ def provenance(response: CupResponse, *, geometry: Mapping[str, Any], mesh: Mapp
     }
 
 
-def stiffness_curve(response: CupResponse, provenance: Mapping[str, Any]) -> StiffnessCurve:
+class CurveArrays(Protocol):
+    """What the hand-off reads: a `CupResponse`, or a cached result with the same arrays."""
+
+    h1_m: float
+    u_m: np.ndarray
+    F0_N: np.ndarray
+    r_c_m: np.ndarray
+    l_m: np.ndarray
+    V_m3: np.ndarray
+
+
+def stiffness_curve(response: CurveArrays, provenance: Mapping[str, Any]) -> StiffnessCurve:
     """The hand-off curve: u, F0 (the plate reaction), r_c, l (weighted width) and V per step."""
     return StiffnessCurve(u_m=response.u_m, F0_N=response.F0_N + 0.0, h1_m=response.h1_m,
                           r_c_m=response.r_c_m, l_m=response.l_m, V_m3=response.V_m3,

@@ -141,11 +141,9 @@ class FemResult:
         return PchipInterpolator(self.u_m, y, extrapolate=False)
 
     def stiffness_curve(self):
-        """The hand-off `StiffnessCurve` (u, F0, r_c, l, V), as `validation.handoff` builds it."""
-        from reduced.stiffness_curve import StiffnessCurve
-        return StiffnessCurve(u_m=self.u_m, F0_N=self.F0_N + 0.0, h1_m=self.h1_m, r_c_m=self.r_c_m,
-                              l_m=self.l_m, V_m3=self.V_m3,
-                              provenance={"source": "fem", **asdict(self.request)})
+        """The hand-off `StiffnessCurve` (u, F0, r_c, l, V), built by `validation.handoff`."""
+        from validation.handoff import stiffness_curve
+        return stiffness_curve(self, {"source": "fem", **asdict(self.request)})
 
 
 def compute(request: FemRun, progress: Callable[[float, str], None] | None = None) -> FemResult:
