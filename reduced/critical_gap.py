@@ -19,11 +19,12 @@ from __future__ import annotations
 
 import math
 import os
-from bisect import bisect_right
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from reduced.loglog import LogLogSegments, elementwise, read_two_columns
 
 __all__ = ["UcTable", "illustrative_uc_table", "ILLUSTRATIVE_UC_CSV"]
 
@@ -38,8 +39,7 @@ class UcTable:
     p_over_E: np.ndarray
     u_c_m: np.ndarray
     provenance: str = ""
-    _log_p: list = field(init=False, repr=False, compare=False)
-    _log_u: list = field(init=False, repr=False, compare=False)
+    _open: LogLogSegments = field(init=False, repr=False, compare=False)
     _seal: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -62,8 +62,7 @@ class UcTable:
         u.flags.writeable = False
         object.__setattr__(self, "p_over_E", p)
         object.__setattr__(self, "u_c_m", u)
-        object.__setattr__(self, "_log_p", [math.log(v) for v in p[:open_rows]])
-        object.__setattr__(self, "_log_u", [math.log(v) for v in u[:open_rows]])
+        object.__setattr__(self, "_open", LogLogSegments(p[:open_rows], u[:open_rows]))
         object.__setattr__(self, "_seal", float(p[open_rows]) if open_rows < p.size else math.inf)
 
     @property
@@ -73,44 +72,26 @@ class UcTable:
 
     def __call__(self, p_over_E):
         """u_c [m] at p/E (float -> float, array -> array)."""
-        if np.ndim(p_over_E) == 0:
-            return self.scalar(float(p_over_E))
-        return np.array([self.scalar(float(v)) for v in np.ravel(p_over_E)]).reshape(np.shape(p_over_E))
+        return elementwise(self.scalar, p_over_E)
 
     def scalar(self, x: float) -> float:
         if not x > 0:
             raise ValueError(f"p_over_E: contact pressure over modulus must be > 0, got {x}")
-        lp, lu, seal = self._log_p, self._log_u, self._seal
-        n = len(lp)
+        seal = self._seal
+        n = len(self._open.lx)
         if seal < math.inf and x > self.p_over_E[n - 1]:
             if x >= seal:
                 return 0.0
             # between the last open row and the first sealed row: linear in p/E down to 0
             p_last = float(self.p_over_E[n - 1])
             return float(self.u_c_m[n - 1]) * (seal - x) / (seal - p_last)
-        lx = math.log(x)
-        i = min(max(bisect_right(lp, lx) - 1, 0), n - 2)
-        slope = (lu[i + 1] - lu[i]) / (lp[i + 1] - lp[i])
-        return math.exp(lu[i] + slope * (lx - lp[i]))
+        return self._open.value_and_slope(x)[0]
 
     # --------------------------------------------------------------------- IO
     @classmethod
     def from_csv(cls, path: str | os.PathLike) -> UcTable:
-        path = Path(path)
-        if not path.is_file():
-            raise ValueError(f"uc-table: no such file '{path}'")
-        lines = [ln.strip() for ln in path.read_text().splitlines()]
-        body = [ln for ln in lines if ln and not ln.startswith("#")]
-        if not body or [c.strip() for c in body[0].split(",")] != _HEADER.split(","):
-            raise ValueError(f"uc-table: '{path}' must start with the header '{_HEADER}'")
-        try:
-            data = np.array([[float(v) for v in ln.split(",")] for ln in body[1:]], dtype=float)
-        except ValueError as exc:
-            raise ValueError(f"uc-table: '{path}' has a non-numeric entry ({exc})") from None
-        if data.ndim != 2 or data.shape[1] != 2:
-            raise ValueError(f"uc-table: '{path}' needs two columns per row, {_HEADER}")
-        comments = " ".join(ln[1:].strip() for ln in lines if ln.startswith("#"))
-        return cls(data[:, 0], data[:, 1], provenance=comments or f"csv:{path.name}")
+        p, u, comments = read_two_columns(path, _HEADER, "uc-table")
+        return cls(p, u, provenance=comments or f"csv:{Path(path).name}")
 
     def to_csv(self, path: str | os.PathLike) -> Path:
         """Write the table atomically, provenance as '#' comment lines."""

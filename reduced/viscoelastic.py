@@ -19,15 +19,14 @@ rdot = 0.185 mm/s, phi0 = 13.0 s. See `measurement_contact_time`.
 
 from __future__ import annotations
 
-import math
 import os
-from bisect import bisect_right
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from reduced.cup import CupParameters
+from reduced.loglog import LogLogSegments, elementwise, read_two_columns
 
 __all__ = ["RelaxationModulus", "default_relaxation", "measurement_contact_time",
            "contact_time_rate", "PAPER_PLATE_SPEED_M_S"]
@@ -44,8 +43,7 @@ class RelaxationModulus:
     t_s: np.ndarray
     E_Pa: np.ndarray
     provenance: str = ""
-    _lt: list = field(init=False, repr=False)
-    _lE: list = field(init=False, repr=False)
+    _law: LogLogSegments = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         t = np.array(self.t_s, dtype=float).reshape(-1)
@@ -59,41 +57,22 @@ class RelaxationModulus:
         for name, arr in (("t_s", t), ("E_Pa", E)):
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
-        object.__setattr__(self, "_lt", [math.log(v) for v in t])
-        object.__setattr__(self, "_lE", [math.log(v) for v in E])
+        object.__setattr__(self, "_law", LogLogSegments(t, E))
 
     def modulus_and_log_slope(self, t: float) -> tuple[float, float]:
         """(E_eff(t) [Pa], d ln E / d ln t); the slope is 0 on the short-time plateau."""
-        lt, lE = self._lt, self._lE
         if t <= self.t_s[0]:
             return float(self.E_Pa[0]), 0.0
-        x = math.log(t)
-        i = min(bisect_right(lt, x) - 1, len(lt) - 2)
-        slope = (lE[i + 1] - lE[i]) / (lt[i + 1] - lt[i])
-        return math.exp(lE[i] + slope * (x - lt[i])), slope
+        return self._law.value_and_slope(t)
 
     def __call__(self, t_s):
         """E_eff(t) [Pa] (float or array)."""
-        if np.ndim(t_s) == 0:
-            return self.modulus_and_log_slope(float(t_s))[0]
-        values = [self.modulus_and_log_slope(float(v))[0] for v in np.ravel(t_s)]
-        return np.array(values).reshape(np.shape(t_s))
+        return elementwise(lambda t: self.modulus_and_log_slope(t)[0], t_s)
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike) -> RelaxationModulus:
-        path = Path(path)
-        if not path.is_file():
-            raise ValueError(f"relaxation: no such file '{path}'")
-        body = [ln.strip() for ln in path.read_text().splitlines() if ln.strip() and not ln.startswith("#")]
-        if not body or [c.strip() for c in body[0].split(",")] != _HEADER.split(","):
-            raise ValueError(f"relaxation: '{path}' must start with the header '{_HEADER}'")
-        try:
-            data = np.array([[float(v) for v in ln.split(",")] for ln in body[1:]], dtype=float)
-        except ValueError as exc:
-            raise ValueError(f"relaxation: '{path}' has a non-numeric entry ({exc})") from None
-        if data.ndim != 2 or data.shape[1] != 2:
-            raise ValueError(f"relaxation: '{path}' needs two columns per row, {_HEADER}")
-        return cls(data[:, 0], data[:, 1], provenance=f"csv:{path.name}")
+        t, E, _ = read_two_columns(path, _HEADER, "relaxation")
+        return cls(t, E, provenance=f"csv:{Path(path).name}")
 
 
 def default_relaxation() -> RelaxationModulus:
