@@ -32,8 +32,9 @@ Per converged step, `CupResponse` holds (all SI):
 * ``V_m3``: the cavity volume under the plate and inside the cup down to z = 0 (the region of
   eq. 4), `postprocess.enclosed_volume` of the deformed cavity path down to its first contact;
 * ``l_m``: the pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
-  (`contact_width`), exactly l for a uniform strip of width l (the paper's eq. 6 picture) and an
-  integral of the pressure, hence mesh-convergent; ``l_half_max_m``: the width at half maximum
+  (`contact_width`), l (1 + l / 2 r_c) for a uniform strip of width l (the paper's eq. 6 picture);
+  its int p^2 reacts to the singular pressure at a sharp rim corner, so it converges poorly (the
+  hand-off's l for now; see ``l_median_m``); ``l_half_max_m``: the width at half maximum
   of the lumped nodal pressure (`postprocess.half_maximum_width`); ``l_median_m``: twice the
   distance from r_c within which half of the radial line force int p dr acts
   (`postprocess.median_force_width`: exact for a uniform strip, and, resting on a cumulative
@@ -54,7 +55,8 @@ from skfem import Mesh
 
 from .contact import PressureProfile, RigidPlane
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
-from .postprocess import enclosed_volume, half_maximum_width, inner_contact_radius, median_force_width
+from .postprocess import (enclosed_volume, half_maximum_width, inner_contact_radius,
+                          median_force_width, weighted_width)
 from .forms import Mechanics
 from .kinematics import Kinematics
 from .material import NeoHookean
@@ -183,9 +185,8 @@ def contact_width(profile: PressureProfile, r_c_m: float) -> float:
     consistent L2 projection at the boundary Gauss points (0 without contact)."""
     if profile.w_m2.size == 0:
         return 0.0
-    P1 = np.sum(profile.p_gauss_Pa * profile.w_m2)
-    P2 = np.sum(profile.p_gauss_Pa**2 * profile.w_m2)
-    return float(P1**2 / (2.0 * np.pi * r_c_m * P2)) if P2 > 0 else 0.0
+    return weighted_width(float(np.sum(profile.p_gauss_Pa * profile.w_m2)),
+                          float(np.sum(profile.p_gauss_Pa**2 * profile.w_m2)), r_c_m)
 
 
 def _edge_and_widths(profile: PressureProfile, r_rim: float) -> tuple[float, float, float]:

@@ -6,8 +6,10 @@ solver, each checked against closed forms in ``tests/test_fem_postprocess.py``.
 - `enclosed_volume`: the cavity volume V of eq. (4), by the divergence theorem on the deformed
   cavity-facing polyline.
 - `inner_contact_radius`: r_c, the inner edge of the contact (cf. eq. 3).
-- `pressure_weighted_width` and `half_maximum_width`: two mesh-convergent definitions of the
-  contact-strip width l of eqs. (5)-(6).
+- `pressure_weighted_width`, `half_maximum_width` and `median_force_width`: three definitions of
+  the contact-strip width l of eqs. (5)-(6). Only the median-force width rests on a cumulative
+  integral of p alone; the other two react to a singular rim-corner pressure and converge poorly
+  (benchmarks/bench_strip_width.py).
 
 Pressure profiles p(r) are sampled at increasing radii and taken piecewise-linear between the
 samples; integrals of such profiles are exact (no quadrature error beyond the interpolation).
@@ -20,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["enclosed_volume", "inner_contact_radius", "pressure_weighted_width",
+__all__ = ["enclosed_volume", "inner_contact_radius", "pressure_weighted_width", "weighted_width",
            "half_maximum_width", "contact_force", "Richardson", "richardson"]
 
 
@@ -96,9 +98,14 @@ def pressure_weighted_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | No
         raise ValueError("p_Pa: no positive contact pressure, the strip width is undefined")
     r_c = inner_contact_radius(r, p) if r_c_m is None else float(r_c_m)
     one = np.ones_like(p)
-    first = _integral_pr(r, p, one)      # int p r dr
-    second = _integral_pr(r, p, p)       # int p^2 r dr
-    return float((2 * math.pi * first) ** 2 / (2 * math.pi * r_c * 2 * math.pi * second))
+    return weighted_width(2 * math.pi * _integral_pr(r, p, one),      # int p dA
+                          2 * math.pi * _integral_pr(r, p, p), r_c)     # int p^2 dA
+
+
+def weighted_width(force_N: float, p2_integral: float, r_c_m: float) -> float:
+    """l_w = F^2 / (2 pi r_c int p^2 dA) [m] from the two integrals F = int p dA and int p^2 dA
+    (0 when there is no pressure): the one formula behind `pressure_weighted_width`."""
+    return float(force_N**2 / (2 * math.pi * r_c_m * p2_integral)) if p2_integral > 0 else 0.0
 
 
 def half_maximum_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = None) -> float:
