@@ -2,8 +2,8 @@
 
 Cup A (E = 4 MPa, nu = 0.49), pressed to 0.9 h1 at fidelity coarse, medium and fine, with load steps
 of at most 2 % of the range (so the curves are sampled alike). Prints F0, r_c and the three strip
-widths of `fem.cup.CupResponse` (pressure-weighted l_m, half-maximum l_half_max_m, median-force
-l_median_m) at u/h1 = 0.2 ... 0.9, one row per level. Takes ~2-3 min (the fine level dominates).
+widths of `fem.cup.CupResponse` (median-force l_m, the hand-off's; pressure-weighted
+l_weighted_m; half-maximum l_half_max_m) at u/h1 = 0.2 ... 0.9, one row per level. Takes ~2-3 min (the fine level dominates).
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_strip_width.py [frictionless|sticking]
 """
@@ -18,8 +18,8 @@ from fem.geometry import cup_geometry
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
 
-QUANTITIES = (("F0_N", 1.0, "F0 [N]"), ("r_c_m", 1e3, "r_c [mm]"), ("l_m", 1e3, "l weighted [mm]"),
-              ("l_half_max_m", 1e3, "l half-max [mm]"), ("l_median_m", 1e3, "l median [mm]"))
+QUANTITIES = (("F0_N", 1.0, "F0 [N]"), ("r_c_m", 1e3, "r_c [mm]"), ("l_weighted_m", 1e3, "l weighted [mm]"),
+              ("l_half_max_m", 1e3, "l half-max [mm]"), ("l_m", 1e3, "l median [mm]"))
 
 
 def main(contact: str = "frictionless") -> None:

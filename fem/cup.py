@@ -18,10 +18,8 @@ touch the plane (`fem.contact`); the contact zones are whatever the solution mak
 
 The pressure profile p(r) (`fem.contact.PressureProfile`) holds the lumped nodal pressure of the
 nodes in contact, sorted by deformed radius, and the consistent L2 projection at the boundary
-Gauss points (for integrals). r_c, l_half_max and V come from the pure functions of
-`fem.postprocess`; l uses the same definition as `postprocess.pressure_weighted_width` with the
-integrals over the Gauss points (`contact_width`), because the piecewise-linear nodal profile
-converges much more slowly (a node-spaced peak at the contact edge).
+Gauss points (for integrals). r_c, the strip widths and V come from the pure functions of
+`fem.postprocess`.
 
 Per converged step, `CupResponse` holds (all SI):
 
@@ -31,14 +29,16 @@ Per converged step, `CupResponse` holds (all SI):
   the innermost node in contact and its free neighbour, where a square-root edge extrapolates to 0;
 * ``V_m3``: the cavity volume under the plate and inside the cup down to z = 0 (the region of
   eq. 4), `postprocess.enclosed_volume` of the deformed cavity path down to its first contact;
-* ``l_m``: the pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
-  (`contact_width`), l (1 + l / 2 r_c) for a uniform strip of width l (the paper's eq. 6 picture);
-  its int p^2 reacts to the singular pressure at a sharp rim corner, so it converges poorly (the
-  hand-off's l for now; see ``l_median_m``); ``l_half_max_m``: the width at half maximum
-  of the lumped nodal pressure (`postprocess.half_maximum_width`); ``l_median_m``: twice the
-  distance from r_c within which half of the radial line force int p dr acts
-  (`postprocess.median_force_width`: exact for a uniform strip, and, resting on a cumulative
-  integral of p alone, insensitive to the singular pressure at a sharp rim corner);
+* ``l_m``: the strip width l handed to the reduced model (eq. 5's l, the width of the strip of
+  eq. 6 that carries the contact load): the median-force width, twice the distance from r_c within
+  which half of the radial line force int p dr acts (`postprocess.median_force_width`; exact for a
+  uniform strip, and, resting on a cumulative integral of p alone, insensitive to the singular
+  pressure at a sharp rim corner, so it converges with the mesh: `benchmarks/bench_strip_width.py`);
+* ``l_weighted_m``: the pressure-weighted width (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
+  (`contact_width`, the integrals over the Gauss-point projection), l (1 + l / 2 r_c) for a uniform
+  strip; its int p^2 reacts to the singular rim-corner pressure, so it scatters 10-30 % between
+  mesh levels (kept for comparison); ``l_half_max_m``: the width at half maximum of the lumped nodal
+  pressure (`postprocess.half_maximum_width`);
 * ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
   elastic energy), ``newton_iterations``, and the pressure profiles ``pressure[i]``.
 """
@@ -79,8 +79,8 @@ class CupResponse:
     r_c_m: np.ndarray
     V_m3: np.ndarray
     l_m: np.ndarray
+    l_weighted_m: np.ndarray
     l_half_max_m: np.ndarray
-    l_median_m: np.ndarray
     penetration_m: np.ndarray
     energy_J: np.ndarray
     newton_iterations: np.ndarray
@@ -154,8 +154,8 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     col = lambda k: np.array([st[k] for st in steps])       # noqa: E731
     return CupResponse(
         h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
-        F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l"),
-        l_half_max_m=col("l_hm"), l_median_m=col("l_med"), penetration_m=col("pen"), energy_J=col("W"),
+        F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l_med"),
+        l_weighted_m=col("l_w"), l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
         newton_iterations=col("its").astype(int), pressure=tuple(st["p"] for st in steps),
         stats=stats,
         mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
@@ -174,7 +174,7 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
     return {"u": s.t, "F0": -float(np.sum(s.r_int[2 * top + 1])),
             "Fc": float(np.sum(prof.p_gauss_Pa * prof.w_m2)), "r_c": r_c,
             "V": enclosed_volume(x[0, path], x[1, path], on_path),
-            "l": contact_width(prof, r_c), "l_hm": l_hm, "l_med": l_med,
+            "l_w": contact_width(prof, r_c), "l_hm": l_hm, "l_med": l_med,
             "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations,
             "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
 
