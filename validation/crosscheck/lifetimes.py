@@ -6,7 +6,9 @@ EMT, nu = 0.5), fed by four stiffness sources:
 
 (a) Appendix A, paper reading (d0 = 2 mm, d1 = 0), cone laws (3)-(5): the reference model;
 (b) FEM frictionless F0(h), cone laws; (c) FEM sticking F0(h), cone laws;
-(d) FEM sticking F0(h) with its own r_c(h), V(h), l(h) (``geometry="curve"``);
+(d) FEM sticking F0(h) with its own r_c(h), V(h), l(h) (``geometry="curve"``); where the FEM
+    resolves no strip (only the rim corner touches the plane, one node: l = 0, before the wall
+    lands and, for sticking, after it buckles away), l falls back to eq (5) at the FEM's r_c;
 (e) the same with the frictionless FEM;
 (f), (g) FEM sticking / frictionless F0, r_c and V, with l from eq (5) at the FEM's r_c (to separate
 the effect of the FEM's strip width from that of its radius and volume).
@@ -54,10 +56,24 @@ def sources(ctx: Context, fidelity: str = DEFAULT_FIDELITY) -> dict[str, tuple]:
     return {"(a) Appendix A": (appendix_a_curve(CUP_A, E_Pa=4e6, d0_m=2e-3), "cone"),
             "(b) FEM frictionless": (fric, "cone"),
             "(c) FEM sticking": (stick, "cone"),
-            "(d) FEM sticking + own r, V, l": (stick, "curve"),
-            "(e) FEM frictionless + own r, V, l": (fric, "curve"),
+            "(d) FEM sticking + own r, V, l": (fem_width(stick), "curve"),
+            "(e) FEM frictionless + own r, V, l": (fem_width(fric), "curve"),
             "(f) FEM sticking + own r, V; l eq 5": (eq5_width(stick), "curve"),
             "(g) FEM frictionless + own r, V; l eq 5": (eq5_width(fric), "curve")}
+
+
+def fem_width(curve):
+    """The FEM curve with its own strip width where it resolves one (l > 0), eq (5) at its r_c
+    where it does not (l = 0: the rim corner alone touches, a strip narrower than an element)."""
+    from dataclasses import replace
+
+    eq5 = eq5_width(curve).l_m
+    unresolved = curve.l_m <= 0
+    u = 1e3 * curve.u_m[unresolved]
+    note = (f"FEM; eq 5 at FEM r_c at {unresolved.sum()} samples with no resolved strip "
+            f"(u in [{u.min():.3g}, {u.max():.3g}] mm)" if unresolved.any() else "FEM")
+    return replace(curve, l_m=np.where(unresolved, eq5, curve.l_m),
+                   provenance={**curve.provenance, "l": note})
 
 
 def eq5_width(curve):
@@ -76,7 +92,8 @@ def run(ctx: Context) -> None:
     uc = pmma_uc_table()
     forces = QUICK_FORCES_N if ctx.quick else FORCES_N
     table, series = {}, {}
-    for label, (curve, geometry) in sources(ctx).items():
+    srcs = sources(ctx)
+    for label, (curve, geometry) in srcs.items():
         model = leakage_model(curve, geometry, uc, label)
         ctx.progress(0.0, f"lifetimes {label}")
         try:
@@ -98,7 +115,7 @@ def run(ctx: Context) -> None:
     rep.table(NAME, "largest_holdable_force", ["source", "largest_force_N"],
               [[k, v[0]] for k, v in table.items()], "Largest force the freshly pressed cup holds")
     _figure(ctx, series)
-    _explain_sealing(ctx, table)
+    _explain_sealing(ctx, table, srcs)
     ref = "(a) Appendix A"
     ratios = {}
     for k in table:
@@ -126,18 +143,21 @@ def _figure(ctx: Context, series) -> None:
     ctx.report.figure(NAME, "lifetime_by_stiffness_source", fig, "Lifetime against F1 by stiffness source")
 
 
-def _explain_sealing(ctx: Context, table) -> None:
-    """Say where a FEM-geometry run seals and what the FEM's strip width is there."""
+def _explain_sealing(ctx: Context, table, srcs) -> None:
+    """Say where a FEM-geometry run seals and where the FEM resolves no strip width."""
     for label, (_, results) in table.items():
         sealed = [r for r in results if r.reason == "sealed"]
         if sealed:
             ctx.report.text(NAME, f"*{label}*: sealed at {len(sealed)} of {len(results)} forces "
                                   f"({sealed[0].message}).")
+    for label, (curve, _) in srcs.items():
+        if label[:3] in ("(d)", "(e)"):
+            ctx.report.text(NAME, f"*{label}*: strip width: {curve.provenance['l']}.")
     ctx.report.text(NAME, """
-Why the FEM's own strip width seals: before the wall lands (u below ~0.25 h1 for cup A) only the rim
-corner touches the smooth rigid plane, so the FEM's pressure-weighted width l is 0 (a point contact on
-the mesh) while F0 > 0; eq (6) then gives an unbounded strip pressure, above the surface's sealing
-pressure, and every trajectory that ends at r1 passes through it. The paper's l1 = 0.8 mm at r1 is an
-optical observation of the real, rounded rim on a rough surface, which this FEM (sharp rim corner,
-smooth plane) does not model. Sources (f), (g) keep the FEM's r and V but take l from eq (5).
+The FEM's strip width l is the median-force width (`fem.cup`). Before the wall lands (u below
+~0.25 h1 for cup A) only the rim corner touches the smooth rigid plane: the FEM resolves no strip
+there (one node in contact, l = 0) while F0 > 0, and eq (6) would give an unbounded strip pressure,
+i.e. a perfect seal. The paper's l1 = 0.8 mm at r1 is an optical observation of the real, rounded
+rim on a rough surface, which this FEM (sharp rim corner, smooth plane) does not model; (d) and (e)
+take eq (5) there. Sources (f), (g) keep the FEM's r and V but take l from eq (5) everywhere.
 """)
