@@ -95,9 +95,10 @@ class CupResponse:
         """Cup height h = h1 - u [m]."""
         return self.h1_m - self.u_m
 
-    def write_fields(self, path: str | Path, step: int = -1) -> Path:
-        """Write displacement, Cauchy stress (element means) and contact pressure of one step as
-        VTU (or another format meshio infers from the suffix) on the reference mesh."""
+    def write_fields(self, path: str | Path, step: int | None = -1) -> Path:
+        """Write displacement, Cauchy stress (element means) and contact pressure on the reference
+        mesh: one step as VTU (or another format meshio infers from the suffix), or, to an .xdmf,
+        one step or every step (step=None) as a time series over u (`fem.fields`)."""
         from .fields import write_fields
         return write_fields(self, path, step)
 

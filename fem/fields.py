@@ -5,12 +5,18 @@ ParaView's "Warp By Vector" with ``displacement`` shows the deformed cup. Point 
 ``displacement`` [m] (3 components, u_theta = 0) and ``contact_pressure`` [Pa] (the projected
 pressure of `fem.contact`, 0 off contact). Cell data: the element mean (over the 3x3 Gauss points,
 weighted by dV) of the Cauchy stress ``sigma_rr, sigma_zz, sigma_tt, sigma_rz`` [Pa].
+
+Formats: ``.vtu`` (or any single-step format meshio infers from the suffix) holds one step;
+``.xdmf`` holds one step or the whole path as a time series whose "time" is the plate
+displacement u [m] (ParaView's time slider then walks the compression). The XDMF is written with
+its data inline as XML (meshio's `TimeSeriesWriter`, ``data_format="XML"``): one self-contained
+file, no HDF5 library needed.
 """
 
 from __future__ import annotations
 
 import os
-import tempfile
+import secrets
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -38,34 +44,44 @@ def element_cauchy_stress(mech: Mechanics, u: np.ndarray) -> np.ndarray:
     return np.sum(s * dV, axis=2) / dV.sum(axis=1)
 
 
-def write_fields(resp: "CupResponse", path: str | Path, step: int = -1) -> Path:
-    """Write one step of `resp` to `path` (format from the suffix: .vtu, or any other meshio
-    format; meshio's XDMF writer needs h5py, which cupcheck does not depend on), atomically."""
+def write_fields(resp: "CupResponse", path: str | Path, step: int | None = -1) -> Path:
+    """Write step `step` of `resp` (None: every step, .xdmf only) to `path`, atomically."""
     path = Path(path)
     n_steps = len(resp.u_m)
-    if not -n_steps <= step < n_steps:
+    xdmf = path.suffix.lower() == ".xdmf"
+    if step is None and not xdmf:
+        raise ValueError(f"step: every step (None) needs an .xdmf time series, got '{path.name}'")
+    if step is not None and not -n_steps <= step < n_steps:
         raise ValueError(f"step: must be in [{-n_steps}, {n_steps - 1}], got {step}")
+    steps = range(n_steps) if step is None else [step % n_steps]
     kin = Kinematics.of(resp.mesh)
     mech = Mechanics(kin, resp.material)
-    u = resp.displacements[step]
-    cells = kin.dofs[0::2].T // 2            # node ids per element, in VTK's node order
-    kind = "quad9" if cells.shape[1] == 9 else "triangle6"
-    disp = np.zeros((kin.mesh.doflocs.shape[1], 3))
-    disp[:, 0], disp[:, 1] = u[0::2], u[1::2]
-    sig = element_cauchy_stress(mech, u)
-    out = meshio.Mesh(
-        points=np.column_stack([kin.mesh.doflocs.T, np.zeros(disp.shape[0])]),
-        cells=[(kind, cells)],
-        point_data={"displacement": disp, "contact_pressure": resp.nodal_pressure_Pa[step]},
-        cell_data={name: [sig[k]] for k, name in
-                   enumerate(("sigma_rr", "sigma_zz", "sigma_tt", "sigma_rz"))},
-    )
+    nodes = kin.dofs[0::2].T // 2            # node ids per element, in VTK's node order
+    cells = [("quad9" if nodes.shape[1] == 9 else "triangle6", nodes)]
+    points = np.column_stack([kin.mesh.doflocs.T, np.zeros(kin.mesh.doflocs.shape[1])])
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=path.suffix)
-    os.close(fd)
+    # a unique sibling, created by the writer with the normal (umask) permissions (not mkstemp's 0600)
+    tmp = path.with_name(f".{path.stem}.{os.getpid()}.{secrets.token_hex(4)}{path.suffix}")
     try:
-        out.write(tmp)
+        if xdmf:
+            with meshio.xdmf.TimeSeriesWriter(tmp, data_format="XML") as series:
+                series.write_points_cells(points, cells)
+                for k in steps:
+                    series.write_data(float(resp.u_m[k]), *_step_data(resp, mech, k))
+        else:
+            point_data, cell_data = _step_data(resp, mech, steps[0])
+            meshio.Mesh(points, cells, point_data=point_data, cell_data=cell_data).write(tmp)
         os.replace(tmp, path)
     finally:
         Path(tmp).unlink(missing_ok=True)
     return path
+
+
+def _step_data(resp: "CupResponse", mech: Mechanics, k: int) -> tuple[dict, dict]:
+    """Point data (displacement, contact pressure) and cell data (Cauchy stress) of step k."""
+    u = resp.displacements[k]
+    disp = np.zeros((mech.kin.mesh.doflocs.shape[1], 3))
+    disp[:, 0], disp[:, 1] = u[0::2], u[1::2]
+    sig = element_cauchy_stress(mech, u)
+    return ({"displacement": disp, "contact_pressure": resp.nodal_pressure_Pa[k]},
+            {name: [sig[i]] for i, name in enumerate(("sigma_rr", "sigma_zz", "sigma_tt", "sigma_rz"))})

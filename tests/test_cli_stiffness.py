@@ -68,7 +68,7 @@ def test_user_mesh_and_geometry_file(tmp_path):
     (["--mesh", "missing.msh"], "mesh"),
     (["--mesh", "meshes/user_lip.msh", "--fidelity", "fine"], "mesh"),
     (["--mesh", "meshes/user_lip.msh", "--mesh-unit", "m"], "mesh"),
-    (["--fields-out", "f.xdmf"], "fields_out"),
+    (["--fields-out", "f.vtk"], "fields_out"),
 ])
 def test_bad_input_exits_2_with_one_line_and_no_output(tmp_path, capsys, monkeypatch, argv, field):
     monkeypatch.chdir(REPO)

@@ -164,3 +164,20 @@ def test_triangle_mesh_agrees_with_quadrilaterals(mesh):
     tri = cup_mesh(GEOMETRY, "coarse", element="tri")
     F = [compress_cup(m, NeoHookean(), u_max_m=0.5 * H1, max_step=0.1).F0_N[-1] for m in (mesh, tri)]
     assert F[1] == pytest.approx(F[0], rel=0.03)
+
+
+def test_the_whole_path_is_written_as_an_xdmf_time_series(frictionless, tmp_path):
+    out = frictionless.write_fields(tmp_path / "cup.xdmf", step=None)
+    with meshio.xdmf.TimeSeriesReader(out) as reader:
+        points, cells = reader.read_points_cells()
+        assert reader.num_steps == len(frictionless.u_m)
+        for k in (0, reader.num_steps - 1):
+            t, point_data, cell_data = reader.read_data(k)
+            assert t == pytest.approx(frictionless.u_m[k], rel=1e-12)   # "time" is u [m]
+            assert np.allclose(point_data["displacement"][:, 1], frictionless.displacements[k][1::2])
+    assert cells[0].data.shape[1] == 9
+    vtu = meshio.read(frictionless.write_fields(tmp_path / "last.vtu"))
+    assert np.allclose(cell_data["sigma_zz"], vtu.cell_data["sigma_zz"][0])
+    with pytest.raises(ValueError, match="step: every step"):
+        frictionless.write_fields(tmp_path / "all.vtu", step=None)
+    assert not list(tmp_path.glob(".*"))

@@ -56,8 +56,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     r.add_argument("--u-max-mm", type=float, default=None, dest="u_max_mm",
                    help="largest plate displacement u [mm], in (0, h1] (default 0.9 h1; at h1 the plate edge reaches the plane)")
     r.add_argument("--fields-out", type=Path, metavar="FILE",
-                   help="also write the last step's fields (displacement, Cauchy stress, contact "
-                        "pressure) as .vtu")
+                   help="also write the fields (displacement, Cauchy stress, contact pressure): "
+                        "the last step as .vtu, or every step as an .xdmf time series over u")
     r.add_argument("--out", type=Path, required=True, metavar="CSV",
                    help="the stiffness curve (.csv); the sidecar goes to the same name with .json")
 
@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
         handoff.write_sidecar(handoff.sidecar(response, prov), tmp_json)
         if args.fields_out is not None:
             with atomic_file(args.fields_out) as tmp_fields:
-                response.write_fields(tmp_fields)
+                response.write_fields(tmp_fields, step=None if tmp_fields.suffix == ".xdmf" else -1)
     s = response.stats
     print(f"cupcheck stiffness: wrote {args.out} and {job['sidecar'].name}: {s.steps} steps, "
           f"{s.newton_iterations} Newton iterations, {s.dofs} dofs, {s.wall_time_s:.1f} s; "
@@ -98,8 +98,9 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         raise ValueError(f"out: the stiffness curve must be a .csv file, got '{out}'")
     if out.is_dir():
         raise ValueError(f"out: '{out}' is a directory; give a .csv file name")
-    if args.fields_out is not None and Path(args.fields_out).suffix.lower() != ".vtu":
-        raise ValueError(f"fields_out: must end in .vtu, got '{args.fields_out}'")
+    if args.fields_out is not None and Path(args.fields_out).suffix not in (".vtu", ".xdmf"):
+        raise ValueError(f"fields_out: must end in .vtu (last step) or .xdmf (every step), "
+                         f"got '{args.fields_out}'")
     material = NeoHookean(E_Pa=_positive(args.E_MPa, "E_MPa", "Young's modulus") * 1e6,
                           nu=args.nu, formulation=args.formulation)
     fidelity = args.fidelity or "coarse"
