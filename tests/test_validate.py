@@ -130,3 +130,43 @@ def test_bad_input_exits_2_without_output(capsys, tmp_path, argv, message):
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and message in err
     assert list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------ extremes: the energy check
+class _QuadraticForce:
+    """A fake context whose runs sample F0 = c u^2 at steps of max_step u_max; W exact (or not)."""
+
+    def __init__(self, defect=1.0):
+        self.defect, self.steps = defect, []
+
+    def outcome(self, request: FemRun):
+        self.steps.append(request.max_step)
+        u = np.linspace(0.0, 1e-3, round(1 / request.max_step) + 1)
+        z = np.zeros_like(u)
+        return FemResult(request=request, h1_m=1e-3, u_m=u, F0_N=1e6 * u**2, F0_contact_N=1e6 * u**2,
+                         r_c_m=z, l_m=z, V_m3=z, energy_J=self.defect * 1e6 * u**3 / 3, penetration_m=z,
+                         wall_s=0.0, steps=len(u), newton_iterations=0, dofs=1, outline_r_m=z,
+                         outline_z_m=z, outline_p_Pa=z)
+
+
+def _trapezoid_error(h):
+    """Relative error of the trapezoid int_0^u s^2 ds, h^2 / (2 u^2), at the first grid point with
+    W > 1 % of W(1) (the check's window), on the grid of step h (u_max = 1)."""
+    u = np.arange(0.0, 1.0 + h / 2, h)
+    u1 = u[u**3 > 0.01][0]
+    return h**2 / (2 * u1**2)
+
+
+def test_energy_check_halves_the_step_for_a_quadrature_error_but_not_for_a_defect():
+    from validation.crosscheck.extremes import _energy_with_step_halving, fem_checks
+    req = FemRun(d_root_mm=0.5, max_step=0.1)
+    ctx = _QuadraticForce()
+    first = fem_checks(ctx.outcome(req), 3e-4)["energy"]
+    assert first[0] == pytest.approx(_trapezoid_error(0.1), rel=1e-9) and first[0] > first[1]
+    (value, tol), text = _energy_with_step_halving(ctx, req, first)
+    # 0.056 -> 0.020 (just above 2 %) -> 0.0062: judged on the finest run
+    assert ctx.steps[1:] == [0.05, 0.025] and value == pytest.approx(_trapezoid_error(0.025), rel=1e-9)
+    assert value <= tol and text.count("->") == 2
+    bad = _QuadraticForce(defect=1.05)            # W off by 5 %: halving the step cannot fix it
+    (value, tol), _ = _energy_with_step_halving(bad, req, fem_checks(bad.outcome(req), 3e-4)["energy"])
+    assert value > tol and bad.steps[1:] == [0.05, 0.025]

@@ -7,8 +7,10 @@ stops first): the grid alpha x root thickness at nu = 0.49, E = 4 MPa; the nu ax
 
 * energy: the work int F0 du (trapezoid over the load steps) equals the stored energy W(u) where
   W > 1 % of its final value, to 2 % (frictionless contact does no work; the budget is the
-  trapezoid's O(du^2) error at load steps of <= 1 % of u_max, 5 % in --quick, which a kink of F0,
-  where the wall lands flat, makes largest);
+  trapezoid's O(du^2) error at load steps of <= 1 % of u_max, 5 % in --quick, which the steep end
+  u -> h1 and a kink of F0, where the wall lands flat, make largest); if it is exceeded the case is
+  rerun with the load step halved, up to twice, and judged on the finest run: a quadrature error
+  drops ~4x per halving, a real energy defect does not (the table shows the sequence);
 * reaction: the plate reaction equals the integrated contact pressure, to 1e-4 of max F0 (equilibrium;
   the Newton tolerance is 1e-6 of the reaction);
 * penetration: the largest violation of z >= 0 is below 5 % of the rim thickness;
@@ -110,6 +112,7 @@ def fem_row(ctx: Context, req: FemRun, axis: str) -> list:
     if isinstance(out, Exception):
         return [axis, params, "failed fast (solver)", "", _first_line(out)[:300]]
     checks = fem_checks(out, req.thickness_at_ends_m()[1])
+    checks["energy"], halvings = _energy_with_step_halving(ctx, req, checks["energy"])
     if axis == "grid" and not ctx.quick:
         fine = ctx.outcome(FemRun(**{**req.__dict__, "fidelity": "medium"}))
         if isinstance(fine, Exception):
@@ -118,9 +121,31 @@ def fem_row(ctx: Context, req: FemRun, axis: str) -> list:
             u = 0.5 * min(out.u_m[-1], fine.u_m[-1])
             checks["mesh"] = (abs(float(fine.F0_at(u) / out.F0_at(u)) - 1.0), 5e-2)
     verdict, text = _verdict(checks)
+    if halvings:
+        text += f" (energy mismatch with the load step halved: {halvings})"
     reached = out.u_m[-1] / out.h1_m
     return [axis, params, verdict, text, f"u_end = {reached:.3g} h1, F0_end = {out.F0_N[-1]:.4g} N, "
                                          f"{out.steps} steps, {out.wall_s:.3g} s"]
+
+
+def _energy_with_step_halving(ctx: Context, req: FemRun, energy: tuple[float, float],
+                              halvings: int = 2) -> tuple[tuple[float, float], str]:
+    """The energy check's budget is the trapezoid's O(du^2) error, largest at the steep end
+    (u -> h1). If it is exceeded, rerun with the load step halved (up to `halvings` times): a
+    quadrature error drops ~4x per halving and the check is judged on the finest run; a real
+    energy defect (a non-conservative solution) would not drop. Returns the check and the
+    sequence of mismatches ("" if no rerun was needed)."""
+    seq = [energy[0]]
+    step = req.max_step
+    while not seq[-1] <= energy[1] and len(seq) <= halvings:
+        step /= 2
+        res = ctx.outcome(FemRun(**{**req.__dict__, "max_step": step}))
+        if isinstance(res, Exception):
+            break
+        seq.append(fem_checks(res, req.thickness_at_ends_m()[1])["energy"][0])
+    text = "" if len(seq) == 1 else (" -> ".join(f"{e:.2g}" for e in seq) +
+                                     f" at max_step {req.max_step:g} ... {step:g} u_max")
+    return (seq[-1], energy[1]), text
 
 
 def scaling_row(ctx: Context, runs: list[FemRun]) -> list:

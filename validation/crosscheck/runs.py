@@ -66,6 +66,8 @@ class FemRun:
             parts.append(self.formulation)
         if self.u_max_over_h1 != 0.9:
             parts.append(f"u_max {self.u_max_over_h1:g} h1")
+        if self.max_step != 0.05:
+            parts.append(f"step <= {self.max_step:g} u_max")
         return ", ".join(parts)
 
     def geometry(self):
