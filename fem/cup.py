@@ -129,6 +129,8 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     if not isinstance(material, NeoHookean):
         raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
     u_max = 0.9 * h1 if u_max_m is None else float(u_max_m)
+    if h1 < u_max <= h1 * (1 + 1e-9):        # h1 itself, up to the round-off of a unit conversion
+        u_max = h1
     if not (0.0 < u_max <= h1):
         raise ValueError(f"u_max_m: plate displacement must be in (0, h1] = (0, "
                          f"{h1 * 1e3:.4g} mm] (at u = h1 the plate reaches the plane), "

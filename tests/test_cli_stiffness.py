@@ -83,3 +83,19 @@ def test_output_must_be_a_csv_file(tmp_path, capsys):
     assert main(["stiffness", "--out", str(tmp_path / "curve.txt")]) == 2
     assert "out:" in capsys.readouterr().err
     assert _files(tmp_path) == []
+
+
+def test_h1_typed_in_mm_is_full_flattening_not_an_error():
+    # 1e3 h1 in full precision, times 1e-3, can land one ulp above h1: that is h1, not "beyond h1"
+    import argparse
+
+    from fem.geometry import cup_geometry
+    from validation.commands import stiffness
+    h1 = cup_geometry("B").h1_m
+    parser = argparse.ArgumentParser()
+    stiffness.add_arguments(parser)
+    args = parser.parse_args(["--cup", "B", "--u-max-mm", repr(1e3 * h1), "--out", "c.csv"])
+    assert stiffness._prepare(args)["u_max_m"] == h1
+    args = parser.parse_args(["--cup", "B", "--u-max-mm", repr(1e3 * h1 * (1 + 1e-6)), "--out", "c.csv"])
+    with pytest.raises(ValueError, match=r"u_max_mm: .* \(0, 5.37409649\] mm, got 5.37410186"):
+        stiffness._prepare(args)

@@ -129,9 +129,10 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         u_max = 0.9 * h1
     else:
         u_max = _positive(args.u_max_mm, "u_max_mm", "plate displacement") * 1e-3
-        if u_max > h1:
+        if u_max > h1 * (1 + 1e-9):          # beyond the round-off of the mm -> m conversion
             raise ValueError(f"u_max_mm: plate displacement must be in (0, h1] = (0, "
-                             f"{1e3 * h1:.4g}] mm, got {args.u_max_mm:g}")
+                             f"{1e3 * h1:.9g}] mm, got {args.u_max_mm:.9g}")
+        u_max = min(u_max, h1)
     return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
             "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json")}
 
