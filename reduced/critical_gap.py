@@ -1,8 +1,9 @@
 """The critical gap u_c(p/E): the surface separation at the critical constrictions (Sec. 4, 5.1).
 
 The reduced model takes u_c as any callable `u_c(p_over_E) -> metres`. `UcTable` is the standard
-one: a table `p_over_E,u_c_m` (as Fig. 1pressureMPa.2loguc shows it), interpolated linearly in
-log-log and extrapolated linearly in log-log beyond both ends.
+one: a table `p_over_E,u_c_m` (as Fig. 1pressureMPa.2loguc shows it), interpolated in
+log-log (a monotone cubic in ln u_c over ln p/E, `reduced.loglog`) and extrapolated as power laws
+beyond both ends.
 
 u_c = 0 is legal and means a sealed interface (the contact area percolates): no leak. Zeros may
 only form a trailing block (once sealed, a higher pressure stays sealed). Between the last open
@@ -24,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reduced.loglog import LogLogSegments, elementwise, read_two_columns
+from reduced.loglog import LogLogPchip, elementwise, read_two_columns
 
 __all__ = ["UcTable", "illustrative_uc_table", "ILLUSTRATIVE_UC_CSV"]
 
@@ -39,7 +40,7 @@ class UcTable:
     p_over_E: np.ndarray
     u_c_m: np.ndarray
     provenance: str = ""
-    _open: LogLogSegments = field(init=False, repr=False, compare=False)
+    _open: LogLogPchip = field(init=False, repr=False, compare=False)
     _seal: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -62,7 +63,7 @@ class UcTable:
         u.flags.writeable = False
         object.__setattr__(self, "p_over_E", p)
         object.__setattr__(self, "u_c_m", u)
-        object.__setattr__(self, "_open", LogLogSegments(p[:open_rows], u[:open_rows]))
+        object.__setattr__(self, "_open", LogLogPchip(p[:open_rows], u[:open_rows]))
         object.__setattr__(self, "_seal", float(p[open_rows]) if open_rows < p.size else math.inf)
 
     @property
@@ -78,7 +79,7 @@ class UcTable:
         if not x > 0:
             raise ValueError(f"p_over_E: contact pressure over modulus must be > 0, got {x}")
         seal = self._seal
-        n = len(self._open.lx)
+        n = self._open.n
         if seal < math.inf and x > self.p_over_E[n - 1]:
             if x >= seal:
                 return 0.0

@@ -1,35 +1,44 @@
-"""Piecewise power laws: tables interpolated linearly in log-log, and their two-column CSVs.
+"""Log-log interpolated tables and their two-column CSVs.
 
-Shared by the critical-gap table u_c(p/E) and the relaxation modulus E_eff(t). Evaluation is on
-Python floats (the reduced model's hot path); beyond either end the first or last segment's power
-law continues.
+Shared by the critical-gap table u_c(p/E) and the relaxation modulus E_eff(t). ln y is interpolated
+over ln x by the monotone piecewise cubic (PCHIP), so y(x) is C1 and exact for a power law; beyond
+either end the power law with the end's log-log slope continues. C1 matters: the tabulated
+functions are smooth, and a piecewise power law (C0 in log-log) puts a kink at every row, which
+fools the lifetime integrator's error estimate (measured: lifetime errors ~100 rtol at the default
+rtol, against ~rtol with this interpolant). Evaluation is on Python floats (the reduced model's hot
+path).
 """
 
 from __future__ import annotations
 
 import math
 import os
-from bisect import bisect_right
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from reduced.fast_curve import ScalarPchip
 
-class LogLogSegments:
-    """y(x) linear in (ln x, ln y) between samples, extrapolated with the end segments' slopes."""
+
+class LogLogPchip:
+    """y(x) with ln y a PCHIP in ln x between samples, power laws beyond the ends."""
 
     def __init__(self, x: np.ndarray, y: np.ndarray):
-        self.lx = [math.log(v) for v in x]
-        self.ly = [math.log(v) for v in y]
+        lx, ly = np.log(np.asarray(x, float)), np.log(np.asarray(y, float))
+        self.n = len(lx)
+        self._cubic = ScalarPchip(lx, ly, "log-log table")
+        self._lo = (float(lx[0]), float(ly[0]), float(self._cubic.pp(lx[0], 1)))
+        self._hi = (float(lx[-1]), float(ly[-1]), float(self._cubic.pp(lx[-1], 1)))
 
     def value_and_slope(self, x: float) -> tuple[float, float]:
         """(y(x), d ln y / d ln x) for x > 0."""
-        lx, ly = self.lx, self.ly
         t = math.log(x)
-        i = min(max(bisect_right(lx, t) - 1, 0), len(lx) - 2)
-        slope = (ly[i + 1] - ly[i]) / (lx[i + 1] - lx[i])
-        return math.exp(ly[i] + slope * (t - lx[i])), slope
+        if self._lo[0] <= t <= self._hi[0]:
+            ly, slope = self._cubic.value_and_slope(t)
+            return math.exp(ly), slope
+        t_end, ly_end, slope = self._lo if t < self._lo[0] else self._hi
+        return math.exp(ly_end + slope * (t - t_end)), slope
 
 
 def elementwise(scalar: Callable[[float], float], x):

@@ -1,6 +1,6 @@
 """Viscoelastic relaxation: E_eff(t) (Sec. 5.2) and the contact-time state phi, eq (10).
 
-`RelaxationModulus` is a table (t_s, E_Pa) interpolated linearly in log-log, and extrapolated
+`RelaxationModulus` is a table (t_s, E_Pa) interpolated in log-log (`reduced.loglog`), and extrapolated
 in log-log beyond its last sample (the relaxation continues as the last power law).
 
 t -> 0: the data start at 1 s (the DMA creep test), and a power law diverges as t -> 0, so
@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from reduced.cup import CupParameters
-from reduced.loglog import LogLogSegments, elementwise, read_two_columns
+from reduced.loglog import LogLogPchip, elementwise, read_two_columns
 
 __all__ = ["RelaxationModulus", "default_relaxation", "measurement_contact_time",
            "contact_time_rate", "PAPER_PLATE_SPEED_M_S"]
@@ -43,7 +43,7 @@ class RelaxationModulus:
     t_s: np.ndarray
     E_Pa: np.ndarray
     provenance: str = ""
-    _law: LogLogSegments = field(init=False, repr=False)
+    _law: LogLogPchip = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         t = np.array(self.t_s, dtype=float).reshape(-1)
@@ -57,7 +57,7 @@ class RelaxationModulus:
         for name, arr in (("t_s", t), ("E_Pa", E)):
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
-        object.__setattr__(self, "_law", LogLogSegments(t, E))
+        object.__setattr__(self, "_law", LogLogPchip(t, E))
 
     def modulus_and_log_slope(self, t: float) -> tuple[float, float]:
         """(E_eff(t) [Pa], d ln E / d ln t); the slope is 0 on the short-time plateau."""
