@@ -37,7 +37,13 @@ starts at kappa0 = E_eff(phi=0)/E_eff(phi0) (1.25 for cup A with the default law
 
 Liquid (fluid='water'): the cavity is full of an incompressible liquid; its volume V(h) is the
 content, p_b follows from eq (7), the inflow is eq (24). F1 leaves h at h_start (p_b drops by
-F1 / (pi r^2), possibly below zero: tension; no cavitation model) and the cup detaches at r1.
+F1 / (pi r^2), possibly below zero: tension, the paper's metastable liquid, Sec. 6) and the cup
+detaches at r1. With a cavitation pressure p_cav (e.g. water's vapour pressure, 2.34 kPa at 20 C)
+the liquid cannot go below it: if F1 would pull p_b below p_cav, a vapour bubble at p_cav opens at
+t = 0 and the cup rises at once to h_c, the lowest height where the force balance holds with
+p_b = p_cav, pi r^2 (p_a - p_cav) = F0 + F1; the liquid flows in at h_c (eq 24 with p_b = p_cav)
+until the bubble has refilled, then the cup follows the liquid branch from h_c. The largest
+holdable force is then the largest pi r^2 (p_a - p_cav) - F0 on the way to r1.
 
 Reference mode (`reference_model`): Appendix A stiffness (x0 = r0, x1 = r1, d0 = 2 mm, d1 = 0,
 E = 4 MPa), no relaxation (kappa = 1, E = 4 MPa for p/E), air at 293.15 K (eta = 1.81e-5 Pa s,
@@ -55,7 +61,7 @@ from functools import cached_property
 
 import numpy as np
 from scipy.integrate import quad
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from reduced.appendix_a import appendix_a_curve
 from reduced.cup import CupParameters
@@ -88,6 +94,8 @@ class LeakageModel:
     (r, V, l from the stiffness curve). fluid: 'air' (the gas leaks in, eqs 8, 19) or 'water' (the
     cavity is full of an incompressible liquid that flows in by eq 24; its "content" is the liquid
     volume, p_b follows from the force balance and may become negative, i.e. tension, Sec. 6).
+    cavitation_pressure_Pa: water only; None: the liquid sustains any tension (metastable); a value
+    in [0, p_a): below it a vapour bubble at that pressure opens (module docstring).
     """
 
     cup: CupParameters
@@ -101,6 +109,7 @@ class LeakageModel:
     geometry: str = "cone"
     fluid: str = "air"
     liquid_viscosity_Pa_s: float = WATER_VISCOSITY_PA_S
+    cavitation_pressure_Pa: float | None = None
     label: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
@@ -118,6 +127,13 @@ class LeakageModel:
             raise ValueError("fluid: the water-filled cavity is implemented without relaxation only")
         if not (math.isfinite(self.liquid_viscosity_Pa_s) and self.liquid_viscosity_Pa_s > 0):
             raise ValueError(f"liquid_viscosity_Pa_s: must be > 0, got {self.liquid_viscosity_Pa_s}")
+        p_cav = self.cavitation_pressure_Pa
+        if p_cav is not None:
+            if self.fluid != "water":
+                raise ValueError("cavitation_pressure_Pa: only for fluid 'water'")
+            if not (math.isfinite(p_cav) and 0.0 <= p_cav < self.p_a_Pa):
+                raise ValueError(f"cavitation_pressure_Pa: must be in [0, p_a) = [0, {self.p_a_Pa:g}) Pa, "
+                                 f"got {p_cav}")
 
     @property
     def reference(self) -> bool:
@@ -353,7 +369,7 @@ class _Core:
                                   f"curve's range [{1e3 * self.h_lo:.6g}, {1e3 * self.h_hi:.6g}] mm")
         N0 = self.n_eq(hs, kappa0, 0.0)[0]
         if self.liquid:   # incompressible: h stays at h_start when F1 is applied; p_b takes it all
-            return hs, N0, kappa0, math.inf, hs
+            return hs, N0, kappa0, self.largest_liquid_force(hs), hs
         if N0 <= 0:
             raise ValueError(f"r_start_m: the stiffness force at r_start exceeds the full vacuum force "
                              f"(no gas can be trapped); check the stiffness curve or r_start")
@@ -373,6 +389,41 @@ class _Core:
             hm = brentq(lambda x: self.holding_force(x, N0, kappa0)[1], float(hh[j - 1]), float(hh[j]),
                         xtol=1e-15 * self.h1)
         return hs, N0, kappa0, self.holding_force(hm, N0, kappa0)[0], hm
+
+    # ------------------------------------------------------------------ cavitation (water)
+    def liquid_capacity(self, h: np.ndarray) -> np.ndarray:
+        """pi r^2 (p_a - p_cav) - F0: the largest F1 the liquid holds at height h without cavitating."""
+        r = self.geo.at_array(h)[0]
+        return math.pi * r * r * (self.pa - self.m.cavitation_pressure_Pa) - self.spring_array(h)[0]
+
+    def largest_liquid_force(self, hs: float) -> float:
+        """The largest capacity on the way from h_start to r1 (inf without a cavitation pressure)."""
+        if self.m.cavitation_pressure_Pa is None:
+            return math.inf
+        h, _ = self.grid
+        hh = np.concatenate(([hs], h[h > hs]))
+        cap = self.liquid_capacity(hh)
+        j = int(np.argmax(cap))
+        if 0 < j < len(hh) - 1:       # an interior maximum: refine it between its neighbours
+            res = minimize_scalar(lambda x: -float(self.liquid_capacity(np.array([x]))[0]),
+                                  bounds=(float(hh[j - 1]), float(hh[j + 1])), method="bounded",
+                                  options={"xatol": 1e-12 * self.h1})
+            return max(float(cap[j]), -float(res.fun))
+        return float(cap[j])
+
+    def liquid_start(self, F1: float) -> float:
+        """h_c: h_start if the liquid holds F1 there with p_b >= p_cav, else the lowest height above it
+        where pi r^2 (p_a - p_cav) = F0 + F1 (a vapour bubble opens and the cup rises to it)."""
+        hs = self.geo.h_start_m
+        if self.m.cavitation_pressure_Pa is None:
+            return hs
+        cap = lambda x: float(self.liquid_capacity(np.array([x]))[0]) - F1     # noqa: E731
+        if cap(hs) >= 0.0:
+            return hs
+        h, _ = self.grid
+        hh = np.concatenate(([hs], h[h > hs]))
+        j = int(np.argmax(self.liquid_capacity(hh) >= F1))     # F1 < F_max: a crossing exists
+        return brentq(cap, float(hh[j - 1]), float(hh[j]), xtol=1e-15 * self.h1, rtol=1e-15)
 
     @cached_property
     def initial(self):
@@ -409,8 +460,8 @@ def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol
         msg = (f"F1 = {F1:g} N is at or above the largest force the cup can hold at t = 0, "
                f"{Fmax:.4g} N: it detaches at once")
         return _result(core, F1, 0.0, "over_force", msg, Fmax, N0, [0.0], [[N0, 0.0]], [hs], 0)
-    h0 = hs if core.liquid else brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
-                                       xtol=1e-15 * core.h1, rtol=1e-15)
+    h0 = core.liquid_start(F1) if core.liquid else brentq(
+        lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm, xtol=1e-15 * core.h1, rtol=1e-15)
     run = _run_reference if model.reference else _run_relaxed
     result = run(core, F1, N0, h0, Fmax, t_max_s, rtol, refine)
     if progress:
@@ -444,11 +495,14 @@ def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifeti
         return _result(core, F1, math.inf, "sealed",
                        f"u_c = 0 at h = {1e3 * sealed_at:.4g} mm on the way: the interface seals, no "
                        f"further leak", Fmax, N0, [0.0], [[N0, 0.0]], [h0], 0)
-    last = [h0, N0, core.n_eq(h0, 1.0, F1)[1]]     # last root, its N and dN_eq/dh: a predictor
+    N_h0, slope0 = core.n_eq(h0, 1.0, F1)
+    last = [h0, N_h0, slope0]     # last root, its N and dN_eq/dh: a predictor
 
     def h_of(N: float) -> float:
         if N >= N_end:
             return h_end
+        if N <= N_h0:             # water with a vapour bubble (N0 < V(h_c)): the cup waits at h_c
+            return h0
         guess = last[0] + (N - last[1]) / last[2] if last[2] > 0 else last[0]
         h, slope = core.branch_root(N, 1.0, F1, guess, h0, h_end)
         last[:] = h, N, slope
@@ -469,19 +523,51 @@ def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifeti
     # there, ~1 rtol otherwise). Fold endings are therefore integrated at rtol / 10.
     if reason == "fold":
         rtol = 0.1 * rtol
-    sol = dopri5(rhs, 0.0, [0.0], t_max, rtol, [rtol * Q_end], events=[lambda t, y: y[0] - Q_end],
+    # water with a vapour bubble: the cup waits at h_c while the bubble refills at the constant
+    # rate Ndot(h_c); that phase is exact, and integrating across its end (a kink of Ndot(N))
+    # would cost the error control ~100 rtol
+    Q_bubble = max(N_h0 - N0, 0.0) if core.liquid else 0.0
+    t_bubble = Q_bubble / Ndot0 if Q_bubble > 0 else 0.0
+    if t_bubble >= t_max:
+        return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s (the "
+                       f"vapour bubble refills at {t_bubble:.4g} s)", Fmax, N0, [0.0, t_max],
+                       [[N0, 0.0], [N0 + Ndot0 * t_max, 0.0]], [h0, h0], 0)
+    sol = dopri5(rhs, t_bubble, [Q_bubble], t_max, rtol, [rtol * Q_end],
+                 events=[lambda t, y: y[0] - Q_end],
                  h0=1e-2 * Q_end / Ndot0 if Ndot0 > 0 else None, dense_output=refine > 1)
     ts, ys = _outputs(sol, refine)
+    if Q_bubble > 0:
+        ts, ys = [0.0] + ts, [[0.0]] + ys
     ys = [[N0 + y[0], 0.0] for y in ys]
     if sol.event is not None:
         ys[-1][0] = N_end      # the event is N = N_end; only its time is interpolated
-    last[:] = h0, N0, core.n_eq(h0, 1.0, F1)[1]
+    last[:] = h0, N_h0, slope0
     hs = [h_of(y[0]) for y in ys]
+    bubble = _cavitation_note(core, F1, N0, h0, N_h0)
     if sol.event is None:
-        return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s",
+        return _result(core, F1, math.inf, "horizon", f"still attached at t_max = {t_max:g} s" + bubble,
                        Fmax, N0, ts, ys, hs, sol.steps)
-    return _result(core, F1, ts[-1], reason, _end_message(reason, ts[-1]), Fmax, N0, ts, ys,
+    return _result(core, F1, ts[-1], reason, _end_message(reason, ts[-1]) + bubble, Fmax, N0, ts, ys,
                    hs, sol.steps)
+
+
+def _cavitation_note(core: _Core, F1: float, N0: float, h0: float, N_h0: float) -> str:
+    """Water with a cavitation pressure: what the bubble did (empty if none opened). On the liquid
+    branch beyond h_c, p_b must stay >= p_cav: a second cavitation is not modelled, so it is an error."""
+    p_cav = core.m.cavitation_pressure_Pa
+    if not core.liquid or p_cav is None:
+        return ""
+    h, _ = core.grid
+    beyond = np.concatenate(([h0], h[h > h0]))
+    short = core.liquid_capacity(beyond) < F1 * (1 - 1e-9)
+    if short.any():
+        raise RuntimeError(f"cavitation: p_b falls below p_cav = {p_cav:g} Pa again at h = "
+                           f"{1e3 * beyond[short][0]:.4g} mm, after the cup has passed h_c = "
+                           f"{1e3 * h0:.4g} mm; a second cavitation is not modelled")
+    if N_h0 <= N0:
+        return ""
+    return (f"; cavitation at t = 0: a vapour bubble of {1e9 * (N_h0 - N0):.4g} mm^3 at "
+            f"{p_cav:g} Pa let the cup rise to h_c = {1e3 * h0:.4g} mm")
 
 
 def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> LifetimeResult:
@@ -627,8 +713,8 @@ def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 
     hs, N0, kappa0, Fmax, hm = core.initial
     if F1 >= Fmax:
         return 0.0
-    h0 = hs if core.liquid else brentq(lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm,
-                                       xtol=1e-15 * core.h1, rtol=1e-15)
+    h0 = core.liquid_start(F1) if core.liquid else brentq(
+        lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm, xtol=1e-15 * core.h1, rtol=1e-15)
     h_end, _ = core.branch_end(h0, 1.0, F1)
 
     def integrand(h: float) -> float:
@@ -638,8 +724,11 @@ def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 
 
     if _sealed_on_branch(core, h0, h_end, F1) is not None:
         return math.inf
+    t_bubble = 0.0
+    if core.liquid and N0 < core.n_eq(h0, 1.0, F1)[0]:    # the vapour bubble refills at h_c
+        t_bubble = (core.n_eq(h0, 1.0, F1)[0] - N0) / core.state(h0, N0, 1.0, core.m.E_Pa, F1)[0]
     # the PCHIP breakpoints are kinks of higher derivatives: hand them to quad
     knots = sorted(x for x in (core.h1 - u for u in core.F0.x) if h0 < x < h_end)
     t, err = quad(integrand, h0, h_end, epsabs=0.0, epsrel=epsrel, limit=4 * len(knots) + 200,
                   points=knots[:: max(1, len(knots) // 100)] or None)
-    return t
+    return t_bubble + t

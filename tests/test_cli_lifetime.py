@@ -63,6 +63,8 @@ def test_out_writes_trajectories_atomically(capsys, tmp_path):
     (["--E-MPa", "0"], "--E-MPa: modulus must be > 0 MPa"),
     (["--fluid", "water", "--relaxation", "default"], "fluid: the water-filled cavity"),
     (["--reference-mode", "--fluid", "water"], "--reference-mode: fixes --fluid"),
+    (["--cavitation-kPa", "2.34"], "--cavitation-kPa: only with --fluid water"),
+    (["--fluid", "water", "--cavitation-kPa", "100"], "--cavitation-kPa: must be in [0, p_a) = [0, 100) kPa"),
 ])
 def test_bad_input_exits_2_with_one_line_and_no_output(capsys, tmp_path, argv, message):
     out = tmp_path / "out"

@@ -250,3 +250,55 @@ def test_curve_geometry_with_a_vanishing_strip_width_is_an_input_error():
     model = dataclasses.replace(REF_A, stiffness=curve, geometry="curve")
     with pytest.raises(ValueError, match="l_mm: .* strip width is 0"):
         lifetime(model, 20.0)
+
+
+def test_water_cavitation_against_a_hand_written_bubble_ode():
+    """With a cavitation pressure the liquid cannot pull p_b below it: a vapour bubble opens at t = 0,
+    the cup rises to h_c where pi r^2 (p_a - p_cav) = F0 + F1, waits there while the liquid
+    refills the bubble, then follows the liquid branch to r1. Written out here with scipy: the
+    state is the liquid volume V_L, h = max(h(V_L), h_c) by inverting eq (4) by hand."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq
+    c, p_cav, F1 = CUP_A, 2339.0, 60.0
+    water = dataclasses.replace(REF_A, fluid="water", cavitation_pressure_Pa=p_cav)
+    radius = lambda h: c.r0_m * (1 + h / c.h0_m)                                 # eq (3)  # noqa: E731
+    volume = lambda h: math.pi * c.r0_m ** 2 * c.h0_m / 3 * ((radius(h) / c.r0_m) ** 3 - 1)  # noqa: E731
+    height = lambda V: c.h0_m * ((1 + 3 * V / (math.pi * c.r0_m ** 2 * c.h0_m)) ** (1 / 3) - 1)  # noqa: E731
+    F0 = lambda h: appendix_a_force(c.h1_m - h, 33.0, 4e6, 2e-3, c.r0_m, c.r1_m)  # noqa: E731
+    hc = brentq(lambda h: math.pi * radius(h) ** 2 * (1e5 - p_cav) - F0(h) - F1, c.h_start_m, c.h1_m,
+                xtol=1e-16)
+
+    def Vdot(t, y):
+        h = max(height(y[0]), hc)
+        rr = radius(h)
+        pb = 1e5 - (F0(h) + F1) / (math.pi * rr ** 2)                             # = p_cav at h_c
+        l = c.contact_width(rr)
+        p = F0(h) / (2 * math.pi * rr * l) + 0.8 * (1e5 - pb)
+        uc = 0.68e-6 * 0.025 / (p / 4e6)
+        return [(2 * math.pi * rr / l) * uc ** 3 * (1e5 - pb) / (12 * 1.002e-3)]  # eq (24)
+
+    top = lambda t, y: y[0] - volume(c.h1_m)                                     # noqa: E731
+    top.terminal = True
+    sol = solve_ivp(Vdot, (0, 1e9), [volume(c.h_start_m)], method="LSODA", rtol=1e-10, atol=1e-15,
+                    events=top)
+    r = lifetime(water, F1)
+    assert r.reason == "reached_r1" and "cavitation at t = 0" in r.message
+    assert r.h_m[0] == pytest.approx(hc, rel=1e-9) and r.p_b_Pa[0] == pytest.approx(p_cav, rel=1e-6)
+    # PCHIP of the Appendix A force (1e-7) and the integration at rtol 1e-6
+    assert r.lifetime_s == pytest.approx(sol.t_events[0][0], rel=1e-5)
+    assert lifetime_by_quadrature(water, F1) == pytest.approx(r.lifetime_s, rel=1e-4)
+    # it shortens the metastable (tension) lifetime; below the cavitation load nothing changes
+    assert r.lifetime_s < lifetime(dataclasses.replace(water, cavitation_pressure_Pa=None), F1).lifetime_s
+    low = lifetime(water, 20.0)
+    assert low.p_b_Pa[0] > p_cav and "cavitation" not in low.message
+    # the largest holdable force: the capacity at r1, where F0 = 0
+    assert largest_holdable_force(water) == pytest.approx(math.pi * c.r1_m ** 2 * (1e5 - p_cav), rel=1e-9)
+    assert lifetime(water, 111.0).reason == "over_force"
+
+
+@pytest.mark.parametrize("kw,match", [({"cavitation_pressure_Pa": 2339.0}, "only for fluid 'water'"),
+                                      ({"fluid": "water", "cavitation_pressure_Pa": -1.0}, r"\[0, p_a\)"),
+                                      ({"fluid": "water", "cavitation_pressure_Pa": 1e5}, r"\[0, p_a\)")])
+def test_bad_cavitation_pressure_is_rejected(kw, match):
+    with pytest.raises(ValueError, match="cavitation_pressure_Pa: .*" + match):
+        dataclasses.replace(REF_A, **kw)

@@ -69,6 +69,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--liquid-viscosity-Pa-s", dest="liquid_viscosity", type=float, default=1.002e-3,
                    help="viscosity of the liquid in Pa s for --fluid water "
                         "(default: 1.002e-3, water at 20 C)")
+    p.add_argument("--cavitation-kPa", dest="cavitation_kPa", type=float, default=None,
+                   help="for --fluid water: the pressure in kPa below which the liquid cavitates (a "
+                        "vapour bubble at that pressure opens and the cup rises); water's vapour "
+                        "pressure is 2.34 kPa at 20 C (default: none, the liquid sustains tension)")
     p.add_argument("--T-K", dest="T_K", type=float, default=293.15, help="temperature in K (default: 293.15)")
     p.add_argument("--p-a-Pa", dest="p_a_Pa", type=float, default=1e5,
                    help="ambient pressure in Pa (default: 1e5)")
@@ -123,12 +127,19 @@ def build_model(args: argparse.Namespace):
             ("--d0-mm", args.d0_mm, 2.0), ("--relaxation", args.relaxation, "none"),
             ("--geometry", args.geometry, "cone"), ("--T-K", args.T_K, 293.15),
             ("--p-a-Pa", args.p_a_Pa, 1e5), ("--phi0-s", args.phi0_s, None),
-            ("--fluid", args.fluid, "air")) if val != default]
+            ("--fluid", args.fluid, "air"), ("--cavitation-kPa", args.cavitation_kPa, None))
+            if val != default]
         if changed:
             raise ValueError(f"--reference-mode: fixes {', '.join(changed)}; drop them")
         return reference_model(cup, uc)
     if not (math.isfinite(args.E_MPa) and args.E_MPa > 0):
         raise ValueError(f"--E-MPa: modulus must be > 0 MPa, got {args.E_MPa:g}")
+    p_cav = args.cavitation_kPa
+    if p_cav is not None and args.fluid != "water":
+        raise ValueError("--cavitation-kPa: only with --fluid water")
+    if p_cav is not None and not (math.isfinite(p_cav) and 0 <= 1e3 * p_cav < args.p_a_Pa):
+        raise ValueError(f"--cavitation-kPa: must be in [0, p_a) = [0, {args.p_a_Pa / 1e3:g}) kPa, "
+                         f"got {p_cav:g}")
     if args.stiffness == "appendix-a":
         if not (math.isfinite(args.d0_mm) and args.d0_mm > 0):
             raise ValueError(f"--d0-mm: wall thickness must be > 0 mm, got {args.d0_mm:g}")
@@ -145,7 +156,8 @@ def build_model(args: argparse.Namespace):
     model = LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
                          E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
                          geometry=args.geometry, fluid=args.fluid,
-                         liquid_viscosity_Pa_s=args.liquid_viscosity)
+                         liquid_viscosity_Pa_s=args.liquid_viscosity,
+                         cavitation_pressure_Pa=None if p_cav is None else 1e3 * p_cav)
     largest_holdable_force(model)   # builds the start state: checks geometry and curve range now
     return model
 
