@@ -25,7 +25,7 @@ pointwise profile is the lumped projection p_a = lambda_a / sum_b M_ab, which is
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -51,16 +51,14 @@ def _shape(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class ContactState:
-    """Which candidate nodes are on the plane, and (sticking) their frozen radial displacement."""
+    """Which candidate nodes are held on the plane, and (sticking) their frozen radial displacement."""
 
     active: np.ndarray         # bool [ncand]
     u_r_stick: np.ndarray      # float [ncand], meaningful where active
-    slipping: np.ndarray | None = None   # bool [ncand]: sticking law, node may slide this step
 
     def key(self) -> bytes:
-        """Identity of the set for cycle detection."""
-        slip = self.slipping if self.slipping is not None else np.zeros_like(self.active)
-        return self.active.tobytes() + slip.tobytes()
+        """Identity of the set."""
+        return self.active.tobytes()
 
 
 @dataclass(frozen=True)
@@ -104,6 +102,15 @@ class RigidPlane:
         if self.exclude is not None:
             nodes = np.setdiff1d(nodes, self.exclude)
         object.__setattr__(self, "nodes", nodes)
+        # neighbours along the boundary (vertex - midpoint - vertex), among the candidates
+        index = np.full(mesh.doflocs.shape[1], -1)
+        index[nodes] = np.arange(len(nodes))
+        i, j = index[np.concatenate([fn[0], fn[2]])], index[np.concatenate([fn[2], fn[1]])]
+        ok = (i >= 0) & (j >= 0)
+        adj = sp.coo_matrix((np.ones(2 * ok.sum()), (np.concatenate([i[ok], j[ok]]),
+                                                    np.concatenate([j[ok], i[ok]]))),
+                            shape=(len(nodes), len(nodes))).tocsr()
+        object.__setattr__(self, "_adjacency", adj)
 
     @classmethod
     def on(cls, kin: Kinematics, boundaries: list[str], exclude: list[str] = (),
@@ -120,7 +127,7 @@ class RigidPlane:
     # --- the state -----------------------------------------------------------------------
     def initial_state(self) -> ContactState:
         n = len(self.nodes)
-        return ContactState(np.zeros(n, bool), np.zeros(n), np.zeros(n, bool))
+        return ContactState(np.zeros(n, bool), np.zeros(n))
 
     def gap(self, u: np.ndarray) -> np.ndarray:
         """Signed nodal gap g = Z + u_z [m] (negative: penetration)."""
@@ -132,62 +139,63 @@ class RigidPlane:
         dofs = [2 * self.nodes[a] + 1]
         vals = [-self.kin.node_coordinates()[1, self.nodes[a]]]
         if self.law == "sticking":
-            stuck = np.flatnonzero(state.active & ~state.slipping)
-            dofs.append(2 * self.nodes[stuck])
-            vals.append(state.u_r_stick[stuck])
+            dofs.append(2 * self.nodes[a])
+            vals.append(state.u_r_stick[a])
         return np.concatenate(dofs), np.concatenate(vals)
 
     def reactions(self, r_int: np.ndarray) -> np.ndarray:
         """Nodal normal reactions lambda_a [N] (> 0: the plane pushes up) = internal force at z-dofs."""
         return r_int[2 * self.nodes + 1]
 
-    def update(self, state: ContactState, u: np.ndarray, r_int: np.ndarray,
-               u_start: np.ndarray, stiffness: np.ndarray | None = None) -> ContactState:
-        """One primal-dual active-set update (module docstring). u_start: last converged state,
-        used to locate the touchdown point of newly active nodes for the sticking law.
+    def project(self, u: np.ndarray, u_start: np.ndarray, state: ContactState,
+                on_plane: np.ndarray) -> np.ndarray:
+        """The nearest admissible displacement: the `on_plane` nodes exactly on the plane (those
+        held by `state` where it holds them), and every other penetrating node (g < 0) put back on
+        the plane. For the sticking law such a landing node is put where it touched down,
+        interpolated linearly in the load step between u_start (gap g0 > 0) and u (gap < 0); a node
+        that was on the plane at the step start (g0 = 0) lands where u puts it."""
+        out = u.copy()
+        nodes, Z = self.nodes, self.kin.node_coordinates()[1, self.nodes]
+        g = self.gap(u)
+        land = ~on_plane & (g < 0.0)
+        out[2 * nodes[on_plane | land] + 1] = -Z[on_plane | land]
+        if self.law == "sticking":
+            held = on_plane & state.active
+            out[2 * nodes[held]] = state.u_r_stick[held]
+            if np.any(land):
+                g0 = self.gap(u_start)[land]
+                t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g[land], 1e-300), 1.0)
+                ur0, ur1 = u_start[2 * nodes[land]], u[2 * nodes[land]]
+                out[2 * nodes[land]] = ur0 + np.clip(t, 0.0, 1.0) * (ur1 - ur0)
+        return out
 
-        With `stiffness` (the tangent's diagonal), only the single worst violation changes: the
-        largest of the penetration -g and the tensile reaction over the dof stiffness, -lambda/k."""
-        g, lam = self.gap(u), self.reactions(r_int)
-        active = np.where(state.active, lam >= 0.0, g < 0.0)
-        if stiffness is not None:
-            k = stiffness[2 * self.nodes + 1]
-            violation = np.where(state.active, -lam / k, -g)
-            active = state.active.copy()
-            worst = int(np.argmax(violation))
-            if violation[worst] > 0:
-                active[worst] = not active[worst]
-        return self.activate(replace(state, active=active & state.active,
-                                     slipping=state.slipping & active),
-                             active & ~state.active, u, u_start)
-
-    def activate(self, state: ContactState, nodes: np.ndarray, u: np.ndarray,
-                 u_start: np.ndarray) -> ContactState:
-        """Put `nodes` on the plane; newly active ones stick (sticking law) at their touchdown
-        point, interpolated linearly in the step between u_start (gap g0 > 0) and u (gap < 0);
-        a node that was on the plane at the step start (g0 = 0), lifted off during the iteration
-        and lands again, lands where the iterate puts it."""
-        new = nodes & ~state.active
+    def hold(self, state: ContactState, active: np.ndarray, u: np.ndarray, u_start: np.ndarray,
+             u_free: np.ndarray, released: np.ndarray) -> ContactState:
+        """The state holding `active`. Sticking law: a node held anew sticks where it touched
+        down, interpolated linearly in the load step between u_start (gap g0) and its free
+        flight u_free (the iterate it would reach unsupported, gap g1 < 0), at t = g0 / (g0 - g1);
+        so a node resting on the plane at the step start (g0 = 0, e.g. the rim corner at u = 0)
+        does not slide. A node `released` in this step (its reaction turned tensile: no
+        friction can hold it) lands again where u puts it: it has slipped. If its free flight
+        does not reach the plane, a node lands where u puts it."""
+        new = active & ~state.active
         stick = state.u_r_stick.copy()
-        if np.any(new):
-            g, g0 = self.gap(u)[new], self.gap(u_start)[new]
-            t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g, 1e-300), 1.0)
-            ur0, ur1 = u_start[2 * self.nodes[new]], u[2 * self.nodes[new]]
-            stick[new] = ur0 + np.clip(t, 0.0, 1.0) * (ur1 - ur0)
-        return replace(state, active=state.active | nodes, u_r_stick=stick)
+        if self.law == "sticking" and np.any(new):
+            nodes = self.nodes[new]
+            g0, g1 = self.gap(u_start)[new], self.gap(u_free)[new]
+            fly = (g1 < 0.0) & ~released[new]
+            t = np.where(fly, np.clip(g0, 0.0, None) / np.maximum(g0 - g1, 1e-300), 1.0)
+            r1 = np.where(fly, u_free[2 * nodes], u[2 * nodes])
+            stick[new] = u_start[2 * nodes] + np.clip(t, 0.0, 1.0) * (r1 - u_start[2 * nodes])
+        return ContactState(active, stick)
 
-    def let_slip(self, state: ContactState, nodes: np.ndarray) -> ContactState:
-        """Sticking law, a node cycling between stuck-with-tension and lift-off-into-penetration
-        within a step: its normal force is zero to within the step, so no friction can hold it
-        (Coulomb with zero normal force); keep it on the plane, free to slide, for this step."""
-        return replace(state, active=state.active | nodes, slipping=state.slipping | nodes)
-
-    def settle(self, state: ContactState, u: np.ndarray) -> ContactState:
-        """End of a converged step: slipping nodes stick where they are now."""
-        if not np.any(state.slipping):
-            return state
-        stick = np.where(state.slipping, u[2 * self.nodes], state.u_r_stick)
-        return replace(state, u_r_stick=stick, slipping=np.zeros_like(state.slipping))
+    def near_front(self, state: ContactState, hops: int = 3) -> np.ndarray:
+        """Held nodes within `hops` boundary neighbours of a free candidate: where the contact
+        zones end, the nodes whose contact the linearized problem may release."""
+        reach = ~state.active
+        for _ in range(hops):
+            reach = reach | (self._adjacency @ reach.astype(float) > 0)
+        return state.active & reach
 
     # --- post-processing -----------------------------------------------------------------
     def _positions(self, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:
