@@ -1,19 +1,22 @@
-"""Contact with the rigid plane z = 0: a node-based primal-dual active set, no penalty parameter.
+"""Contact with the rigid plane z = 0: node-based Signorini conditions, no penalty parameter.
 
 Every boundary node that may touch the plane (all boundary nodes except those clamped to the top
-plate) is a candidate. An *active* node is held exactly on the plane, z = Z + u_z = 0, by
+plate) is a candidate. A *held* (active) node is kept exactly on the plane, z = Z + u_z = 0, by
 eliminating its vertical dof like a Dirichlet condition; for ``"sticking"`` contact its radial
-displacement is also frozen at the value it had when it touched down. The nodal contact reaction
-lambda_a (the internal force at the eliminated dof, > 0 when the plane pushes) is what the
-constraint costs. Inside Newton (a semi-smooth Newton / primal-dual active-set iteration):
+displacement is also frozen where it touched down. The nodal contact reaction lambda_a (the
+internal force at the eliminated dof, > 0 when the plane pushes) is what the constraint costs.
+Which nodes are held is decided inside each Newton step by a small linear complementarity
+problem (`fem.solver`): the nodes the step would push through the plane and the held nodes it
+would pull on; `project` puts any node that still penetrates back on the plane, `hold` records
+the new set. A converged step satisfies g >= 0, lambda >= 0, g lambda = 0 at the nodes (to the
+Newton tolerance), so there is no enforcement parameter whose value could change the result.
+Between nodes the quadratic edge may dip below the plane; `largest_penetration` reports the
+largest such violation.
 
-    inactive -> active   if the node penetrates, gap g_a = Z_a + u_z,a < 0,
-    active   -> inactive if its reaction turns tensile, lambda_a < 0 (the node lifts off),
-
-and a load step is converged only when the active set no longer changes. The solution satisfies
-the Signorini conditions g >= 0, lambda >= 0, g lambda = 0 exactly at the nodes, so there is no
-enforcement parameter whose value could change the result. Between nodes the quadratic edge may
-dip below the plane; `largest_penetration` reports the largest such violation.
+Sticking: a node that lands sticks at its touchdown point, interpolated linearly in the load
+step between the step's start and its free flight (`hold`); a held node whose reaction turns
+tensile is released (it carries no normal force, so no friction holds it) and lands again where
+the iteration puts it: it has slipped.
 
 The contact pressure p is the L2 projection, on the deformed contact boundary (weight 2 pi r ds),
 of the nodal reactions: M p = lambda over the facets touching an active node. With the consistent

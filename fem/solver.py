@@ -1,21 +1,39 @@
-"""Quasi-static path following: adaptive load steps, a secant predictor, Newton with line search.
+"""Quasi-static path following: adaptive load steps, Newton with a contact QP and an energy line search.
 
 The body is loaded by a parameter t (the plate displacement for the cup, a load factor elsewhere)
 that enters through prescribed displacements ``dirichlet(t) -> (dofs, values)`` and optionally an
-external force ``f_ext(t)``. Contact with a `RigidPlane` adds the active-set constraints.
+external force ``f_ext(t)``. Contact with a `RigidPlane` adds unilateral constraints g_a >= 0.
 
-Each step t0 -> t1 starts from the secant predictor u1 = u0 + (t1 - t0)/(t0 - t_prev) (u0 - u_prev)
-and iterates Newton on the free dofs (prescribed and active-contact dofs eliminated). The step has
-converged when
+Every load step solves the equilibrium at t1 as the minimum of the total energy
+Pi(u) = W(u) - f_ext . u over the admissible set (the prescribed values, g >= 0, and for the
+sticking law the frozen radial positions of the nodes held on the plane). Newton's method on it:
 
-* the active contact set did not change in the last iteration and all constraints hold,
-* the free residual satisfies ||r_f|| <= rtol * max(||reactions||, f_floor), and
-* the energy norm of the last correction |du . r_f| <= etol * f_ref * max|u| (the work scale).
+* Predictor: the converged state u0; the first iteration imposes the prescribed increment
+  through the tangent (a tangent predictor, which sees the contact; a secant extrapolation of u
+  pushed the contact front through the plane and then released it node by node).
+* Step: the quadratic model of Pi minimized on the free dofs (prescribed and held contact dofs
+  eliminated, K_ff factored once, `fem.linsolve`) subject to the linearized contact conditions
+  g_a + du_z,a >= 0 of the free nodes the unconstrained step would push through the plane, and
+  of the held nodes whose linearized reaction lambda_a + (K du)_z,a would turn tensile. With the
+  columns K_ff^-1 e_a of those m nodes this is the small LCP lambda >= 0, w = q + S lambda >= 0,
+  lambda . w = 0 (S = E^T K_ff^-1 E), solved exactly by non-negative least squares: the whole
+  contact front moves in one iteration. Nodes pressed (lambda > 0) are held afterwards; held
+  nodes the LCP lets go are released.
+* Line search: along the projected path P(u + a du) (penetrating nodes put back on the plane),
+  backtracking until the Armijo condition on Pi holds. The energy decreases at every iteration,
+  so the contact set cannot cycle.
+* Instability: if K_ff is not positive definite (buckling, a wall lifting off the plane), the
+  diagonal is shifted, K_ff + s diag(K_ff) (Levenberg-Marquardt), the direction then descends,
+  and the iteration follows the energy down to the next stable state (this may take tens of
+  iterations, hence max_iterations = 100). When it still fails, the step is first enlarged (2x,
+  4x the last good step) to jump across the limit point, then halved. The energy such jumps lose,
+  W0 + work - W1 summed over the steps, is reported as `SolverStats.dissipated_J`.
 
-A line search along the Newton direction (secant on the energy slope s(a) = du . r_f(u + a du))
-is taken when the slope does not drop below 0.8 |s(0)|, or when an element would invert. A step
-that fails is cut back (halved); when the step falls below ``min_step`` a `ConvergenceError`
-reports the step, the residual history and the likely cause. Nothing is accepted silently.
+The step has converged when the prescribed values hold, no held node pulls on the plane beyond
+the tolerance, ||r_f|| <= rtol * max(||reactions||, f_floor), and the energy norm of the next
+correction |du . r| <= etol * f_ref * max|u| (the work scale). A step that fails is cut back
+(halved); when the step falls below ``min_step`` a `ConvergenceError` reports the step, the
+residual history and the likely cause. Nothing is accepted silently.
 """
 
 from __future__ import annotations
@@ -43,14 +61,16 @@ class SolverOptions:
 
     rtol: float = 1e-6          # residual / reaction
     etol: float = 1e-12         # energy norm of the correction / work scale f_ref max|u|
-    max_iterations: int = 25
+    max_iterations: int = 100   # a step that follows an instability descends for many iterations
     initial_step: float = 0.01  # first step as a fraction of t_max
     max_step: float = 0.05      # largest step as a fraction of t_max (resolution of the curve)
     min_step: float = 1e-5      # smallest step as a fraction of t_max before giving up
     growth: float = 1.5         # step growth after an easy step (<= easy_iterations)
     easy_iterations: int = 6
-    active_set_rtol: float = 1e-3   # residual / reaction below which the contact set is revisited
-    max_active_sets: int = 40       # distinct contact sets tried in one step before giving up
+    # unused since the contact set is solved for in every Newton step (module docstring); kept
+    # so that option sets written for the earlier active-set iteration still validate
+    active_set_rtol: float = 1e-3
+    max_active_sets: int = 40
 
     def __post_init__(self) -> None:
         for name in ("rtol", "etol", "initial_step", "max_step", "min_step", "active_set_rtol"):
@@ -71,6 +91,8 @@ class SolverStats:
     wall_time_s: float
     dofs: int
     unstable_steps: int = 0     # steps whose tangent was not positive definite on the way (buckling)
+    dissipated_J: float = 0.0   # sum over steps of W0 + work - W1: jumps across instabilities
+    #                             (snap-through), sticking-law slips, and the O(dt^3) trapezoid error
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,9 +107,9 @@ class StepResult:
 
 
 class _StepFailure(Exception):
-    def __init__(self, cause: str, history: list[float]):
+    def __init__(self, cause: str, history: list[float], indefinite: bool = False):
         super().__init__(cause)
-        self.cause, self.history = cause, history
+        self.cause, self.history, self.indefinite = cause, history, indefinite
 
 
 def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, np.ndarray]],
@@ -109,21 +131,27 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     solver = BandedCholesky(mech.linearize(u0)[1], mech.kin.node_coordinates())
     if on_step:
         on_step(StepResult(0.0, u0, r0, state, 0))
-    t, u_prev, t_prev = 0.0, None, None
-    dt = options.initial_step * t_max
-    steps = iterations = cutbacks = unstable = 0
+    t, W0 = 0.0, mech.energy(u0)
+    dt = dt_ok = options.initial_step * t_max
+    steps = iterations = cutbacks = unstable = jumps = 0
+    dissipated = 0.0
     while t < t_max * (1 - 1e-12):
         t1 = min(t + dt, t_max)
         if t_max - t1 < 0.2 * dt:          # don't leave a sliver at the end
             t1 = t_max
-        guess = u0
         try:
-            u1, r1, state1, its, indefinite = _newton(mech, dirichlet, f_ext, plane, state, u0, guess,
+            u1, r1, state1, its, indefinite = _newton(mech, dirichlet, f_ext, plane, state, u0, u0,
                                                       t1, options, solver)
         except _StepFailure as fail:
             cutbacks += 1
             iterations += len(fail.history)
-            dt *= 0.5
+            if fail.indefinite and jumps < _JUMPS:
+                # a structural instability: smaller steps only creep up to the limit point, so
+                # first try to step across it (the path jumps; the energy it loses is reported)
+                jumps += 1
+                dt = dt_ok * 2.0**jumps
+                continue
+            dt = (dt if not fail.indefinite else min(dt, dt_ok)) * 0.5
             if dt < options.min_step * t_max:
                 raise ConvergenceError(
                     f"load step {steps + 1} from {name} = {t:.6g} to {t1:.6g} did not converge "
@@ -135,19 +163,45 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         steps += 1
         iterations += its
         unstable += indefinite
-        u_prev, t_prev, u0, state, t = u0, t, u1, state1, t1
+        W1 = mech.energy(u1)
+        dissipated += W0 + _work(dirichlet, f_ext, t, t1, u0, u1, r0, r1) - W1
+        u0, r0, W0, state, t, jumps = u1, r1, W1, state1, t1, 0
+        dt_ok = min(dt, t_max - t) if t < t_max else dt
         if on_step:
             on_step(StepResult(t, u1, r1, state1, its))
         if progress:
             progress(t / t_max, f"step {steps}: {name} = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:
             dt = min(dt * options.growth, options.max_step * t_max)
-    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n), unstable)
+        dt = min(dt, options.max_step * t_max)
+    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n), unstable,
+                       dissipated)
+
+
+_JUMPS = 2          # attempts to step across an instability (2x, 4x the last good step)
+
+
+def _work(dirichlet, f_ext, t0, t1, u0, u1, r0, r1) -> float:
+    """Work done on the body in the step t0 -> t1 by the prescribed displacements (their
+    reactions, r_int at those dofs) and by f_ext, by the trapezoidal rule [J]."""
+    d0, v0 = dirichlet(t0)
+    d1, v1 = dirichlet(t1)
+    work = 0.5 * (r0[d1] + r1[d1]) @ (v1 - v0) if np.array_equal(d0, d1) else 0.0
+    return work + 0.5 * (f_ext(t0) + f_ext(t1)) @ (u1 - u0)
 
 
 def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver):
     """Newton iterations of one step with a contact QP per iteration (module docstring);
     returns (u, r_int, contact state, iterations, whether the tangent was indefinite on the way)."""
+    flags = {"indefinite": False}
+    try:
+        return _iterate(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver, flags)
+    except _StepFailure as fail:
+        fail.indefinite = flags["indefinite"]
+        raise
+
+
+def _iterate(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver, flags):
     n = mech.kin.ndofs
     fixed_dofs, fixed_vals = dirichlet(t)
     fext = f_ext(t)
@@ -171,6 +225,7 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solve
         step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref)
         shift = step.solve(solver, K, shift, history)
         indefinite |= shift > 0.0
+        flags["indefinite"] = indefinite
         energy = abs(step.du @ res)
         e_ref = f_ref * max(np.max(np.abs(u)), np.max(np.abs(step.du)), 1e-9 * _size(mech))
         held = not np.any(du_fixed)
@@ -179,9 +234,9 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solve
             return u, r, state, it, indefinite
         it += 1
         if it >= opts.max_iterations:
-            raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely "
-                               "cause: a structural instability (snap-through/buckling) that the "
-                               "step jumps across, or a too-large step", history)
+            raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely cause: a "
+                               "structural instability (snap-through/buckling) that the step jumps "
+                               "across, or a too-large step", history)
         u_prev = u
         alpha, u, Pi, r, K, shift = _line_search(mech, solver, step, u_start, u, Pi, res, K, fext,
                                                  shift, held, history)
@@ -192,9 +247,10 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solve
 
 class _Step:
     """The Newton step of one iterate: the quadratic model of the energy minimized on the free
-    dofs subject to the linearized contact conditions g_a + du_z,a >= 0 of the free nodes that it
-    would push through the plane (a small QP, module docstring); and the held nodes whose
-    linearized reaction after the step, lambda + (K du)_z, is tensile, to be released."""
+    dofs subject to the linearized contact conditions g_a + du_z,a >= 0 (a small QP, module
+    docstring) of the free nodes it would push through the plane and of the held nodes whose
+    linearized reaction lambda + (K du)_z would turn tensile (these are freed in K_ff, if it
+    stays positive definite without them)."""
 
     def __init__(self, plane, state, u, res, free, du_fixed, tol):
         self.plane, self.state, self.u, self.res, self.du_fixed = plane, state, u, res, du_fixed
@@ -202,17 +258,37 @@ class _Step:
 
     def solve(self, solver, K, shift, history) -> float:
         """Factor (with a diagonal shift if K_ff is not positive definite), solve, and add
-        contact constraints until no free candidate penetrates. Returns the shift used."""
+        contact constraints until no free candidate penetrates; then let the held nodes the
+        step would pull on take part. Returns the shift used."""
         fac, shift = _factor(solver, K, self.free, shift, history)
-        du0 = fac.solve(-self.res, self.du_fixed)
-        self.du, self.du0, self.qp, self.lam = du0, du0, np.zeros(0, int), np.zeros(0)
+        self._constrained(fac, np.zeros(0, int))
         if self.plane is None:
             return shift
         zdof = 2 * self.plane.nodes + 1
+        tensile = self.state.active & ((self.res + K @ self.du)[zdof] < -self.tol)
+        self.release = np.zeros_like(tensile)
+        if tensile.any():
+            free = self.free.copy()
+            free[zdof[tensile]] = True
+            # without them K_ff may be indefinite (the contact held the structure): shifted
+            fac, shift = _factor(solver, K, free, 10.0 * shift, history)
+            self._constrained(fac, np.flatnonzero(tensile))
+            self.release = tensile
+        return shift
+
+    def _constrained(self, fac, candidates: np.ndarray) -> None:
+        """du0 = -K_ff^-1 r, then the LCP of `candidates` and every free node that du penetrates."""
+        du0 = fac.solve(-self.res, self.du_fixed)
+        self.du, self.du0, self.qp, self.lam = du0, du0, np.zeros(0, int), np.zeros(0)
+        if self.plane is None:
+            return
+        zdof = 2 * self.plane.nodes + 1
         g = self.plane.gap(self.u)
+        add = np.zeros(len(g), bool)
+        add[candidates] = True
         cols = np.zeros((len(du0), 0))
         for _ in range(20):
-            add = ~self.state.active & (g + self.du[zdof] < 0.0)
+            add |= ~self.state.active & (g + self.du[zdof] < 0.0)
             add[self.qp] = False
             if not add.any():
                 break
@@ -224,24 +300,23 @@ class _Step:
             S = cols[zdof[self.qp]]
             self.lam = _lcp(0.5 * (S + S.T), g[self.qp] + du0[zdof[self.qp]])
             self.du = du0 + cols @ self.lam
-        reaction = (self.res + K @ self.du)[zdof]
-        self.release = self.state.active & (reaction < -self.tol)
-        return shift
+            add[:] = False
 
     def holds(self, alpha: float) -> np.ndarray:
-        """The held set after a step of length alpha: the held nodes less the released ones, and
-        after a full step the QP nodes it presses onto the plane (lambda > 0)."""
+        """The held set after a step of length alpha: the held nodes outside the QP, those in
+        it that stay pressed (lambda > 0), and after a full step the free nodes it presses
+        onto the plane."""
         active = self.state.active & ~self.release
+        pressed = self.qp[self.lam > 0.0]
         if alpha == 1.0:
-            active[self.qp[self.lam > 0.0]] = True
+            active[pressed] = True
+        else:
+            active[pressed] = self.state.active[pressed]
         return active
 
     def on_plane(self, alpha: float) -> np.ndarray:
         """Nodes the step puts exactly on the plane (round-off of g + du_z = 0 removed)."""
-        active = self.state.active.copy()
-        if alpha == 1.0:
-            active[self.qp[self.lam > 0.0]] = True
-        return active
+        return self.holds(alpha)
 
 
 def _lcp(S, q):
