@@ -175,7 +175,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             dt = min(dt * options.growth, options.max_step * t_max)
         dt = min(dt, options.max_step * t_max)
     return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n), unstable,
-                       dissipated)
+                       float(dissipated))
 
 
 _JUMPS = 2          # attempts to step across an instability (2x, 4x the last good step)
