@@ -59,10 +59,6 @@ class ContactState:
     active: np.ndarray         # bool [ncand]
     u_r_stick: np.ndarray      # float [ncand], meaningful where active
 
-    def key(self) -> bytes:
-        """Identity of the set."""
-        return self.active.tobytes()
-
 
 @dataclass(frozen=True)
 class PressureProfile:
@@ -105,15 +101,6 @@ class RigidPlane:
         if self.exclude is not None:
             nodes = np.setdiff1d(nodes, self.exclude)
         object.__setattr__(self, "nodes", nodes)
-        # neighbours along the boundary (vertex - midpoint - vertex), among the candidates
-        index = np.full(mesh.doflocs.shape[1], -1)
-        index[nodes] = np.arange(len(nodes))
-        i, j = index[np.concatenate([fn[0], fn[2]])], index[np.concatenate([fn[2], fn[1]])]
-        ok = (i >= 0) & (j >= 0)
-        adj = sp.coo_matrix((np.ones(2 * ok.sum()), (np.concatenate([i[ok], j[ok]]),
-                                                    np.concatenate([j[ok], i[ok]]))),
-                            shape=(len(nodes), len(nodes))).tocsr()
-        object.__setattr__(self, "_adjacency", adj)
 
     @classmethod
     def on(cls, kin: Kinematics, boundaries: list[str], exclude: list[str] = (),
@@ -191,14 +178,6 @@ class RigidPlane:
             r1 = np.where(fly, u_free[2 * nodes], u[2 * nodes])
             stick[new] = u_start[2 * nodes] + np.clip(t, 0.0, 1.0) * (r1 - u_start[2 * nodes])
         return ContactState(active, stick)
-
-    def near_front(self, state: ContactState, hops: int = 3) -> np.ndarray:
-        """Held nodes within `hops` boundary neighbours of a free candidate: where the contact
-        zones end, the nodes whose contact the linearized problem may release."""
-        reach = ~state.active
-        for _ in range(hops):
-            reach = reach | (self._adjacency @ reach.astype(float) > 0)
-        return state.active & reach
 
     # --- post-processing -----------------------------------------------------------------
     def _positions(self, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:

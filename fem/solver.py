@@ -165,8 +165,8 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         unstable += indefinite
         W1 = mech.energy(u1)
         dissipated += W0 + _work(dirichlet, f_ext, t, t1, u0, u1, r0, r1) - W1
+        dt_ok = t1 - t
         u0, r0, W0, state, t, jumps = u1, r1, W1, state1, t1, 0
-        dt_ok = min(dt, t_max - t) if t < t_max else dt
         if on_step:
             on_step(StepResult(t, u1, r1, state1, its))
         if progress:
@@ -303,8 +303,9 @@ class _Step:
             add[:] = False
 
     def holds(self, alpha: float) -> np.ndarray:
-        """The held set after a step of length alpha: the held nodes outside the QP, those in
-        it that stay pressed (lambda > 0), and after a full step the free nodes it presses
+        """The held set after a step of length alpha (also the nodes the step puts exactly on
+        the plane, removing the round-off of g + du_z = 0): the held nodes outside the QP, those
+        in it that stay pressed (lambda > 0), and after a full step the free nodes it presses
         onto the plane."""
         active = self.state.active & ~self.release
         pressed = self.qp[self.lam > 0.0]
@@ -313,10 +314,6 @@ class _Step:
         else:
             active[pressed] = self.state.active[pressed]
         return active
-
-    def on_plane(self, alpha: float) -> np.ndarray:
-        """Nodes the step puts exactly on the plane (round-off of g + du_z = 0 removed)."""
-        return self.holds(alpha)
 
 
 def _lcp(S, q):
@@ -387,7 +384,7 @@ def _line_search(mech, solver, step, u_start, u, Pi, res, K, fext, shift, held, 
             try:
                 trial = u + alpha * du
                 if plane is not None:
-                    trial = plane.project(trial, u_start, step.state, step.on_plane(alpha))
+                    trial = plane.project(trial, u_start, step.state, step.holds(alpha))
                 Pi1, r1, K1 = _evaluate(mech, trial, fext)
             except FloatingPointError:
                 alpha *= 0.5
