@@ -8,6 +8,11 @@ between steps adds no error of its own; and the observed orders. Run from the re
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_fem.py [--repeat 3]
 
+Timing only (no reference runs, no errors; median of --repeat runs at every chosen level):
+
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_fem.py --timing \
+        --levels coarse medium --repeat 3
+
 Error measures (relative to the extrapolated value at the same u):
   F0            largest |F0 - F0*| / F0* over u/h1 = 0.10, 0.15, ..., 0.80;
   @0.9          the same at u = 0.9 h1, the steep end where the wall is pressed flat;
@@ -97,13 +102,37 @@ def report(contact: str, runs: list[dict], reference: list[dict], detail: bool) 
                       f"{unit * runs[0][q][k]:9.4f}")
 
 
+def timing(contacts: list[str], levels: list[str], repeat: int) -> int:
+    """Cost table: DOFs, steps, Newton iterations, cut-backs and the median wall time per level."""
+    print(f"cup A, u = 0 .. {U_MAX} h1, default solver options, median of {repeat} run(s)")
+    print(f"{'contact':13} {'fidelity':8} {'DOFs':>6} {'steps':>5} {'Newton':>6} {'time/s':>7}  (all runs)")
+    for contact in contacts:
+        for level in levels:
+            geometry = cup_geometry("A")
+            mesh = cup_mesh(geometry, level)
+            times = []
+            for _ in range(repeat):
+                t0 = time.perf_counter()
+                resp = compress_cup(mesh, NeoHookean(), contact=contact, u_max_m=U_MAX * geometry.h1_m)
+                times.append(time.perf_counter() - t0)
+            s = resp.stats
+            print(f"{contact:13} {level:8} {s.dofs:>6} {s.steps:>5} {s.newton_iterations:>6} "
+                  f"{statistics.median(times):>7.2f}  ({', '.join(f'{t:.2f}' for t in times)})", flush=True)
+    return 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeat", type=int, default=1, help="runs per level for the median wall time")
     parser.add_argument("--detail", action="store_true", help="also print the sampled curves per u")
     parser.add_argument("--contact", choices=("frictionless", "sticking"), nargs="+",
                         default=["frictionless", "sticking"])
+    parser.add_argument("--levels", choices=tuple(FIDELITIES), nargs="+", default=list(FIDELITIES))
+    parser.add_argument("--timing", action="store_true",
+                        help="only time the default-step runs of --levels (median of --repeat each)")
     args = parser.parse_args()
+    if args.timing:
+        return timing(args.contact, args.levels, args.repeat)
     for contact in args.contact:
         runs, reference, failures = [], [], []
         for level in FIDELITIES:

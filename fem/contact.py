@@ -1,19 +1,22 @@
-"""Contact with the rigid plane z = 0: a node-based primal-dual active set, no penalty parameter.
+"""Contact with the rigid plane z = 0: node-based Signorini conditions, no penalty parameter.
 
 Every boundary node that may touch the plane (all boundary nodes except those clamped to the top
-plate) is a candidate. An *active* node is held exactly on the plane, z = Z + u_z = 0, by
+plate) is a candidate. A *held* (active) node is kept exactly on the plane, z = Z + u_z = 0, by
 eliminating its vertical dof like a Dirichlet condition; for ``"sticking"`` contact its radial
-displacement is also frozen at the value it had when it touched down. The nodal contact reaction
-lambda_a (the internal force at the eliminated dof, > 0 when the plane pushes) is what the
-constraint costs. Inside Newton (a semi-smooth Newton / primal-dual active-set iteration):
+displacement is also frozen where it touched down. The nodal contact reaction lambda_a (the
+internal force at the eliminated dof, > 0 when the plane pushes) is what the constraint costs.
+Which nodes are held is decided inside each Newton step by a small linear complementarity
+problem (`fem.solver`): the nodes the step would push through the plane and the held nodes it
+would pull on; `project` puts any node that still penetrates back on the plane, `hold` records
+the new set. A converged step satisfies g >= 0, lambda >= 0, g lambda = 0 at the nodes (to the
+Newton tolerance), so there is no enforcement parameter whose value could change the result.
+Between nodes the quadratic edge may dip below the plane; `largest_penetration` reports the
+largest such violation.
 
-    inactive -> active   if the node penetrates, gap g_a = Z_a + u_z,a < 0,
-    active   -> inactive if its reaction turns tensile, lambda_a < 0 (the node lifts off),
-
-and a load step is converged only when the active set no longer changes. The solution satisfies
-the Signorini conditions g >= 0, lambda >= 0, g lambda = 0 exactly at the nodes, so there is no
-enforcement parameter whose value could change the result. Between nodes the quadratic edge may
-dip below the plane; `largest_penetration` reports the largest such violation.
+Sticking: a node that lands sticks at its touchdown point, interpolated linearly in the load
+step between the step's start and its free flight (`hold`); a held node whose reaction turns
+tensile is released (it carries no normal force, so no friction holds it) and lands again where
+the iteration puts it: it has slipped.
 
 The contact pressure p is the L2 projection, on the deformed contact boundary (weight 2 pi r ds),
 of the nodal reactions: M p = lambda over the facets touching an active node. With the consistent
@@ -25,7 +28,7 @@ pointwise profile is the lumped projection p_a = lambda_a / sum_b M_ab, which is
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -51,16 +54,10 @@ def _shape(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class ContactState:
-    """Which candidate nodes are on the plane, and (sticking) their frozen radial displacement."""
+    """Which candidate nodes are held on the plane, and (sticking) their frozen radial displacement."""
 
     active: np.ndarray         # bool [ncand]
     u_r_stick: np.ndarray      # float [ncand], meaningful where active
-    slipping: np.ndarray | None = None   # bool [ncand]: sticking law, node may slide this step
-
-    def key(self) -> bytes:
-        """Identity of the set for cycle detection."""
-        slip = self.slipping if self.slipping is not None else np.zeros_like(self.active)
-        return self.active.tobytes() + slip.tobytes()
 
 
 @dataclass(frozen=True)
@@ -120,7 +117,7 @@ class RigidPlane:
     # --- the state -----------------------------------------------------------------------
     def initial_state(self) -> ContactState:
         n = len(self.nodes)
-        return ContactState(np.zeros(n, bool), np.zeros(n), np.zeros(n, bool))
+        return ContactState(np.zeros(n, bool), np.zeros(n))
 
     def gap(self, u: np.ndarray) -> np.ndarray:
         """Signed nodal gap g = Z + u_z [m] (negative: penetration)."""
@@ -132,62 +129,55 @@ class RigidPlane:
         dofs = [2 * self.nodes[a] + 1]
         vals = [-self.kin.node_coordinates()[1, self.nodes[a]]]
         if self.law == "sticking":
-            stuck = np.flatnonzero(state.active & ~state.slipping)
-            dofs.append(2 * self.nodes[stuck])
-            vals.append(state.u_r_stick[stuck])
+            dofs.append(2 * self.nodes[a])
+            vals.append(state.u_r_stick[a])
         return np.concatenate(dofs), np.concatenate(vals)
 
     def reactions(self, r_int: np.ndarray) -> np.ndarray:
         """Nodal normal reactions lambda_a [N] (> 0: the plane pushes up) = internal force at z-dofs."""
         return r_int[2 * self.nodes + 1]
 
-    def update(self, state: ContactState, u: np.ndarray, r_int: np.ndarray,
-               u_start: np.ndarray, stiffness: np.ndarray | None = None) -> ContactState:
-        """One primal-dual active-set update (module docstring). u_start: last converged state,
-        used to locate the touchdown point of newly active nodes for the sticking law.
+    def project(self, u: np.ndarray, u_start: np.ndarray, state: ContactState,
+                on_plane: np.ndarray) -> np.ndarray:
+        """The nearest admissible displacement: the `on_plane` nodes exactly on the plane (those
+        held by `state` where it holds them), and every other penetrating node (g < 0) put back on
+        the plane. For the sticking law such a landing node is put where it touched down,
+        interpolated linearly in the load step between u_start (gap g0 > 0) and u (gap < 0); a node
+        that was on the plane at the step start (g0 = 0) lands where u puts it."""
+        out = u.copy()
+        nodes, Z = self.nodes, self.kin.node_coordinates()[1, self.nodes]
+        g = self.gap(u)
+        land = ~on_plane & (g < 0.0)
+        out[2 * nodes[on_plane | land] + 1] = -Z[on_plane | land]
+        if self.law == "sticking":
+            held = on_plane & state.active
+            out[2 * nodes[held]] = state.u_r_stick[held]
+            if np.any(land):
+                g0 = self.gap(u_start)[land]
+                t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g[land], 1e-300), 1.0)
+                ur0, ur1 = u_start[2 * nodes[land]], u[2 * nodes[land]]
+                out[2 * nodes[land]] = ur0 + np.clip(t, 0.0, 1.0) * (ur1 - ur0)
+        return out
 
-        With `stiffness` (the tangent's diagonal), only the single worst violation changes: the
-        largest of the penetration -g and the tensile reaction over the dof stiffness, -lambda/k."""
-        g, lam = self.gap(u), self.reactions(r_int)
-        active = np.where(state.active, lam >= 0.0, g < 0.0)
-        if stiffness is not None:
-            k = stiffness[2 * self.nodes + 1]
-            violation = np.where(state.active, -lam / k, -g)
-            active = state.active.copy()
-            worst = int(np.argmax(violation))
-            if violation[worst] > 0:
-                active[worst] = not active[worst]
-        return self.activate(replace(state, active=active & state.active,
-                                     slipping=state.slipping & active),
-                             active & ~state.active, u, u_start)
-
-    def activate(self, state: ContactState, nodes: np.ndarray, u: np.ndarray,
-                 u_start: np.ndarray) -> ContactState:
-        """Put `nodes` on the plane; newly active ones stick (sticking law) at their touchdown
-        point, interpolated linearly in the step between u_start (gap g0 > 0) and u (gap < 0);
-        a node that was on the plane at the step start (g0 = 0), lifted off during the iteration
-        and lands again, lands where the iterate puts it."""
-        new = nodes & ~state.active
+    def hold(self, state: ContactState, active: np.ndarray, u: np.ndarray, u_start: np.ndarray,
+             u_free: np.ndarray, released: np.ndarray) -> ContactState:
+        """The state holding `active`. Sticking law: a node held anew sticks where it touched
+        down, interpolated linearly in the load step between u_start (gap g0) and its free
+        flight u_free (the iterate it would reach unsupported, gap g1 < 0), at t = g0 / (g0 - g1);
+        so a node resting on the plane at the step start (g0 = 0, e.g. the rim corner at u = 0)
+        does not slide. A node `released` in this step (its reaction turned tensile: no
+        friction can hold it) lands again where u puts it: it has slipped. If its free flight
+        does not reach the plane, a node lands where u puts it."""
+        new = active & ~state.active
         stick = state.u_r_stick.copy()
-        if np.any(new):
-            g, g0 = self.gap(u)[new], self.gap(u_start)[new]
-            t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g, 1e-300), 1.0)
-            ur0, ur1 = u_start[2 * self.nodes[new]], u[2 * self.nodes[new]]
-            stick[new] = ur0 + np.clip(t, 0.0, 1.0) * (ur1 - ur0)
-        return replace(state, active=state.active | nodes, u_r_stick=stick)
-
-    def let_slip(self, state: ContactState, nodes: np.ndarray) -> ContactState:
-        """Sticking law, a node cycling between stuck-with-tension and lift-off-into-penetration
-        within a step: its normal force is zero to within the step, so no friction can hold it
-        (Coulomb with zero normal force); keep it on the plane, free to slide, for this step."""
-        return replace(state, active=state.active | nodes, slipping=state.slipping | nodes)
-
-    def settle(self, state: ContactState, u: np.ndarray) -> ContactState:
-        """End of a converged step: slipping nodes stick where they are now."""
-        if not np.any(state.slipping):
-            return state
-        stick = np.where(state.slipping, u[2 * self.nodes], state.u_r_stick)
-        return replace(state, u_r_stick=stick, slipping=np.zeros_like(state.slipping))
+        if self.law == "sticking" and np.any(new):
+            nodes = self.nodes[new]
+            g0, g1 = self.gap(u_start)[new], self.gap(u_free)[new]
+            fly = (g1 < 0.0) & ~released[new]
+            t = np.where(fly, np.clip(g0, 0.0, None) / np.maximum(g0 - g1, 1e-300), 1.0)
+            r1 = np.where(fly, u_free[2 * nodes], u[2 * nodes])
+            stick[new] = u_start[2 * nodes] + np.clip(t, 0.0, 1.0) * (r1 - u_start[2 * nodes])
+        return ContactState(active, stick)
 
     # --- post-processing -----------------------------------------------------------------
     def _positions(self, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:

@@ -31,8 +31,8 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import BilinearForm, LinearForm, MeshQuad2
 
-from .kinematics import Kinematics
-from .material import NeoHookean, jacobian, jacobian_gradient, jacobian_hessian
+from .kinematics import IDENTITY, Kinematics
+from .material import NeoHookean, jacobian, jacobian_gradient, jacobian_hessian, jacobian_minus_one
 
 __all__ = ["Mechanics", "internal_force_form", "tangent_form", "energy_form"]
 
@@ -155,11 +155,11 @@ class Mechanics:
         return np.einsum("ea,aeq->eq", coef, q)
 
     # --- the three quantities -------------------------------------------------------------
-    def pressure_and_dilatation(self, f: np.ndarray):
-        """For the mixed form: Theta = Pi_h J, p = Pi_h U'(Theta) at the points."""
+    def pressure_and_dilatation(self, f: np.ndarray, h: np.ndarray | None = None):
+        """For the mixed form: Theta = Pi_h J, p = Pi_h U'(Theta) at the points (h = f - 1 if known)."""
         # project J - 1 rather than J: the projection of the constant 1 carries round-off that
         # lambda would amplify into a spurious pressure (~1e-6 Pa at nu = 0.49)
-        dtheta = self.project(jacobian(f) - 1.0)
+        dtheta = self.project(jacobian(f) - 1.0 if h is None else jacobian_minus_one(h))
         if np.any(dtheta <= -1.0):
             raise FloatingPointError("projected dilatation Theta <= 0 (inverted element)")
         theta = 1.0 + dtheta
@@ -167,13 +167,14 @@ class Mechanics:
 
     def energy(self, u: np.ndarray) -> float:
         """Stored elastic energy Pi(u) [J]."""
-        f = self.kin.deformation_gradient(u)
+        h = self.kin.displacement_gradient(u)
+        f = IDENTITY[:, None, None] + h
         m = self.material
         if m.formulation == "displacement":
-            W = m.energy(f)
+            W = m.energy(f, h)
         else:
-            theta, _ = self.pressure_and_dilatation(f)
-            W = m.isochoric(f)[0] + m.volumetric(theta, np.log1p(theta - 1.0))[0]
+            theta, _ = self.pressure_and_dilatation(f, h)
+            W = m.isochoric(f, h)[0] + m.volumetric(theta, np.log1p(theta - 1.0))[0]
         return float(np.sum(W * self.kin.dV))
 
     def stress(self, f: np.ndarray) -> np.ndarray:
@@ -195,15 +196,27 @@ class Mechanics:
 
     def linearize(self, u: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
         """Internal force r(u) and consistent tangent K(u) = d2Pi/du2."""
-        f = self.kin.deformation_gradient(u)
-        if np.any(jacobian(f) <= 0):
+        return self.evaluate(u)[1:]
+
+    def evaluate(self, u: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
+        """Stored energy Pi(u) [J], internal force r(u) and tangent K(u), from one evaluation of F."""
+        h = self.kin.displacement_gradient(u)
+        f = IDENTITY[:, None, None] + h
+        J = jacobian(f)
+        if np.any(J <= 0):
             raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
         m, dV = self.material, self.kin.dV
         if m.formulation == "displacement":
-            P, A = m.stress(f), m.tangent(f)
+            W, P, A = m.isochoric(f, h)
+            U, dU, d2U = m.volumetric(J, np.log1p(jacobian_minus_one(h)))
+            g = jacobian_gradient(f)
+            W = W + U
+            P = P + dU * g
+            A = A + d2U * g[:, None] * g[None, :] + dU * jacobian_hessian(f)
         else:
-            theta, p = self.pressure_and_dilatation(f)
-            _, P, A = m.isochoric(f)
+            theta, p = self.pressure_and_dilatation(f, h)
+            W, P, A = m.isochoric(f, h)
+            W = W + m.volumetric(theta, np.log1p(theta - 1.0))[0]
             g = jacobian_gradient(f)
             P = P + p * g
             A = A + p * jacobian_hessian(f)
@@ -222,4 +235,4 @@ class Mechanics:
             D = np.einsum("aeq,beq,eq->eab", q, q, d2U * dV)
             C = Minv @ D @ Minv
             Ke += np.einsum("eai,eab,ebj->eij", G, C, G)
-        return self._vector(re), self._matrix(Ke)
+        return float(np.sum(W * dV)), self._vector(re), self._matrix(Ke)

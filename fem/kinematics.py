@@ -87,7 +87,11 @@ class Kinematics:
 
     def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
         """f(u) at the quadrature points, [5, nel, nq]."""
-        return IDENTITY[:, None, None] + np.einsum("ikeq,ie->keq", self.B, self.local(u))
+        return IDENTITY[:, None, None] + self.displacement_gradient(u)
+
+    def displacement_gradient(self, u: np.ndarray) -> np.ndarray:
+        """h(u) = f(u) - 1 at the quadrature points, [5, nel, nq] (exact for small u, unlike f - 1)."""
+        return np.einsum("ikeq,ie->keq", self.B, self.local(u))
 
     def node_coordinates(self) -> np.ndarray:
         """Reference coordinates of the mesh nodes [2, nnodes] (node n carries dofs 2n, 2n+1)."""

@@ -31,7 +31,8 @@ from typing import Literal
 
 import numpy as np
 
-__all__ = ["NeoHookean", "jacobian", "jacobian_gradient", "jacobian_hessian", "cauchy_stress"]
+__all__ = ["NeoHookean", "jacobian", "jacobian_minus_one", "jacobian_gradient", "jacobian_hessian",
+           "cauchy_stress"]
 
 Formulation = Literal["displacement", "mixed"]
 
@@ -71,22 +72,32 @@ class NeoHookean:
         lnJ = np.log(J) if lnJ is None else lnJ
         return (0.5 * self.lam * lnJ**2, self.lam * lnJ / J, self.lam * (1.0 - lnJ) / J**2)
 
-    def isochoric(self, f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """W_iso = mu/2 (I1 - 3) - mu ln J: energy, stress P_iso[5, ...], tangent A_iso[5, 5, ...]."""
+    def isochoric(self, f: np.ndarray, h: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """W_iso = mu/2 (I1 - 3) - mu ln J: energy, stress P_iso[5, ...], tangent A_iso[5, 5, ...].
+
+        The energy is evaluated from the displacement gradient h = f - 1 (pass it if known more
+        accurately than f - 1) without cancellation: with j = J - 1,
+        W_iso = mu (tr h - j) + mu (j - ln(1 + j)) + mu/2 |h|^2, every term O(h^2)."""
         J = jacobian(f)
         g = jacobian_gradient(f)
         mu = self.mu
-        I1 = np.sum(f**2, axis=0)
-        W = 0.5 * mu * (I1 - 3.0) - mu * np.log(J)
+        h = f - _IDENTITY.reshape((5,) + (1,) * (f.ndim - 1)) if h is None else h
+        j = jacobian_minus_one(h)
+        # tr h - j = -(h0 h3 - h1 h2) - a h4 with a = J_2D - 1 (exact algebra, no cancellation)
+        a = h[0] + h[3] + h[0] * h[3] - h[1] * h[2]
+        W = mu * (-(h[0] * h[3] - h[1] * h[2]) - a * h[4] + _x_minus_log1p(j)) \
+            + 0.5 * mu * np.sum(h**2, axis=0)
         dW, d2W = -mu / J, mu / J**2
         P = mu * f + dW * g
         A = d2W * g[:, None] * g[None, :] + dW * jacobian_hessian(f)
         A[np.arange(5), np.arange(5)] += mu
         return W, P, A
 
-    def energy(self, f: np.ndarray) -> np.ndarray:
-        """W(F) per unit reference volume [J/m^3] (pointwise, all terms)."""
-        return self.isochoric(f)[0] + self.volumetric(jacobian(f))[0]
+    def energy(self, f: np.ndarray, h: np.ndarray | None = None) -> np.ndarray:
+        """W(F) per unit reference volume [J/m^3] (pointwise, all terms; h = f - 1 if known)."""
+        h = f - _IDENTITY.reshape((5,) + (1,) * (f.ndim - 1)) if h is None else h
+        return self.isochoric(f, h)[0] + self.volumetric(jacobian(f), np.log1p(jacobian_minus_one(h)))[0]
 
     def stress(self, f: np.ndarray) -> np.ndarray:
         """First Piola-Kirchhoff stress P = dW/dF as a 5-vector [Pa] (pointwise, all terms)."""
@@ -99,6 +110,28 @@ class NeoHookean:
         J, g = jacobian(f), jacobian_gradient(f)
         _, dU, d2U = self.volumetric(J)
         return A + d2U * g[:, None] * g[None, :] + dU * jacobian_hessian(f)
+
+
+_IDENTITY = np.array([1.0, 0.0, 0.0, 1.0, 1.0])
+
+
+def jacobian_minus_one(h: np.ndarray) -> np.ndarray:
+    """J - 1 from the displacement gradient h = f - 1, without cancellation for small h."""
+    a = h[0] + h[3] + h[0] * h[3] - h[1] * h[2]
+    return a + h[4] + a * h[4]
+
+
+def _x_minus_log1p(x: np.ndarray) -> np.ndarray:
+    """x - ln(1 + x), by its series for |x| < 0.1 (no cancellation; truncation < 1e-13 relative)."""
+    x = np.asarray(x, dtype=float)
+    small = np.abs(x) < 0.1
+    xs = np.where(small, x, 0.0)
+    series = np.zeros_like(xs)
+    term = xs * xs
+    for k in range(2, 16):
+        series += term / k if k % 2 == 0 else -term / k
+        term = term * xs
+    return np.where(small, series, x - np.log1p(np.where(small, 0.0, x)))
 
 
 def jacobian(f: np.ndarray) -> np.ndarray:

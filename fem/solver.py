@@ -1,21 +1,39 @@
-"""Quasi-static path following: adaptive load steps, a secant predictor, Newton with line search.
+"""Quasi-static path following: adaptive load steps, Newton with a contact QP and an energy line search.
 
 The body is loaded by a parameter t (the plate displacement for the cup, a load factor elsewhere)
 that enters through prescribed displacements ``dirichlet(t) -> (dofs, values)`` and optionally an
-external force ``f_ext(t)``. Contact with a `RigidPlane` adds the active-set constraints.
+external force ``f_ext(t)``. Contact with a `RigidPlane` adds unilateral constraints g_a >= 0.
 
-Each step t0 -> t1 starts from the secant predictor u1 = u0 + (t1 - t0)/(t0 - t_prev) (u0 - u_prev)
-and iterates Newton on the free dofs (prescribed and active-contact dofs eliminated). The step has
-converged when
+Every load step solves the equilibrium at t1 as the minimum of the total energy
+Pi(u) = W(u) - f_ext . u over the admissible set (the prescribed values, g >= 0, and for the
+sticking law the frozen radial positions of the nodes held on the plane). Newton's method on it:
 
-* the active contact set did not change in the last iteration and all constraints hold,
-* the free residual satisfies ||r_f|| <= rtol * max(||reactions||, f_floor), and
-* the energy norm of the last correction |du . r_f| <= etol * f_ref * max|u| (the work scale).
+* Predictor: the converged state u0; the first iteration imposes the prescribed increment
+  through the tangent (a tangent predictor, which sees the contact; a secant extrapolation of u
+  pushed the contact front through the plane and then released it node by node).
+* Step: the quadratic model of Pi minimized on the free dofs (prescribed and held contact dofs
+  eliminated, K_ff factored once, `fem.linsolve`) subject to the linearized contact conditions
+  g_a + du_z,a >= 0 of the free nodes the unconstrained step would push through the plane, and
+  of the held nodes whose linearized reaction lambda_a + (K du)_z,a would turn tensile. With the
+  columns K_ff^-1 e_a of those m nodes this is the small LCP lambda >= 0, w = q + S lambda >= 0,
+  lambda . w = 0 (S = E^T K_ff^-1 E), solved exactly by non-negative least squares: the whole
+  contact front moves in one iteration. Nodes pressed (lambda > 0) are held afterwards; held
+  nodes the LCP lets go are released.
+* Line search: along the projected path P(u + a du) (penetrating nodes put back on the plane),
+  backtracking until the Armijo condition on Pi holds. The energy decreases at every iteration,
+  so the contact set cannot cycle.
+* Instability: if K_ff is not positive definite (buckling, a wall lifting off the plane), the
+  diagonal is shifted, K_ff + s diag(K_ff) (Levenberg-Marquardt), the direction then descends,
+  and the iteration follows the energy down to the next stable state (this may take tens of
+  iterations, hence max_iterations = 100). When it still fails, the step is first enlarged (2x,
+  4x the last good step) to jump across the limit point, then halved. The energy such jumps lose,
+  W0 + work - W1 summed over the steps, is reported as `SolverStats.dissipated_J`.
 
-A line search along the Newton direction (secant on the energy slope s(a) = du . r_f(u + a du))
-is taken when the slope does not drop below 0.8 |s(0)|, or when an element would invert. A step
-that fails is cut back (halved); when the step falls below ``min_step`` a `ConvergenceError`
-reports the step, the residual history and the likely cause. Nothing is accepted silently.
+The step has converged when the prescribed values hold, no held node pulls on the plane beyond
+the tolerance, ||r_f|| <= rtol * max(||reactions||, f_floor), and the energy norm of the next
+correction |du . r| <= etol * f_ref * max|u| (the work scale). A step that fails is cut back
+(halved); when the step falls below ``min_step`` a `ConvergenceError` reports the step, the
+residual history and the likely cause. Nothing is accepted silently.
 """
 
 from __future__ import annotations
@@ -25,10 +43,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
+from .linsolve import BandedCholesky, NotPositiveDefinite
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
 
@@ -43,14 +61,16 @@ class SolverOptions:
 
     rtol: float = 1e-6          # residual / reaction
     etol: float = 1e-12         # energy norm of the correction / work scale f_ref max|u|
-    max_iterations: int = 25
+    max_iterations: int = 100   # a step that follows an instability descends for many iterations
     initial_step: float = 0.01  # first step as a fraction of t_max
     max_step: float = 0.05      # largest step as a fraction of t_max (resolution of the curve)
     min_step: float = 1e-5      # smallest step as a fraction of t_max before giving up
     growth: float = 1.5         # step growth after an easy step (<= easy_iterations)
     easy_iterations: int = 6
-    active_set_rtol: float = 1e-3   # residual / reaction below which the contact set is revisited
-    max_active_sets: int = 40       # distinct contact sets tried in one step before giving up
+    # unused since the contact set is solved for in every Newton step (module docstring); kept
+    # so that option sets written for the earlier active-set iteration still validate
+    active_set_rtol: float = 1e-3
+    max_active_sets: int = 40
 
     def __post_init__(self) -> None:
         for name in ("rtol", "etol", "initial_step", "max_step", "min_step", "active_set_rtol"):
@@ -70,6 +90,9 @@ class SolverStats:
     cutbacks: int
     wall_time_s: float
     dofs: int
+    unstable_steps: int = 0     # steps whose tangent was not positive definite on the way (buckling)
+    dissipated_J: float = 0.0   # sum over steps of W0 + work - W1: jumps across instabilities
+    #                             (snap-through), sticking-law slips, and the O(dt^3) trapezoid error
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,9 +107,9 @@ class StepResult:
 
 
 class _StepFailure(Exception):
-    def __init__(self, cause: str, history: list[float]):
+    def __init__(self, cause: str, history: list[float], indefinite: bool = False):
         super().__init__(cause)
-        self.cause, self.history = cause, history
+        self.cause, self.history, self.indefinite = cause, history, indefinite
 
 
 def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, np.ndarray]],
@@ -105,22 +128,30 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     u0 = np.zeros(n)
     state = plane.initial_state() if plane is not None else None
     r0 = mech.internal_force(u0)
+    solver = BandedCholesky(mech.linearize(u0)[1], mech.kin.node_coordinates())
     if on_step:
         on_step(StepResult(0.0, u0, r0, state, 0))
-    t, u_prev, t_prev = 0.0, None, None
-    dt = options.initial_step * t_max
-    steps = iterations = cutbacks = 0
+    t, W0 = 0.0, mech.energy(u0)
+    dt = dt_ok = options.initial_step * t_max
+    steps = iterations = cutbacks = unstable = jumps = 0
+    dissipated = 0.0
     while t < t_max * (1 - 1e-12):
         t1 = min(t + dt, t_max)
         if t_max - t1 < 0.2 * dt:          # don't leave a sliver at the end
             t1 = t_max
-        guess = u0 if u_prev is None else u0 + (t1 - t) / (t - t_prev) * (u0 - u_prev)
         try:
-            u1, r1, state1, its = _newton(mech, dirichlet, f_ext, plane, state, u0, guess, t1, options)
+            u1, r1, state1, its, indefinite = _newton(mech, dirichlet, f_ext, plane, state, u0, u0,
+                                                      t1, options, solver)
         except _StepFailure as fail:
             cutbacks += 1
             iterations += len(fail.history)
-            dt *= 0.5
+            if fail.indefinite and jumps < _JUMPS:
+                # a structural instability: smaller steps only creep up to the limit point, so
+                # first try to step across it (the path jumps; the energy it loses is reported)
+                jumps += 1
+                dt = dt_ok * 2.0**jumps
+                continue
+            dt = (dt if not fail.indefinite else min(dt, dt_ok)) * 0.5
             if dt < options.min_step * t_max:
                 raise ConvergenceError(
                     f"load step {steps + 1} from {name} = {t:.6g} to {t1:.6g} did not converge "
@@ -131,123 +162,245 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             continue
         steps += 1
         iterations += its
-        u_prev, t_prev, u0, state, t = u0, t, u1, state1, t1
+        unstable += indefinite
+        W1 = mech.energy(u1)
+        dissipated += W0 + _work(dirichlet, f_ext, t, t1, u0, u1, r0, r1) - W1
+        dt_ok = t1 - t
+        u0, r0, W0, state, t, jumps = u1, r1, W1, state1, t1, 0
         if on_step:
             on_step(StepResult(t, u1, r1, state1, its))
         if progress:
             progress(t / t_max, f"step {steps}: {name} = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:
             dt = min(dt * options.growth, options.max_step * t_max)
-    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n))
+        dt = min(dt, options.max_step * t_max)
+    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n), unstable,
+                       float(dissipated))
 
 
-def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts):
-    """Newton iterations of one step; returns (u, r_int, contact state, iterations).
+_JUMPS = 2          # attempts to step across an instability (2x, 4x the last good step)
 
-    The contact active set is revisited whenever the iterate is nearly converged for the
-    current set (||r_f|| <= active_set_rtol * f_ref): all violating nodes change at once; if
-    that reproduces a set already tried in this step, only the worst violation changes."""
+
+def _work(dirichlet, f_ext, t0, t1, u0, u1, r0, r1) -> float:
+    """Work done on the body in the step t0 -> t1 by the prescribed displacements (their
+    reactions, r_int at those dofs) and by f_ext, by the trapezoidal rule [J]."""
+    d0, v0 = dirichlet(t0)
+    d1, v1 = dirichlet(t1)
+    work = 0.5 * (r0[d1] + r1[d1]) @ (v1 - v0) if np.array_equal(d0, d1) else 0.0
+    return work + 0.5 * (f_ext(t0) + f_ext(t1)) @ (u1 - u0)
+
+
+def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver):
+    """Newton iterations of one step with a contact QP per iteration (module docstring);
+    returns (u, r_int, contact state, iterations, whether the tangent was indefinite on the way)."""
+    flags = {"indefinite": False}
+    try:
+        return _iterate(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver, flags)
+    except _StepFailure as fail:
+        fail.indefinite = flags["indefinite"]
+        raise
+
+
+def _iterate(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver, flags):
     n = mech.kin.ndofs
     fixed_dofs, fixed_vals = dirichlet(t)
     fext = f_ext(t)
-    u = guess.copy()
     history: list[float] = []
-    seen = {state.key()} if plane is not None else set()
-    it = 0
     try:
-        r, K = mech.linearize(u)
+        u = plane.project(guess, u_start, state, state.active) if plane is not None else guess
+        Pi, r, K = _evaluate(mech, u, fext)
     except FloatingPointError as err:
         raise _StepFailure(f"{err} at the predictor; likely cause: the step is too large for "
                            "the deformation, or the mesh is too coarse", history) from None
+    it, shift, indefinite = 0, 0.0, False
+    released = np.zeros(len(plane.nodes), bool) if plane is not None else None
     while True:
         res = r - fext
-        if plane is not None:
-            cd, cv = plane.constraints(state)
-            dofs, vals = np.concatenate([fixed_dofs, cd]), np.concatenate([fixed_vals, cv])
-        else:
-            dofs, vals = fixed_dofs, fixed_vals
-        free = np.ones(n, bool)
-        free[dofs] = False
-        du = np.zeros(n)
-        du[dofs] = vals - u[dofs]
+        free, dofs, du_fixed = _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state)
         f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext), _force_floor(mech))
         rnorm = np.linalg.norm(res[free])
         history.append(rnorm / f_ref)
         if not np.all(np.isfinite(res)):
             raise _StepFailure("the residual is not finite", history)
-        try:
-            du = _solve_constrained(K, -res, free, du)
-        except RuntimeError as err:  # singular factor
-            raise _StepFailure(f"singular tangent ({err}); likely cause: an unconstrained "
-                               "rigid-body mode or a structural instability", history) from None
-        if not np.all(np.isfinite(du)):
-            raise _StepFailure("singular tangent; likely cause: an unconstrained rigid-body mode "
-                               "or a structural instability (buckling)", history)
-        energy = abs(du[free] @ res[free])
-        e_ref = f_ref * max(np.max(np.abs(u)), np.max(np.abs(du)), 1e-9 * _size(mech))
-        held = np.max(np.abs(du[dofs]), initial=0.0) <= 1e-14 * (1.0 + np.max(np.abs(u)))
-        converged = held and rnorm <= opts.rtol * f_ref and energy <= opts.etol * e_ref
-        if plane is not None and held and (converged or rnorm <= opts.active_set_rtol * f_ref):
-            new = plane.update(state, u, res, u_start)
-            if np.any(new.active != state.active):
-                if new.key() in seen and plane.law == "sticking":
-                    new = plane.let_slip(state, new.active != state.active)
-                if new.key() in seen:
-                    new = plane.update(state, u, res, u_start, stiffness=K.diagonal())
-                if new.key() in seen or len(seen) > opts.max_active_sets:
-                    raise _StepFailure("the contact active set cycles (nodes chatter between "
-                                       "contact and lift-off); likely cause: too large a step", history)
-                seen.add(new.key())
-                state = new
-                continue
-        if converged:
-            return u, r, (plane.settle(state, u) if plane is not None else state), it
+        step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref)
+        shift = step.solve(solver, K, shift, history)
+        indefinite |= shift > 0.0
+        flags["indefinite"] = indefinite
+        energy = abs(step.du @ res)
+        e_ref = f_ref * max(np.max(np.abs(u)), np.max(np.abs(step.du)), 1e-9 * _size(mech))
+        held = not np.any(du_fixed)
+        tensile = plane is not None and np.any(plane.reactions(res)[state.active] < -opts.rtol * f_ref)
+        if held and not tensile and rnorm <= opts.rtol * f_ref and energy <= opts.etol * e_ref:
+            return u, r, state, it, indefinite
         it += 1
         if it >= opts.max_iterations:
-            raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely "
-                               "cause: a structural instability (snap-through/buckling) or a "
-                               "too-large step", history)
-        # full steps while constraints are being imposed; line search once they hold
-        alpha, (r, K) = _line_search(mech, u, du, res[free], free, fext, history, exact=not held)
-        u = u + alpha * du
+            raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely cause: a "
+                               "structural instability (snap-through/buckling) that the step jumps "
+                               "across, or a too-large step", history)
+        u_prev = u
+        alpha, u, Pi, r, K, shift = _line_search(mech, solver, step, u_start, u, Pi, res, K, fext,
+                                                 shift, held, history)
+        if plane is not None:
+            released |= step.release
+            state = plane.hold(state, step.holds(alpha), u, u_start, u_prev + step.du0, released)
 
 
-def _line_search(mech, u, du, res_free, free, fext, history, exact=False, tries: int = 6):
-    """Step length along du: 1 unless an element inverts (halve) or the energy slope
-    s(a) = du . r_f(u + a du) changes sign and stays above 0.8 |s(0)| (secant to s = 0).
-    With `exact`, only inversion shortens the step (prescribed jumps in du make s meaningless).
-    Returns (alpha, linearization at u + alpha du)."""
-    s0 = du[free] @ res_free
-    alpha = 1.0
-    for _ in range(tries):
+class _Step:
+    """The Newton step of one iterate: the quadratic model of the energy minimized on the free
+    dofs subject to the linearized contact conditions g_a + du_z,a >= 0 (a small QP, module
+    docstring) of the free nodes it would push through the plane and of the held nodes whose
+    linearized reaction lambda + (K du)_z would turn tensile (these are freed in K_ff, if it
+    stays positive definite without them)."""
+
+    def __init__(self, plane, state, u, res, free, du_fixed, tol):
+        self.plane, self.state, self.u, self.res, self.du_fixed = plane, state, u, res, du_fixed
+        self.free, self.tol = free, tol
+
+    def solve(self, solver, K, shift, history) -> float:
+        """Factor (with a diagonal shift if K_ff is not positive definite), solve, and add
+        contact constraints until no free candidate penetrates; then let the held nodes the
+        step would pull on take part. Returns the shift used."""
+        fac, shift = _factor(solver, K, self.free, shift, history)
+        self._constrained(fac, np.zeros(0, int))
+        if self.plane is None:
+            return shift
+        zdof = 2 * self.plane.nodes + 1
+        tensile = self.state.active & ((self.res + K @ self.du)[zdof] < -self.tol)
+        self.release = np.zeros_like(tensile)
+        if tensile.any():
+            free = self.free.copy()
+            free[zdof[tensile]] = True
+            # without them K_ff may be indefinite (the contact held the structure): shifted
+            fac, shift = _factor(solver, K, free, 10.0 * shift, history)
+            self._constrained(fac, np.flatnonzero(tensile))
+            self.release = tensile
+        return shift
+
+    def _constrained(self, fac, candidates: np.ndarray) -> None:
+        """du0 = -K_ff^-1 r, then the LCP of `candidates` and every free node that du penetrates."""
+        du0 = fac.solve(-self.res, self.du_fixed)
+        self.du, self.du0, self.qp, self.lam = du0, du0, np.zeros(0, int), np.zeros(0)
+        if self.plane is None:
+            return
+        zdof = 2 * self.plane.nodes + 1
+        g = self.plane.gap(self.u)
+        add = np.zeros(len(g), bool)
+        add[candidates] = True
+        cols = np.zeros((len(du0), 0))
+        for _ in range(20):
+            add |= ~self.state.active & (g + self.du[zdof] < 0.0)
+            add[self.qp] = False
+            if not add.any():
+                break
+            new = np.flatnonzero(add)
+            E = np.zeros((len(du0), len(new)))
+            E[zdof[new], np.arange(len(new))] = 1.0
+            cols = np.hstack([cols, fac.solve(E)])
+            self.qp = np.concatenate([self.qp, new])
+            S = cols[zdof[self.qp]]
+            self.lam = _lcp(0.5 * (S + S.T), g[self.qp] + du0[zdof[self.qp]])
+            self.du = du0 + cols @ self.lam
+            add[:] = False
+
+    def holds(self, alpha: float) -> np.ndarray:
+        """The held set after a step of length alpha (also the nodes the step puts exactly on
+        the plane, removing the round-off of g + du_z = 0): the held nodes outside the QP, those
+        in it that stay pressed (lambda > 0), and after a full step the free nodes it presses
+        onto the plane."""
+        active = self.state.active & ~self.release
+        pressed = self.qp[self.lam > 0.0]
+        if alpha == 1.0:
+            active[pressed] = True
+        else:
+            active[pressed] = self.state.active[pressed]
+        return active
+
+
+def _lcp(S, q):
+    """lambda >= 0 with w = q + S lambda >= 0 and lambda . w = 0 (S symmetric positive definite):
+    the minimizer of lambda S lambda / 2 + q . lambda over lambda >= 0, by non-negative least
+    squares on the Cholesky factor S = L L^T (Lawson-Hanson, finite)."""
+    from scipy.optimize import nnls
+    scale = np.sqrt(np.diag(S))
+    Sn = S / np.outer(scale, scale)
+    L = np.linalg.cholesky(Sn)
+    y = np.linalg.solve(L, q / scale)
+    x, _ = nnls(L.T, -y)
+    return x / scale
+
+
+def _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state):
+    """(free mask, constrained dofs, du on the constrained dofs): the prescribed and the held
+    contact dofs move to their values (a node held anew jumps to where it stuck)."""
+    dofs, vals = fixed_dofs, fixed_vals
+    if plane is not None:
+        cd, cv = plane.constraints(state)
+        dofs, vals = np.concatenate([fixed_dofs, cd]), np.concatenate([fixed_vals, cv])
+    du_fixed = np.zeros(n)
+    du_fixed[dofs] = vals - u[dofs]
+    free = np.ones(n, bool)
+    free[dofs] = False
+    return free, dofs, du_fixed
+
+
+def _evaluate(mech, u, fext):
+    """Total potential Pi = W(u) - f_ext . u, internal force and tangent at u."""
+    W, r, K = mech.evaluate(u)
+    return W - fext @ u, r, K
+
+
+def _factor(solver, K, free, shift, history):
+    """Factor K_ff; if it is not positive definite (the Newton direction would not descend in
+    energy: a structural instability), shift the diagonal, K_ff + s diag(K_ff), s = 1e-6, 1e-5,
+    ... (Levenberg-Marquardt); a shift that worked is reduced tenfold at the next iteration.
+    Returns (factor, shift)."""
+    shift = shift / 10.0 if shift > 1e-6 else 0.0
+    while True:
         try:
-            trial = mech.linearize(u + alpha * du)
-        except FloatingPointError:
-            alpha *= 0.5
-            continue
-        s1 = du[free] @ (trial[0] - fext)[free]
-        if exact or s0 == 0.0 or np.sign(s1) == np.sign(s0) or abs(s1) <= 0.8 * abs(s0):
-            return alpha, trial
-        alpha *= max(0.1, s0 / (s0 - s1))
-    try:
-        return alpha, mech.linearize(u + alpha * du)
-    except FloatingPointError:
-        raise _StepFailure("line search failed: every step length inverts an element; likely "
-                           "cause: the load step is too large for the deformation", history) from None
+            return solver.factor(K, free, shift), shift
+        except NotPositiveDefinite:
+            shift = max(10.0 * shift, 1e-6)
+            if shift > 1e3:
+                raise _StepFailure("the tangent is not positive definite even with a diagonal shift "
+                                   "of 1e3; likely cause: an unconstrained rigid-body mode", history) from None
 
 
-def _solve_constrained(K, rhs, free, du_fixed):
-    """Solve K du = rhs on the free dofs with du = du_fixed on the others, by symmetric
-    elimination in place of the rows and columns (the sparsity pattern is kept)."""
-    K = K.copy()
-    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-    fixed = ~free
-    b = rhs - K @ np.where(fixed, du_fixed, 0.0)
-    K.data[fixed[rows] | fixed[K.indices]] = 0.0
-    K.data[fixed[rows] & (rows == K.indices)] = 1.0
-    b[fixed] = du_fixed[fixed]
-    # the pattern is structurally symmetric: a minimum-degree ordering of A^T + A suits it
-    return spla.spsolve(K.tocsc(), b, permc_spec="MMD_AT_PLUS_A")
+def _line_search(mech, solver, step, u_start, u, Pi, res, K, fext, shift, held, history,
+                 tries: int = 8):
+    """The next iterate P(u + a du) (projected onto the admissible set) and its linearization.
+
+    While prescribed values are still being imposed (not `held`), a = 1 unless an element would
+    invert (halve). Then a backtracks (quadratic interpolation, a in [0.1 a, 0.5 a]) until the
+    Armijo condition Pi(P(u + a du)) <= Pi(u) + 1e-4 r . (P(u + a du) - u) holds (to round-off
+    of Pi); if no a does, the direction is not one of descent: the diagonal shift is raised
+    (at most three times) and the direction recomputed. Returns (a, u, Pi, r, K, shift)."""
+    slack = 1e-12 * abs(Pi) + 1e-14 * np.linalg.norm(res) * np.max(np.abs(u))
+    plane = step.plane
+    for attempt in range(4):
+        du = step.du
+        s0 = du @ res
+        alpha = 1.0
+        for _ in range(tries):
+            try:
+                trial = u + alpha * du
+                if plane is not None:
+                    trial = plane.project(trial, u_start, step.state, step.holds(alpha))
+                Pi1, r1, K1 = _evaluate(mech, trial, fext)
+            except FloatingPointError:
+                alpha *= 0.5
+                continue
+            if not held or Pi1 - Pi <= 1e-4 * (res @ (trial - u)) + slack:
+                return alpha, trial, Pi1, r1, K1, shift
+            # quadratic model along the ray: Pi(a) ~ Pi + s0 a + c a^2
+            curv = (Pi1 - Pi - s0 * alpha) / alpha**2
+            a_min = -s0 / (2.0 * curv) if curv > 0 and s0 < 0 else 0.1 * alpha
+            alpha = float(np.clip(a_min, 0.1 * alpha, 0.5 * alpha))
+        if not held or attempt == 3:
+            break
+        shift = step.solve(solver, K, max(100.0 * shift, 1e-3), history)
+    raise _StepFailure("line search failed: no step length decreases the energy (or every one "
+                       "inverts an element); likely cause: the load step is too large for the "
+                       "deformation", history)
 
 
 def _size(mech: Mechanics) -> float:
