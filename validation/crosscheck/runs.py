@@ -222,6 +222,11 @@ class RunMemo:
             raise outcome
         return outcome
 
+    @property
+    def requests(self) -> tuple[FemRun, ...]:
+        """Every distinct request asked for so far."""
+        return tuple(self._store)
+
     def outcome(self, request: FemRun) -> FemResult | Exception:
         """The result, or the exception the run raised (for outcome tables)."""
         try:
