@@ -40,7 +40,8 @@ Per converged step, `CupResponse` holds (all SI):
   mesh levels (kept for comparison); ``l_half_max_m``: the width at half maximum of the lumped nodal
   pressure (`postprocess.half_maximum_width`);
 * ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
-  elastic energy), ``newton_iterations``, and the pressure profiles ``pressure[i]``.
+  elastic energy), ``newton_iterations``, ``unstable`` (the tangent lost definiteness in the step
+  that ended there: buckling or a snap, across which the path may jump, `fem.solver`), and the pressure profiles ``pressure[i]``.
 """
 
 from __future__ import annotations
@@ -84,6 +85,7 @@ class CupResponse:
     penetration_m: np.ndarray
     energy_J: np.ndarray
     newton_iterations: np.ndarray
+    unstable: np.ndarray
     pressure: tuple[PressureProfile, ...]
     stats: SolverStats
     mesh: Mesh = field(repr=False)
@@ -159,7 +161,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
         h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
         F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l_med"),
         l_weighted_m=col("l_w"), l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
-        newton_iterations=col("its").astype(int), pressure=tuple(st["p"] for st in steps),
+        newton_iterations=col("its").astype(int), unstable=col("unstable").astype(bool), pressure=tuple(st["p"] for st in steps),
         stats=stats,
         mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
         nodal_pressure_Pa=tuple(st["p_nodes"] for st in steps))
@@ -178,7 +180,7 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
             "Fc": float(np.sum(prof.p_gauss_Pa * prof.w_m2)), "r_c": r_c,
             "V": enclosed_volume(x[0, path], x[1, path], on_path),
             "l_w": contact_width(prof, r_c), "l_hm": l_hm, "l_med": l_med,
-            "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations,
+            "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations, "unstable": s.unstable,
             "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
 
 

@@ -104,6 +104,7 @@ class StepResult:
     r_int: np.ndarray
     contact: ContactState | None
     iterations: int
+    unstable: bool = False    # the tangent lost definiteness in this step (buckling, snap-through)
 
 
 class _StepFailure(Exception):
@@ -168,7 +169,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         dt_ok = t1 - t
         u0, r0, W0, state, t, jumps = u1, r1, W1, state1, t1, 0
         if on_step:
-            on_step(StepResult(t, u1, r1, state1, its))
+            on_step(StepResult(t, u1, r1, state1, its, bool(indefinite)))
         if progress:
             progress(t / t_max, f"step {steps}: {name} = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:

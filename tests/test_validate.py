@@ -172,3 +172,34 @@ def test_energy_check_halves_the_step_for_a_quadrature_error_but_not_for_a_defec
     bad = _QuadraticForce(defect=1.05)            # W off by 5 %: halving the step cannot fix it
     (value, tol), _ = _energy_with_step_halving(bad, req, fem_checks(bad.outcome(req), 3e-4)["energy"])
     assert value > tol and bad.steps[1:] == [0.05, 0.025]
+
+
+def _snapping(sign):
+    """F0 = c u^2 on a fine grid (trapezoid error ~1e-5), the stored energy jumping by sign x 10 %
+    of its final value at one step flagged unstable (a snap)."""
+    u = np.linspace(0.0, 1e-3, 401)
+    W = 1e6 * u**3 / 3
+    W[200:] -= sign * 0.1 * W[-1]
+    unstable = np.zeros(u.size, bool)
+    unstable[200] = True
+    z = np.zeros_like(u)
+    return FemResult(request=FemRun(), h1_m=1e-3, u_m=u, F0_N=1e6 * u**2, F0_contact_N=1e6 * u**2,
+                     r_c_m=z, l_m=z, V_m3=z, energy_J=W, penetration_m=z, wall_s=0.0, steps=400,
+                     newton_iterations=0, dofs=1, outline_r_m=z, outline_z_m=z, outline_p_Pa=z,
+                     unstable=unstable)
+
+
+def test_a_snap_may_lose_energy_but_not_create_it():
+    from validation.crosscheck.extremes import _snaps, fem_checks
+    lossy = fem_checks(_snapping(+1), 3e-4)            # the snap dissipates 10 % of W: admissible
+    assert lossy["energy"][0] < 1e-4 and lossy["snap dissipation >= 0"][0] == 0.0
+    assert "dissipating 11.1 % of the final W" in _snaps(_snapping(+1))   # 0.1 / 0.9
+    creating = fem_checks(_snapping(-1), 3e-4)         # a snap that creates energy is a defect
+    assert creating["snap dissipation >= 0"][0] == pytest.approx(0.1 / 1.1, rel=1e-3)
+    unflagged = dataclasses_replace(_snapping(+1), unstable=None)   # the same jump on a "stable" step
+    assert fem_checks(unflagged, 3e-4)["energy"][0] > 0.05
+
+
+def dataclasses_replace(obj, **kw):
+    import dataclasses
+    return dataclasses.replace(obj, **kw)

@@ -124,6 +124,7 @@ class FemResult:
     outline_r_m: np.ndarray = field(repr=False)   # deformed closed outline at the last step
     outline_z_m: np.ndarray = field(repr=False)
     outline_p_Pa: np.ndarray = field(repr=False)  # contact pressure on it (0 off contact)
+    unstable: np.ndarray | None = field(default=None, repr=False)   # per step: tangent indefinite
 
     def F0_at(self, u_m) -> np.ndarray:
         """F0 at plate displacements u [N], monotone cubic (PCHIP) between the steps."""
@@ -165,7 +166,8 @@ def compute(request: FemRun, progress: Callable[[float, str], None] | None = Non
                      F0_contact_N=resp.F0_contact_N, r_c_m=resp.r_c_m, l_m=resp.l_m, V_m3=resp.V_m3,
                      energy_J=resp.energy_J, penetration_m=resp.penetration_m, wall_s=wall,
                      steps=int(resp.stats.steps), newton_iterations=int(resp.stats.newton_iterations),
-                     dofs=int(resp.stats.dofs), outline_r_m=r, outline_z_m=z, outline_p_Pa=p)
+                     dofs=int(resp.stats.dofs), outline_r_m=r, outline_z_m=z, outline_p_Pa=p,
+                     unstable=resp.unstable)
 
 
 def _deformed_outline(resp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
