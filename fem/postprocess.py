@@ -142,8 +142,8 @@ def median_force_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = 
                        innermost: bool = True) -> float:
     """Median-force strip width l_m = 2 (r_half - r_c) [m] of the sealing strip next to r_c.
 
-    r_half is where the radial line force int_{r_c}^{r} p dr (trapezoid rule on the samples) reaches
-    half of its total over the strip: half the load of the strip acts within l_m / 2 of its inner
+    r_half is where the radial line force int_{r_c}^{r} p dr (trapezoid rule on the samples, p
+    interpolated at r_c; nothing inside r_c counts) reaches half of its total over the strip: half the load of the strip acts within l_m / 2 of its inner
     edge. For the paper's uniform strip (eq. 6) it is exactly l; for a triangle falling from the
     edge to zero over w it is (2 - sqrt 2) w. It rests on a cumulative integral of p only, so a
     concentrated (even singular) pressure moves it by what it carries and no more: unlike int p^2
@@ -164,9 +164,13 @@ def median_force_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = 
     if not np.any(p > 0):
         raise ValueError("p_Pa: no positive contact pressure, the strip width is undefined")
     r_c = inner_contact_radius(r, p) if r_c_m is None else float(r_c_m)
-    p = np.where(r >= r_c, np.clip(p, 0.0, None), 0.0)
+    p = np.clip(p, 0.0, None)
     if innermost:
         r, p = _innermost_zone(r, p)
+    beyond = r > r_c                 # the profile from the edge on: p interpolated at r_c
+    r, p = np.concatenate([[r_c], r[beyond]]), np.concatenate([[np.interp(r_c, r, p)], p[beyond]])
+    if r.size < 2 or not np.any(p > 0):
+        return 0.0
     return float(2.0 * (_load_quantile(r, p, 0.5) - r_c))
 
 

@@ -278,3 +278,16 @@ def test_quartile_width_converges_for_an_edge_between_samples():
         errors.append(abs(quartile_width(r, p) - exact))
         assert errors[-1] <= h
     assert errors[-1] < errors[0] / 4
+
+
+def test_median_force_width_counts_no_load_inside_the_edge():
+    # a uniform strip sampled on a grid whose node r_k is the edge: the piecewise-linear ramp
+    # from the free node r_{k-1} to r_k lies inside r_c and must not count (it made l_m < 0 for
+    # a contact zone of one loaded node); the width is then exactly l, and never negative
+    h, r_c, l = 0.1e-3, 10.0e-3, 1.0e-3
+    r = r_c + h * np.arange(-5, 16)
+    r = np.sort(np.concatenate([r, [r_c + l + 1e-12]]))           # a sharp fall at r_c + l
+    p = np.where((r >= r_c - 1e-15) & (r <= r_c + l + 1e-15), 2e4, 0.0)
+    assert median_force_width(r, p, r_c) == pytest.approx(l, rel=1e-9)
+    one = np.array([r_c - h, r_c, r_c + 1e-9, r_c + h])             # one loaded node, then free
+    assert 0.0 <= median_force_width(one, np.array([0.0, 1e4, 0.0, 0.0]), r_c) < 1e-9
