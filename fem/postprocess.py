@@ -6,10 +6,13 @@ solver, each checked against closed forms in ``tests/test_fem_postprocess.py``.
 - `enclosed_volume`: the cavity volume V of eq. (4), by the divergence theorem on the deformed
   cavity-facing polyline.
 - `inner_contact_radius`: r_c, the inner edge of the contact (cf. eq. 3).
-- `pressure_weighted_width`, `half_maximum_width` and `median_force_width`: three definitions of
-  the contact-strip width l of eqs. (5)-(6). Only the median-force width rests on a cumulative
-  integral of p alone; the other two react to a singular rim-corner pressure and converge poorly
-  (benchmarks/bench_strip_width.py).
+- `pressure_weighted_width`, `half_maximum_width`, `median_force_width` and `quartile_width`:
+  four definitions of the contact-strip width l of eqs. (5)-(6), all exact for the paper's
+  uniform strip. The median-force and the force-quartile widths rest on the cumulative line
+  force int p dr alone, over the innermost contact zone (`contact_zones`: the sealing strip next
+  to r_c, without a separate rim-corner contact); the quartile width also does without the
+  contact edge r_c, which jumps from node to node, and is the one that converges with the mesh.
+  The other two react to a singular rim-corner pressure (benchmarks/bench_strip_width.py).
 
 Pressure profiles p(r) are sampled at increasing radii and taken piecewise-linear between the
 samples; integrals of such profiles are exact (no quadrature error beyond the interpolation).
@@ -23,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["enclosed_volume", "inner_contact_radius", "pressure_weighted_width", "weighted_width",
-           "half_maximum_width", "contact_force", "Richardson", "richardson"]
+           "half_maximum_width", "median_force_width", "quartile_width", "contact_zones", "contact_force",
+           "Richardson", "richardson"]
 
 
 def enclosed_volume(r_m: np.ndarray, z_m: np.ndarray, in_contact: np.ndarray | None = None) -> float:
@@ -134,28 +138,92 @@ def half_maximum_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = 
     return float(right - max(left, r_c))
 
 
-def median_force_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = None) -> float:
-    """Median-force strip width l_m = 2 (r_half - r_c) [m].
+def median_force_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | None = None,
+                       innermost: bool = True) -> float:
+    """Median-force strip width l_m = 2 (r_half - r_c) [m] of the sealing strip next to r_c.
 
-    r_half is where the radial line force int_{r_c}^{r} p dr (trapezoid rule on the samples) reaches
-    half of its total: half the load of the strip acts within l_m / 2 of its inner edge. For the
-    paper's uniform strip (eq. 6) it is exactly l; for a triangle falling from the edge to zero
-    over w it is (2 - sqrt 2) w. It rests on a cumulative integral of p only, so a concentrated
-    (even singular) pressure, e.g. at a sharp rim corner, moves it by what it carries and no more:
-    unlike int p^2 in `pressure_weighted_width`, it converges with the mesh. `r_c_m` defaults to
+    r_half is where the radial line force int_{r_c}^{r} p dr (trapezoid rule on the samples, p
+    interpolated at r_c; nothing inside r_c counts) reaches half of its total over the strip: half the load of the strip acts within l_m / 2 of its inner
+    edge. For the paper's uniform strip (eq. 6) it is exactly l; for a triangle falling from the
+    edge to zero over w it is (2 - sqrt 2) w. It rests on a cumulative integral of p only, so a
+    concentrated (even singular) pressure moves it by what it carries and no more: unlike int p^2
+    in `pressure_weighted_width`, it converges with the mesh. `r_c_m` defaults to
     `inner_contact_radius`.
+
+    The strip is the innermost contact zone (`innermost=True`): the samples from r_c up to the
+    first one beyond it where the pressure is back to zero. A wall pressed onto the plane can
+    touch it in two places, the rim corner and, from the mid-wall touchdown on, an inner strip
+    that grows inwards; the zones are separated by a gap (free nodes, p = 0). The paper's l is
+    the width of the sealing strip next to r_c (eqs. 5-6: the strip at the cavity's edge through
+    which the air leaks), so the outer zone is left out: its load sits at a sharp corner over a
+    width the mesh does not resolve, and counted with the strip it made l_m scatter between mesh
+    levels by its load times its distance from the strip. `innermost=False` integrates over all
+    zones outwards of r_c.
     """
     r, p = _profile(r_m, p_Pa, increasing=True)
     if not np.any(p > 0):
         raise ValueError("p_Pa: no positive contact pressure, the strip width is undefined")
     r_c = inner_contact_radius(r, p) if r_c_m is None else float(r_c_m)
-    p = np.where(r >= r_c, np.clip(p, 0.0, None), 0.0)
+    p = np.clip(p, 0.0, None)
+    if innermost:
+        r, p = _innermost_zone(r, p)
+    beyond = r > r_c                 # the profile from the edge on: p interpolated at r_c
+    r, p = np.concatenate([[r_c], r[beyond]]), np.concatenate([[np.interp(r_c, r, p)], p[beyond]])
+    if r.size < 2 or not np.any(p > 0):
+        return 0.0
+    return float(2.0 * (_load_quantile(r, p, 0.5) - r_c))
+
+
+def quartile_width(r_m: np.ndarray, p_Pa: np.ndarray, innermost: bool = True) -> float:
+    """Force-quartile strip width l_q = 2 (r_75 - r_25) [m] of the sealing strip.
+
+    r_25 and r_75 are where the radial line force int p dr (trapezoid rule on the samples), taken
+    from the inner end of the strip outwards, reaches a quarter and three quarters of its total:
+    the middle half of the strip's load lies within l_q / 2. For the paper's uniform strip
+    (eq. 6) it is exactly l, for a triangle falling from the edge to zero over w it is
+    (sqrt 3 - 1) w. Unlike `median_force_width` it does not use the contact edge r_c: where the
+    pressure peaks at the edge (a wall pressed flat onto the plane), r_c jumps by a node spacing
+    each time the contact front passes a node, and 2 (r_half - r_c) jumps by twice that, while
+    the quartiles of the cumulative load move continuously. The strip is the innermost contact
+    zone (see `median_force_width`) unless `innermost=False`.
+    """
+    r, p = _profile(r_m, p_Pa, increasing=True)
+    if not np.any(p > 0):
+        raise ValueError("p_Pa: no positive contact pressure, the strip width is undefined")
+    p = np.clip(p, 0.0, None)
+    if innermost:
+        r, p = _innermost_zone(r, p)
+    return float(2.0 * (_load_quantile(r, p, 0.75) - _load_quantile(r, p, 0.25)))
+
+
+def _load_quantile(r: np.ndarray, p: np.ndarray, fraction: float) -> float:
+    """The radius where the trapezoidal line force int_{r_0}^{r} p dr reaches `fraction` of its total."""
     cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(r))])
-    half = 0.5 * cumulative[-1]
-    i = int(np.searchsorted(cumulative, half))          # first sample at or past half the load
-    r_half = r[i] if cumulative[i] == half else _crossing_cumulative(r[i - 1], r[i], p[i - 1], p[i],
-                                                                      half - cumulative[i - 1])
-    return float(2.0 * (r_half - r_c))
+    target = fraction * cumulative[-1]
+    i = max(int(np.searchsorted(cumulative, target)), 1)     # first sample at or past the target
+    return float(r[i]) if cumulative[i] == target else \
+        _crossing_cumulative(r[i - 1], r[i], p[i - 1], p[i], target - cumulative[i - 1])
+
+
+def contact_zones(r_m: np.ndarray, p_Pa: np.ndarray) -> list[tuple[float, float]]:
+    """The contact zones [(r_in, r_out), ...] [m] of a sampled pressure profile, inner first.
+
+    A zone is a maximal run of samples with p > 0; it extends to the zero-pressure samples on
+    either side (where the piecewise-linear p returns to zero), or ends at the first or last
+    sample if it is loaded."""
+    r, p = _profile(r_m, p_Pa, increasing=True)
+    loaded = p > 0
+    starts = np.flatnonzero(loaded & ~np.concatenate([[False], loaded[:-1]]))
+    ends = np.flatnonzero(loaded & ~np.concatenate([loaded[1:], [False]]))
+    return [(float(r[max(a - 1, 0)]), float(r[min(b + 1, r.size - 1)])) for a, b in zip(starts, ends)]
+
+
+def _innermost_zone(r: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The samples up to the first zero after the first loaded one (the innermost contact zone)."""
+    k = _first_loaded(p, 0.0)
+    free = np.flatnonzero(p[k:] <= 0.0)
+    end = r.size if free.size == 0 else k + int(free[0]) + 1
+    return r[:end], p[:end]
 
 
 def _crossing_cumulative(r0: float, r1: float, p0: float, p1: float, target: float) -> float:

@@ -114,6 +114,34 @@ def test_grading_through_the_thickness():
     assert layers[1:] / layers[:-1] == pytest.approx(np.full(3, 8.0 ** 0.25), rel=1e-12)
 
 
+def test_end_zones_equidistribute_the_closed_form_density():
+    # rho(s) = 1 + A_p exp(-s/w_p) + A_r exp(-(1-s)/w_r) (along_grading 0) integrates to
+    # C(s) = s + A_p w_p (1 - exp(-s/w_p)) + A_r w_r (exp(-(1-s)/w_r) - exp(-1/w_r)); the nodes
+    # must split C(1) into equal parts (the mesh integrates rho numerically on a fine grid)
+    g = cup_geometry("A")
+    spec = MeshSpec(n_along=24, n_through=1, along_grading=0.0, plate_refinement=10.0, plate_width=0.02,
+                    rim_refinement=3.0, rim_width=0.05)
+    mesh = cup_mesh(g, spec)
+    r, _ = mesh.doflocs[:, boundary_path(mesh, "cavity")[::2]]
+    s = (r - g.r0_m) / (g.r1_m - g.r0_m)
+    C = lambda x: (x + 10.0 * 0.02 * (1 - np.exp(-x / 0.02))                  # noqa: E731
+                   + 3.0 * 0.05 * (np.exp(-(1 - x) / 0.05) - np.exp(-1 / 0.05)))
+    assert C(s) / C(1.0) == pytest.approx(np.linspace(0, 1, 25), abs=1e-6)
+    lengths = np.diff(s)        # the first element ~(1 + A_p) times shorter than the middle ones
+    assert lengths[0] < lengths[12] / 5 and lengths[-1] < lengths[12] / 2.5
+
+
+def test_through_clustering_gives_cosine_layers():
+    g = cup_geometry("A")
+    mesh = cup_mesh(g, MeshSpec(n_along=2, n_through=4, through_clustering=1.0))
+    r, z = mesh.doflocs[:, boundary_path(mesh, "top_plate")[::2]]
+    layers = np.hypot(np.diff(r), np.diff(z))
+    d = g.thickness_at(np.array([0.0]))[0]
+    # t_k = (1 - cos(pi k / 4)) / 2: layers 0.146, 0.354, 0.354, 0.146 of the thickness
+    expected = np.diff(0.5 * (1 - np.cos(np.pi * np.arange(5) / 4)))
+    assert np.sort(layers / d) == pytest.approx(np.sort(expected), rel=1e-12)
+
+
 def test_refinement_nests_the_vertices():
     g = cup_geometry("B")
     coarse, fine = (cup_mesh(g, FIDELITIES["coarse"].refined(k)) for k in (1, 2))
@@ -137,7 +165,8 @@ def test_mesh_spec_validation():
     assert mesh_spec("medium").n_along == 2 * mesh_spec("coarse").n_along
     assert mesh_spec("coarse", n_through=3).n_through == 3
     for bad in ({"n_along": 0}, {"n_through": 2.5}, {"along_grading": -2}, {"through_ratio": 0},
-                {"element": "hex"}):
+                {"element": "hex"}, {"plate_refinement": -1}, {"rim_width": 0.0},
+                {"through_clustering": 1.5}):
         with pytest.raises(ValueError, match=next(iter(bad))):
             mesh_spec("coarse", **bad)
     with pytest.raises(ValueError, match="fidelity"):

@@ -8,7 +8,8 @@ from scipy.integrate import quad
 
 from fem.geometry import cup_geometry
 from fem.mesh import boundary_path, cup_mesh
-from fem.postprocess import (contact_force, enclosed_volume, half_maximum_width, median_force_width,
+from fem.postprocess import (contact_force, contact_zones, enclosed_volume, half_maximum_width,
+                             median_force_width, quartile_width,
                              inner_contact_radius, pressure_weighted_width)
 
 MM = 1e-3
@@ -211,3 +212,82 @@ def test_median_force_width_is_bounded_by_a_concentrated_rim_force():
         # half of 1.1 l of load lies at 0.55 l from the edge: l_m -> 1.1 l as the spike narrows,
         # off by no more than the spike's own width (where its load sits), however high it is
         assert abs(median_force_width(r, p, r_c) - 1.1 * l) <= 1.5 * spike
+
+
+def _two_strips(r_c, l, gap, l_out, p_in=3e4, p_out=5e4, eps=1e-12):
+    """A uniform inner strip [r_c, r_c + l] and a uniform outer one beyond a gap, sampled on
+    their edges (plus a zero just inside and one just outside each), so the trapezoid rule is exact."""
+    r_out = r_c + l + gap
+    r = np.array([r_c - 1e-4, r_c, r_c + eps, r_c + l - eps, r_c + l, r_c + l + gap / 2,
+                  r_out, r_out + eps, r_out + l_out - eps, r_out + l_out, r_out + l_out + 1e-4])
+    p = np.array([0, 0, p_in, p_in, 0, 0, 0, p_out, p_out, 0, 0], dtype=float)
+    return r, p
+
+
+def test_contact_zones_of_two_strips():
+    r, p = _two_strips(r_c=10e-3, l=1e-3, gap=0.5e-3, l_out=0.2e-3)
+    zones = contact_zones(r, p)
+    assert len(zones) == 2
+    assert zones[0] == pytest.approx((10e-3, 11e-3), abs=1e-11)
+    assert zones[1] == pytest.approx((11.5e-3, 11.7e-3), abs=1e-11)
+    assert contact_zones(r, np.where(r < 11.2e-3, p, 0.0)) == [zones[0]]
+
+
+def test_median_and_quartile_widths_take_the_innermost_zone():
+    # the paper's l is the sealing strip next to r_c: an outer (rim-corner) zone, however
+    # loaded, does not change it; with innermost=False the closed form of both strips holds
+    r_c, l, gap, l_out = 10e-3, 1e-3, 0.5e-3, 0.2e-3
+    for p_out in (5e4, 5e5):
+        r, p = _two_strips(r_c, l, gap, l_out, p_out=p_out)
+        assert median_force_width(r, p, r_c) == pytest.approx(l, rel=1e-6)
+        assert quartile_width(r, p) == pytest.approx(l, rel=1e-6)
+    # all zones (p_out = 5e5 Pa): line forces 30 N/m inside and 100 N/m outside, so half of the
+    # total lies (65 - 30) N/m / 5e5 Pa into the outer strip
+    f_in, f_out = 3e4 * l, 5e5 * l_out
+    r_half = r_c + l + gap + (0.5 * (f_in + f_out) - f_in) / 5e5
+    assert median_force_width(r, p, r_c, innermost=False) == pytest.approx(2 * (r_half - r_c), rel=1e-6)
+
+
+def test_quartile_width_closed_forms():
+    # uniform strip: exactly l; triangle falling from p0 at the edge to 0 over w: the load
+    # fraction within x is 1 - (1 - x/w)^2, quartiles at w (1 - sqrt(3)/2) and w / 2
+    r = np.array([10e-3, 10.5e-3, 10.5e-3 + 1e-12, 11.7e-3 - 1e-12, 11.7e-3, 12e-3])
+    p = np.array([0.0, 0.0, 3e4, 3e4, 0.0, 0.0])
+    assert quartile_width(r, p) == pytest.approx(1.2e-3, rel=1e-6)
+    r_c, w = 8e-3, 2e-3
+    r = np.linspace(r_c, r_c + w, 9)        # the trapezoid rule is exact for the linear profile
+    p = 5e4 * (1 - (r - r_c) / w)
+    assert quartile_width(r, p) == pytest.approx((np.sqrt(3) - 1) * w, rel=1e-12)
+    # it does not use the contact edge: zero samples further inside change nothing
+    assert quartile_width(np.concatenate([[7e-3, 7.5e-3, r_c - 1e-12], r]),
+                          np.concatenate([[0, 0, 0], p])) == pytest.approx((np.sqrt(3) - 1) * w, rel=1e-9)
+
+
+def test_quartile_width_converges_for_an_edge_between_samples():
+    # a triangle whose edge lies between the samples (the contact front between two nodes): the
+    # sampled (piecewise-linear) profile smears the edge over one spacing h, so l_q converges to
+    # the closed form at first order or better; the median width measured from the sampled edge
+    # r_c = first loaded sample (a pressure falling from the edge) is off by up to 2 h
+    r_c, w = 8.03e-3, 2e-3
+    exact = (np.sqrt(3) - 1) * w
+    errors = []
+    for n in (20, 40, 80, 160):
+        h = 4e-3 / n
+        r = 7e-3 + h * np.arange(n + 1)
+        p = np.where((r >= r_c) & (r <= r_c + w), 5e4 * (1 - (r - r_c) / w), 0.0)
+        errors.append(abs(quartile_width(r, p) - exact))
+        assert errors[-1] <= h
+    assert errors[-1] < errors[0] / 4
+
+
+def test_median_force_width_counts_no_load_inside_the_edge():
+    # a uniform strip sampled on a grid whose node r_k is the edge: the piecewise-linear ramp
+    # from the free node r_{k-1} to r_k lies inside r_c and must not count (it made l_m < 0 for
+    # a contact zone of one loaded node); the width is then exactly l, and never negative
+    h, r_c, l = 0.1e-3, 10.0e-3, 1.0e-3
+    r = r_c + h * np.arange(-5, 16)
+    r = np.sort(np.concatenate([r, [r_c + l + 1e-12]]))           # a sharp fall at r_c + l
+    p = np.where((r >= r_c - 1e-15) & (r <= r_c + l + 1e-15), 2e4, 0.0)
+    assert median_force_width(r, p, r_c) == pytest.approx(l, rel=1e-9)
+    one = np.array([r_c - h, r_c, r_c + 1e-9, r_c + h])             # one loaded node, then free
+    assert 0.0 <= median_force_width(one, np.array([0.0, 1e4, 0.0, 0.0]), r_c) < 1e-9
