@@ -10,9 +10,9 @@ against the reference of
 
   F0            over u/h1 = 0.10, 0.15, ..., 0.90 (sticking: outside the mid-wall touchdown, see
                 below), and at 0.9 h1 alone;
-  l_q           the force-quartile strip width (`postprocess.quartile_width`, innermost zone) over
-                u/h1 = 0.50 ... 0.90, from the lumped nodal pressure of each step;
-  l_m           the hand-off's median-force width (`CupResponse.l_m`) over the same range.
+  l_q           the hand-off's strip width `CupResponse.l_m`: the force-quartile width
+                (`postprocess.quartile_width`, innermost zone) over u/h1 = 0.50 ... 0.90;
+  l_m           the median-force width (`CupResponse.l_median_m`) over the same range.
 
 Sticking contact (cup A): the wall rolls over its stuck rim, F0 passes a maximum and falls until
 the middle of the wall touches down (u_td ~ 0.54 h1), after which F0 rises steeply (x2.5 within
@@ -44,24 +44,12 @@ from fem.cup import compress_cup  # noqa: E402
 from fem.geometry import cup_geometry  # noqa: E402
 from fem.material import NeoHookean  # noqa: E402
 from fem.mesh import FIDELITIES, cup_mesh  # noqa: E402
-from fem.postprocess import quartile_width, richardson  # noqa: E402
+from fem.postprocess import richardson  # noqa: E402
 
 U_F0 = np.round(np.arange(0.10, 0.901, 0.05), 4)      # u / h1 for F0
 U_L = np.round(np.arange(0.50, 0.901, 0.05), 4)       # u / h1 for the strip widths
 U_MAX = 0.9
 MAX_STEP = 0.01
-
-
-def strip_widths(response) -> np.ndarray:
-    """The force-quartile width of every step's lumped nodal pressure profile [m] (0 when fewer
-    than two nodes carry pressure: the rim corner alone)."""
-    out = []
-    for profile in response.pressure:
-        r, p = profile.r_m, profile.p_Pa
-        keep = np.concatenate([[True], np.diff(r) > 0]) if r.size else np.zeros(0, bool)
-        r, p = r[keep], p[keep]
-        out.append(quartile_width(r, p) if np.count_nonzero(p > 0) >= 2 else 0.0)
-    return np.array(out)
 
 
 def run_level(level: str, contact: str, cache: Path | None) -> dict:
@@ -81,7 +69,7 @@ def run_level(level: str, contact: str, cache: Path | None) -> dict:
     u_fine = np.linspace(0.3, U_MAX, 601)
     out = {"spec": repr(spec), "dofs": int(resp.stats.dofs), "steps": int(resp.stats.steps),
            "time_s": time.perf_counter() - t0, "F0": sample(resp.F0_N, U_F0),
-           "l_q": sample(strip_widths(resp), U_L), "l_m": sample(resp.l_m, U_L),
+           "l_q": sample(resp.l_m, U_L), "l_m": sample(resp.l_median_m, U_L),
            "u_td": _touchdown(u_fine, sample(resp.F0_N, u_fine))}
     if file:
         file.parent.mkdir(parents=True, exist_ok=True)

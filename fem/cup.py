@@ -30,10 +30,14 @@ Per converged step, `CupResponse` holds (all SI):
 * ``V_m3``: the cavity volume under the plate and inside the cup down to z = 0 (the region of
   eq. 4), `postprocess.enclosed_volume` of the deformed cavity path down to its first contact;
 * ``l_m``: the strip width l handed to the reduced model (eq. 5's l, the width of the strip of
-  eq. 6 that carries the contact load): the median-force width, twice the distance from r_c within
-  which half of the radial line force int p dr acts (`postprocess.median_force_width`; exact for a
-  uniform strip, and, resting on a cumulative integral of p alone, insensitive to the singular
-  pressure at a sharp rim corner, so it converges with the mesh: `benchmarks/bench_strip_width.py`);
+  eq. 6 that carries the contact load): the force-quartile width 2 (r_75 - r_25) of the innermost
+  contact zone, the sealing strip next to r_c (`postprocess.quartile_width`: the middle half of
+  the strip's radial line force int p dr lies within l / 2; exact for a uniform strip; it rests on
+  the cumulative load only, so the singular pressure at a sharp corner moves it by what it carries,
+  and it does not use r_c, which jumps by a node spacing whenever the front passes a node; it
+  converges with the mesh: `benchmarks/bench_mesh_levels.py`); 0 where the mesh resolves no strip
+  (one loaded node: the rim corner alone); ``l_median_m``: the median-force width 2 (r_half - r_c)
+  (`postprocess.median_force_width`, scatters by the jumps of r_c);
 * ``l_weighted_m``: the pressure-weighted width (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
   (`contact_width`, the integrals over the Gauss-point projection), l (1 + l / 2 r_c) for a uniform
   strip; its int p^2 reacts to the singular rim-corner pressure, so it scatters 10-30 % between
@@ -57,7 +61,7 @@ from skfem import Mesh
 from .contact import PressureProfile, RigidPlane
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
 from .postprocess import (enclosed_volume, half_maximum_width, inner_contact_radius,
-                          median_force_width, weighted_width)
+                          median_force_width, quartile_width, weighted_width)
 from .forms import Mechanics
 from .kinematics import Kinematics
 from .material import NeoHookean
@@ -80,6 +84,7 @@ class CupResponse:
     r_c_m: np.ndarray
     V_m3: np.ndarray
     l_m: np.ndarray
+    l_median_m: np.ndarray
     l_weighted_m: np.ndarray
     l_half_max_m: np.ndarray
     penetration_m: np.ndarray
@@ -159,8 +164,8 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     col = lambda k: np.array([st[k] for st in steps])       # noqa: E731
     return CupResponse(
         h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
-        F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l_med"),
-        l_weighted_m=col("l_w"), l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
+        F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l_q"),
+        l_median_m=col("l_med"), l_weighted_m=col("l_w"), l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
         newton_iterations=col("its").astype(int), unstable=col("unstable").astype(bool), pressure=tuple(st["p"] for st in steps),
         stats=stats,
         mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
@@ -175,11 +180,11 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
     x = mech.kin.node_coordinates() + np.stack([s.u[0::2], s.u[1::2]])
     on_path = np.isin(path, active)
     on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
-    r_c, l_hm, l_med = _edge_and_widths(prof, x[0, path[-1]])
+    r_c, l_q, l_hm, l_med = _edge_and_widths(prof, x[0, path[-1]])
     return {"u": s.t, "F0": -float(np.sum(s.r_int[2 * top + 1])),
             "Fc": float(np.sum(prof.p_gauss_Pa * prof.w_m2)), "r_c": r_c,
             "V": enclosed_volume(x[0, path], x[1, path], on_path),
-            "l_w": contact_width(prof, r_c), "l_hm": l_hm, "l_med": l_med,
+            "l_q": l_q, "l_w": contact_width(prof, r_c), "l_hm": l_hm, "l_med": l_med,
             "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations, "unstable": s.unstable,
             "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
 
@@ -194,16 +199,17 @@ def contact_width(profile: PressureProfile, r_c_m: float) -> float:
                           float(np.sum(profile.p_gauss_Pa**2 * profile.w_m2)), r_c_m)
 
 
-def _edge_and_widths(profile: PressureProfile, r_rim: float) -> tuple[float, float, float]:
-    """(r_c, l_half_max, l_median) from the lumped nodal profile; with fewer than two loaded nodes
-    (the rim corner alone, or no contact at u = 0) r_c is that node's (or the rim's) radius, l = 0."""
+def _edge_and_widths(profile: PressureProfile, r_rim: float) -> tuple[float, float, float, float]:
+    """(r_c, l_quartile, l_half_max, l_median) from the lumped nodal profile; with fewer than two
+    loaded nodes (the rim corner alone, or no contact at u = 0) r_c is that node's (or the rim's)
+    radius and the widths are 0 (no strip the mesh resolves)."""
     r, p = profile.r_m, profile.p_Pa
     keep = np.concatenate([[True], np.diff(r) > 0]) if r.size else np.zeros(0, bool)
     r, p = r[keep], p[keep]
     if np.count_nonzero(p > 0) < 2:
-        return (float(r[np.argmax(p)]) if r.size else float(r_rim)), 0.0, 0.0
+        return (float(r[np.argmax(p)]) if r.size else float(r_rim)), 0.0, 0.0, 0.0
     r_c = inner_contact_radius(r, p)
-    return r_c, half_maximum_width(r, p, r_c), median_force_width(r, p, r_c)
+    return r_c, quartile_width(r, p), half_maximum_width(r, p, r_c), median_force_width(r, p, r_c)
 
 
 def _check_mesh(mesh: Mesh) -> None:

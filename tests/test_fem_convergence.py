@@ -12,7 +12,7 @@ same load steps against that reference; the cheap default test compares coarse a
 0.6 h1.
 
 The strip width checked here is the force-quartile width of the innermost contact zone
-(`fem.postprocess.quartile_width`) of each step's lumped nodal pressure.
+(`fem.postprocess.quartile_width`, the hand-off's `CupResponse.l_m`).
 """
 
 import numpy as np
@@ -23,7 +23,6 @@ from fem.cup import compress_cup
 from fem.geometry import cup_geometry
 from fem.material import NeoHookean
 from fem.mesh import FIDELITIES, cup_mesh
-from fem.postprocess import quartile_width
 
 GEOMETRY = cup_geometry("A")
 U_F0 = np.round(np.arange(0.10, 0.901, 0.05), 4)        # u / h1
@@ -58,23 +57,13 @@ REFERENCE = {
 STICKING_SMOOTH = (U_F0 < 0.5 - 1e-9) | (U_F0 > 0.65 + 1e-9)
 
 
-def strip_widths(resp):
-    """Force-quartile width of each step's lumped nodal pressure (0 below two loaded nodes)."""
-    out = []
-    for prof in resp.pressure:
-        keep = np.concatenate([[True], np.diff(prof.r_m) > 0]) if prof.r_m.size else np.zeros(0, bool)
-        r, p = prof.r_m[keep], prof.p_Pa[keep]
-        out.append(quartile_width(r, p) if np.count_nonzero(p > 0) >= 2 else 0.0)
-    return np.array(out)
-
-
 def _curves(level, u_max_over_h1, contact="frictionless", **solver_opts):
     resp = compress_cup(cup_mesh(GEOMETRY, level), NeoHookean(), contact=contact,
                         u_max_m=u_max_over_h1 * GEOMETRY.h1_m, **solver_opts)
     x = resp.u_m / resp.h1_m
     at = lambda y, u: PchipInterpolator(x, y)(u[u <= u_max_over_h1 + 1e-9])     # noqa: E731
     return {"F0": at(resp.F0_N, U_F0), "r_c": 1e3 * at(resp.r_c_m, U_STRIP),
-            "l": 1e3 * at(strip_widths(resp), U_STRIP)}
+            "l": 1e3 * at(resp.l_m, U_STRIP)}
 
 
 def test_coarse_default_agrees_with_the_medium_mesh():

@@ -10,7 +10,7 @@ from scipy.integrate import cumulative_trapezoid
 from fem.cup import compress_cup
 from fem.geometry import cup_geometry
 from fem.material import NeoHookean
-from fem.mesh import cup_mesh
+from fem.mesh import MeshSpec, cup_mesh
 from fem.solver import ConvergenceError
 
 GEOMETRY = cup_geometry("A")
@@ -89,10 +89,17 @@ def test_sticking_is_stiffer_than_frictionless_at_small_u(frictionless, sticking
 
 
 def test_sticking_nodes_do_not_slide(sticking, mesh):
-    """Between consecutive steps, rim-corner node (in contact from the start) keeps its radius."""
+    """The rim corner rests on the plane from the start: while it is being loaded (its pressure
+    rising step by step) it keeps its radius exactly. Later the wall rolls over the rim and the
+    corner unloads; a node whose normal force passes through zero within a step (held: tensile,
+    free: penetrating) can be held by no friction and slides (`fem.contact`), so only the
+    loading phase is checked."""
     corner = np.argmin(np.hypot(mesh.doflocs[0] - 19e-3, mesh.doflocs[1]))
     u_r = np.array([u[2 * corner] for u in sticking.displacements])
-    assert np.allclose(u_r[:8], 0.0, atol=1e-12)
+    p = np.array([q[corner] for q in sticking.nodal_pressure_Pa])
+    loading = 1 + int(np.argmax(np.diff(p) <= 0))        # steps 0 .. loading-1: p rises
+    assert loading >= 4 and p[loading - 1] > 1e5         # a real loading phase (~0.1 h1)
+    assert np.all(u_r[:loading] == 0.0)
 
 
 def test_results_do_not_depend_on_the_path_parameters(mesh):
@@ -109,7 +116,10 @@ def _F0(mesh, nu, formulation, u):
     return compress_cup(mesh, NeoHookean(4e6, nu, formulation), u_max_m=u, max_step=0.1).F0_N[-1]
 
 
-def test_no_locking_as_nu_tends_to_one_half(mesh):
+def test_no_locking_as_nu_tends_to_one_half():
+    # a formulation test, on a fixed mesh with 3 elements through the wall (the levels change;
+    # with more layers the displacement form locks less visibly: ratio 0.28 on 36x4)
+    mesh = cup_mesh(GEOMETRY, MeshSpec(n_along=32, n_through=3, along_grading=-0.5))
     """Mixed form: F0(u = 0.3 h1) approaches the incompressible limit smoothly, its increments
     shrinking like (1 - 2 nu) (0.49 -> 0.499 -> 0.4999: ratio ~0.1, measured 0.10). The plain
     displacement form does not settle (ratio ~0.5 measured: volumetric locking) and ends stiffer."""

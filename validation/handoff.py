@@ -1,10 +1,11 @@
 """From the FEM's `CupResponse` to the reduced model's `StiffnessCurve`, and the run's JSON sidecar.
 
 The CSV carries only the hand-off columns (``u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3``; l is the
-median-force strip width, `fem.cup`), so that `cupcheck lifetime --stiffness` reads it as it reads a
-measured curve. Everything else a run knows goes to the sidecar ``<out>.json``: the provenance,
-the solver statistics, and per step the plate reaction and the integrated contact force, the
-pressure-weighted and half-maximum strip widths, the largest penetration, the stored energy and the Newton iterations.
+force-quartile width of the sealing strip, `fem.cup`), so that `cupcheck lifetime --stiffness`
+reads it as it reads a measured curve. Everything else a run knows goes to the sidecar
+``<out>.json``: the provenance, the solver statistics, and per step the plate reaction and the
+integrated contact force, the median-force, pressure-weighted and half-maximum strip widths, the
+largest penetration, the stored energy and the Newton iterations.
 """
 
 from __future__ import annotations
@@ -50,8 +51,8 @@ def provenance(response: CupResponse, *, geometry: Mapping[str, Any], mesh: Mapp
         "contact": response.contact,
         "fidelity": fidelity,
         "mesh": dict(mesh),
-        "l_definition": "median-force width: twice the distance from r_c within which half of "
-                        "the radial line force int p dr acts",
+        "l_definition": "force-quartile width 2 (r_75 - r_25) of the radial line force int p dr "
+                        "over the innermost contact zone (0: no strip the mesh resolves)",
         "versions": software_versions(),
     }
 
@@ -68,7 +69,7 @@ class CurveArrays(Protocol):
 
 
 def stiffness_curve(response: CurveArrays, provenance: Mapping[str, Any]) -> StiffnessCurve:
-    """The hand-off curve: u, F0 (the plate reaction), r_c, l (median-force width) and V per step."""
+    """The hand-off curve: u, F0 (the plate reaction), r_c, l (force-quartile width) and V per step."""
     return StiffnessCurve(u_m=response.u_m, F0_N=response.F0_N + 0.0, h1_m=response.h1_m,
                           r_c_m=response.r_c_m, l_m=response.l_m, V_m3=response.V_m3,
                           provenance=provenance)
@@ -84,6 +85,7 @@ def sidecar(response: CupResponse, provenance: Mapping[str, Any]) -> dict[str, A
         "u_mm": response.u_m * 1e3,
         "F0_N": response.F0_N,
         "F0_contact_N": response.F0_contact_N,
+        "l_median_mm": response.l_median_m * 1e3,
         "l_weighted_mm": response.l_weighted_m * 1e3,
         "l_half_max_mm": response.l_half_max_m * 1e3,
         "penetration_mm": response.penetration_m * 1e3,
