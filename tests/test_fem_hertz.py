@@ -94,6 +94,8 @@ def test_hertz_default_mesh():
 def test_hertz_converged_mesh(formulation, nu):
     """Converged mesh (40 x 40, first cell a/40): force and contact radius within 1 % (spec)."""
     F, a, E_star, a_node, pen, _ = press(40, 40, nu, formulation)
-    assert F == pytest.approx(hertz_force(a, E_star), rel=0.01)
     a_hertz = (3 * F * RS / (4 * E_star)) ** (1 / 3)
+    print(f"\nHertz, 40 x 40, {formulation}, nu = {nu}: F / F_Hertz(a) - 1 = "
+          f"{100 * (F / hertz_force(a, E_star) - 1):+.2f} %, a / a_Hertz(F) - 1 = {100 * (a / a_hertz - 1):+.2f} %")
+    assert F == pytest.approx(hertz_force(a, E_star), rel=0.01)
     assert a == pytest.approx(a_hertz, rel=0.01)
