@@ -1,9 +1,9 @@
 """Section 2: the rigid-cone laws, eqs (3)-(5), against the FEM's r_c(h), V(h) and l(h).
 
 At the same plate height h = h1 - u, the FEM's inner contact radius r_c, its enclosed cavity
-volume V and its pressure-weighted strip width l are compared with r = r0 (1 + h/h0) (eq 3),
-V = V0 [(r/r0)^3 - 1] (eq 4, at the cone's r) and l = l0 + l_a (1 - r/r0) (eq 5 with Table 1's
-l0, l1, at the cone's r). Samples: u/h1 = 0.25 ... 0.9, where a contact strip exists (before
+volume V and its strip width l (the force-quartile width of the sealing strip, `fem.cup`) are
+compared with r = r0 (1 + h/h0) (eq 3), V = V0 [(r/r0)^3 - 1] (eq 4, at the cone's r) and
+l = l0 + l_a (1 - r/r0) (eq 5 with Table 1's l0, l1, at the cone's r). Samples: u/h1 = 0.25 ... 0.9, where a contact strip exists (before
 that only the rim corner touches, r_c = r1 and l -> 0 with the mesh).
 """
 

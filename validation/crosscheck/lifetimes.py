@@ -154,10 +154,15 @@ def _explain_sealing(ctx: Context, table, srcs) -> None:
         if label[:3] in ("(d)", "(e)"):
             ctx.report.text(NAME, f"*{label}*: strip width: {curve.provenance['l']}.")
     ctx.report.text(NAME, """
-The FEM's strip width l is the median-force width (`fem.cup`). Before the wall lands (u below
-~0.25 h1 for cup A) only the rim corner touches the smooth rigid plane: the FEM resolves no strip
-there (one node in contact, l = 0) while F0 > 0, and eq (6) would give an unbounded strip pressure,
+The FEM's strip width l is the force-quartile width of the sealing strip (`fem.cup`). Before the
+wall lands (u below ~0.25 h1 for cup A) only the rim corner touches the smooth rigid plane: the FEM
+resolves no strip there (one node in contact, l = 0) while F0 > 0, and eq (6) would give an unbounded strip pressure,
 i.e. a perfect seal. The paper's l1 = 0.8 mm at r1 is an optical observation of the real, rounded
 rim on a rough surface, which this FEM (sharp rim corner, smooth plane) does not model; (d) and (e)
 take eq (5) there. Sources (f), (g) keep the FEM's r and V but take l from eq (5) everywhere.
+With its own l the sticking cup (d) seals on this surface: the rim strip it rolls on is 0.02-0.13 mm
+wide at the start state (a sub-element width that the levels do not agree on, section 4), so eq (6)
+puts the strip pressure above the sealing pressure; the result says that the strip width, not the
+stiffness, decides the sticking cup's lifetime, and that a smooth-plane FEM with a sharp rim corner
+cannot give that width.
 """)
