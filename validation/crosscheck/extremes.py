@@ -200,41 +200,20 @@ def scaling_row(ctx: Context, runs: list[FemRun]) -> list:
 
 def reduced_rows(ctx: Context) -> list[list]:
     from reduced.critical_gap import UcTable
-    from reduced.lifetime import largest_holdable_force, lifetime, lifetime_by_quadrature, reference_model
+    from reduced.lifetime import largest_holdable_force, reference_model
 
     uc = pmma_uc_table()
     model = reference_model(CUP_A, uc)
     Fmax = largest_holdable_force(model)
-    rows = []
-
-    def air_case(label: str, m, F1: float) -> None:
-        ctx.progress(0.0, f"reduced: {label}")
-        try:
-            r = lifetime(m, F1)
-        except (ValueError, RuntimeError) as exc:
-            rows.append(["reduced", label, "failed fast", "", _first_line(exc)])
-            return
-        info = f"lifetime {r.lifetime_s:.4g} s ({r.reason})"
-        if r.reason in ("reached_r1", "fold"):
-            with warnings.catch_warnings():      # quad's round-off warning: the check judges the result
-                warnings.simplefilter("ignore")
-                q = lifetime_by_quadrature(m, F1)
-            verdict, text = _verdict({"quadrature": (abs(q / r.lifetime_s - 1), 1e-4)})
-        elif r.reason == "over_force":
-            verdict, text = _verdict({"lifetime at F1 >= F_max": (r.lifetime_s, 0.0)})
-        else:
-            verdict, text = "pass", "no leak path: nothing to integrate"
-        rows.append(["reduced", label, verdict, text, info])
-
-    air_case("F1 = 1 mN (-> 0)", model, 1e-3)
-    air_case(f"F1 = (1 - 1e-3) F_max = {(1 - 1e-3) * Fmax:.4g} N", model, (1 - 1e-3) * Fmax)
-    air_case(f"F1 = F_max = {Fmax:.4g} N", model, Fmax)
+    cases = [("F1 = 1 mN (-> 0)", model, 1e-3),
+             (f"F1 = (1 - 1e-3) F_max = {(1 - 1e-3) * Fmax:.4g} N", model, (1 - 1e-3) * Fmax),
+             (f"F1 = F_max = {Fmax:.4g} N", model, Fmax)]
     uc_values = (1e-9, 1e-6, 1e-5) if ctx.quick else (1e-9, 1e-8, 1e-7, 1e-6, 1e-5)
     for u in uc_values:
         table = UcTable(np.array([1e-4, 1.0]), np.array([u, u]), provenance="constant")
-        air_case(f"u_c = {u * 1e9:g} nm (constant), F1 = 20 N", reference_model(CUP_A, table), 20.0)
-    rows += water_rows(ctx, uc)
-    return rows
+        cases.append((f"u_c = {u * 1e9:g} nm (constant), F1 = 20 N", reference_model(CUP_A, table), 20.0))
+    rows = [_reduced_case(ctx, label, m, F1, _air_verdict) for label, m, F1 in cases]
+    return rows + water_rows(ctx, uc)
 
 
 def water_rows(ctx: Context, uc) -> list[list]:
@@ -242,26 +221,51 @@ def water_rows(ctx: Context, uc) -> list[list]:
     vapour pressure, from a moderate pull to beyond the largest holdable force."""
     from dataclasses import replace
 
-    from reduced.lifetime import largest_holdable_force, lifetime, lifetime_by_quadrature, reference_model
+    from reduced.lifetime import largest_holdable_force, reference_model
 
     rows = []
     for p_cav in (None, VAPOUR_PRESSURE_PA):
         model = replace(reference_model(CUP_A, uc), fluid="water", cavitation_pressure_Pa=p_cav)
         kind = "metastable (any tension)" if p_cav is None else f"cavitation at {p_cav / 1e3:g} kPa"
         F_cav = largest_holdable_force(replace(model, cavitation_pressure_Pa=VAPOUR_PRESSURE_PA))
-        for F1 in (20.0, 60.0, 100.0, 1.05 * F_cav):
-            label = f"water, {kind}, F1 = {F1:.4g} N"
-            ctx.progress(0.0, f"reduced: {label}")
-            try:
-                r = lifetime(model, F1)
-            except (ValueError, RuntimeError) as exc:
-                rows.append(["reduced", label, "failed fast", "", _first_line(exc)])
-                continue
-            rows.append(["reduced", label, *_water_verdict(model, r, F1, lifetime_by_quadrature)])
+        rows += [_reduced_case(ctx, f"water, {kind}, F1 = {F1:.4g} N", model, F1, _water_verdict)
+                 for F1 in (20.0, 60.0, 100.0, 1.05 * F_cav)]
     return rows
 
 
-def _water_verdict(model, r, F1: float, quadrature) -> tuple[str, str, str]:
+def _reduced_case(ctx: Context, label: str, model, F1: float, judge) -> list:
+    """One reduced-model case: its lifetime judged by `judge(model, result, F1) -> (outcome,
+    checks, details)`, or the error it fails fast with."""
+    from reduced.lifetime import lifetime
+
+    ctx.progress(0.0, f"reduced: {label}")
+    try:
+        r = lifetime(model, F1)
+    except (ValueError, RuntimeError) as exc:
+        return ["reduced", label, "failed fast", "", _first_line(exc)]
+    return ["reduced", label, *judge(model, r, F1)]
+
+
+def _quadrature_error(model, r, F1: float) -> float:
+    """|lifetime by quadrature / lifetime - 1| (`lifetime_by_quadrature`, no time stepping)."""
+    from reduced.lifetime import lifetime_by_quadrature
+
+    with warnings.catch_warnings():      # quad's round-off warning: the check judges the result
+        warnings.simplefilter("ignore")
+        return abs(lifetime_by_quadrature(model, F1) / r.lifetime_s - 1)
+
+
+def _air_verdict(model, r, F1: float) -> tuple[str, str, str]:
+    """The lifetime against the quadrature; an over-force detaches at t = 0."""
+    info = f"lifetime {r.lifetime_s:.4g} s ({r.reason})"
+    if r.reason in ("reached_r1", "fold"):
+        return (*_verdict({"quadrature": (_quadrature_error(model, r, F1), 1e-4)}), info)
+    if r.reason == "over_force":
+        return (*_verdict({"lifetime at F1 >= F_max": (r.lifetime_s, 0.0)}), info)
+    return "pass", "no leak path: nothing to integrate", info
+
+
+def _water_verdict(model, r, F1: float) -> tuple[str, str, str]:
     """Checks: p_b(0) from the force balance (7) at the start height (h_start, or h_c after
     cavitation), never below the cavitation pressure, and the quadrature lifetime."""
     p_cav = model.cavitation_pressure_Pa
@@ -272,7 +276,7 @@ def _water_verdict(model, r, F1: float, quadrature) -> tuple[str, str, str]:
     radius = CUP_A.radius(r.h_m[0])
     pb = model.p_a_Pa - (float(model.stiffness.force(r.h_m[0])) + F1) / (math.pi * radius * radius)
     checks = {"p_b(0) force balance": (abs(r.p_b_Pa[0] - pb) / model.p_a_Pa, 1e-9),
-              "quadrature": (abs(quadrature(model, F1) / r.lifetime_s - 1), 1e-4)}
+              "quadrature": (_quadrature_error(model, r, F1), 1e-4)}
     if p_cav is not None:
         checks["p_b >= p_cav"] = (max(0.0, (p_cav - r.p_b_Pa.min()) / model.p_a_Pa), 1e-9)
         if "cavitation" in r.message:
