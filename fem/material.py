@@ -31,6 +31,8 @@ from typing import Literal
 
 import numpy as np
 
+from .kinematics import IDENTITY
+
 __all__ = ["NeoHookean", "jacobian", "jacobian_minus_one", "jacobian_gradient", "jacobian_hessian",
            "cauchy_stress"]
 
@@ -82,10 +84,10 @@ class NeoHookean:
         J = jacobian(f)
         g = jacobian_gradient(f)
         mu = self.mu
-        h = f - _IDENTITY.reshape((5,) + (1,) * (f.ndim - 1)) if h is None else h
+        h = _displacement_gradient(f) if h is None else h
         j = jacobian_minus_one(h)
         # tr h - j = -(h0 h3 - h1 h2) - a h4 with a = J_2D - 1 (exact algebra, no cancellation)
-        a = h[0] + h[3] + h[0] * h[3] - h[1] * h[2]
+        a = _planar_jacobian_minus_one(h)
         W = mu * (-(h[0] * h[3] - h[1] * h[2]) - a * h[4] + _x_minus_log1p(j)) \
             + 0.5 * mu * np.sum(h**2, axis=0)
         dW, d2W = -mu / J, mu / J**2
@@ -96,7 +98,7 @@ class NeoHookean:
 
     def energy(self, f: np.ndarray, h: np.ndarray | None = None) -> np.ndarray:
         """W(F) per unit reference volume [J/m^3] (pointwise, all terms; h = f - 1 if known)."""
-        h = f - _IDENTITY.reshape((5,) + (1,) * (f.ndim - 1)) if h is None else h
+        h = _displacement_gradient(f) if h is None else h
         return self.isochoric(f, h)[0] + self.volumetric(jacobian(f), np.log1p(jacobian_minus_one(h)))[0]
 
     def stress(self, f: np.ndarray) -> np.ndarray:
@@ -112,12 +114,19 @@ class NeoHookean:
         return A + d2U * g[:, None] * g[None, :] + dU * jacobian_hessian(f)
 
 
-_IDENTITY = np.array([1.0, 0.0, 0.0, 1.0, 1.0])
+def _displacement_gradient(f: np.ndarray) -> np.ndarray:
+    """h = f - 1 (the 5-vector convention of `fem.kinematics`)."""
+    return f - IDENTITY.reshape((5,) + (1,) * (f.ndim - 1))
+
+
+def _planar_jacobian_minus_one(h: np.ndarray) -> np.ndarray:
+    """det of the in-plane 2x2 block of F, minus one, from h (exact algebra, no cancellation)."""
+    return h[0] + h[3] + h[0] * h[3] - h[1] * h[2]
 
 
 def jacobian_minus_one(h: np.ndarray) -> np.ndarray:
     """J - 1 from the displacement gradient h = f - 1, without cancellation for small h."""
-    a = h[0] + h[3] + h[0] * h[3] - h[1] * h[2]
+    a = _planar_jacobian_minus_one(h)
     return a + h[4] + a * h[4]
 
 

@@ -43,6 +43,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import nnls
 
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
@@ -67,13 +68,9 @@ class SolverOptions:
     min_step: float = 1e-5      # smallest step as a fraction of t_max before giving up
     growth: float = 1.5         # step growth after an easy step (<= easy_iterations)
     easy_iterations: int = 6
-    # unused since the contact set is solved for in every Newton step (module docstring); kept
-    # so that option sets written for the earlier active-set iteration still validate
-    active_set_rtol: float = 1e-3
-    max_active_sets: int = 40
 
     def __post_init__(self) -> None:
-        for name in ("rtol", "etol", "initial_step", "max_step", "min_step", "active_set_rtol"):
+        for name in ("rtol", "etol", "initial_step", "max_step", "min_step"):
             v = getattr(self, name)
             if not (0.0 < v <= 1.0):
                 raise ValueError(f"{name}: must be in (0, 1], got {v}")
@@ -141,7 +138,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         if t_max - t1 < 0.2 * dt:          # don't leave a sliver at the end
             t1 = t_max
         try:
-            u1, r1, state1, its, indefinite = _newton(mech, dirichlet, f_ext, plane, state, u0, u0,
+            u1, r1, state1, its, indefinite = _newton(mech, dirichlet, f_ext, plane, state, u0,
                                                       t1, options, solver)
         except _StepFailure as fail:
             cutbacks += 1
@@ -191,24 +188,24 @@ def _work(dirichlet, f_ext, t0, t1, u0, u1, r0, r1) -> float:
     return work + 0.5 * (f_ext(t0) + f_ext(t1)) @ (u1 - u0)
 
 
-def _newton(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver):
+def _newton(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver):
     """Newton iterations of one step with a contact QP per iteration (module docstring);
     returns (u, r_int, contact state, iterations, whether the tangent was indefinite on the way)."""
     flags = {"indefinite": False}
     try:
-        return _iterate(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver, flags)
+        return _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, flags)
     except _StepFailure as fail:
         fail.indefinite = flags["indefinite"]
         raise
 
 
-def _iterate(mech, dirichlet, f_ext, plane, state, u_start, guess, t, opts, solver, flags):
+def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, flags):
     n = mech.kin.ndofs
     fixed_dofs, fixed_vals = dirichlet(t)
     fext = f_ext(t)
     history: list[float] = []
     try:
-        u = plane.project(guess, u_start, state, state.active) if plane is not None else guess
+        u = plane.project(u_start, u_start, state, state.active) if plane is not None else u_start
         Pi, r, K = _evaluate(mech, u, fext)
     except FloatingPointError as err:
         raise _StepFailure(f"{err} at the predictor; likely cause: the step is too large for "
@@ -321,7 +318,6 @@ def _lcp(S, q):
     """lambda >= 0 with w = q + S lambda >= 0 and lambda . w = 0 (S symmetric positive definite):
     the minimizer of lambda S lambda / 2 + q . lambda over lambda >= 0, by non-negative least
     squares on the Cholesky factor S = L L^T (Lawson-Hanson, finite)."""
-    from scipy.optimize import nnls
     scale = np.sqrt(np.diag(S))
     Sn = S / np.outer(scale, scale)
     L = np.linalg.cholesky(Sn)
