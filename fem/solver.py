@@ -126,7 +126,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     u0 = np.zeros(n)
     state = plane.initial_state() if plane is not None else None
     r0 = mech.internal_force(u0)
-    solver = BandedCholesky(mech.linearize(u0)[1], mech.kin.node_coordinates())
+    solver = BandedCholesky(mech.linearize(u0)[1], mech.kin.node_coordinates(), mech.kin.mesh)
     if on_step:
         on_step(StepResult(0.0, u0, r0, state, 0))
     t, W0 = 0.0, mech.energy(u0)

@@ -17,7 +17,7 @@ from fem.cup import compress_cup
 from fem.forms import Mechanics
 from fem.geometry import PRESETS, LinearThickness, cup_geometry
 from fem.kinematics import Kinematics
-from fem.linsolve import BandedCholesky, NotPositiveDefinite, _half_bandwidth
+from fem.linsolve import BandedCholesky, NotPositiveDefinite, _half_bandwidth, wall_ordering
 from fem.material import NeoHookean
 from fem.mesh import FIDELITIES, cup_mesh
 from fem.solver import _lcp
@@ -53,15 +53,23 @@ def test_banded_cholesky_matches_sparse_lu(cup):
 
 
 def test_strip_ordering_gives_a_narrow_band(cup):
-    """The cup strip ordered along its length: the half bandwidth is that of a few node columns
-    (an element couples three; the columns of a tapered, graded wall are slanted against the
-    strip's axis, so the projection interleaves neighbours: at most four columns of
-    2 n_through + 1 nodes x 2 dofs), far below the ~700 of the mesh's own numbering."""
+    """The cup strip ordered column by column (`wall_ordering`): an element couples three adjacent
+    columns of n_c = 2 n_through + 1 nodes, so the half bandwidth is exactly 2 (2 n_c + 3) - 1,
+    whatever the taper and grading; the principal-axis projection, which interleaves the slanted
+    columns, and the mesh's own numbering (~700) are wider."""
     mesh, K, _ = cup
-    nodes_through = 2 * FIDELITIES["coarse"].n_through + 1
-    kd = BandedCholesky(K, mesh.doflocs).kd
-    assert kd <= 4 * nodes_through * 2
+    n_c = 2 * FIDELITIES["coarse"].n_through + 1
+    kd = BandedCholesky(K, mesh.doflocs, mesh).kd
+    assert kd == 2 * (2 * n_c + 3) - 1
+    assert kd < BandedCholesky(K, mesh.doflocs).kd
     assert kd < 0.1 * _half_bandwidth(K, np.arange(K.shape[0]))
+
+
+def test_wall_ordering_needs_the_tags(cup):
+    """Without the top_plate/cavity tags there is no wall ordering (the other candidates remain)."""
+    mesh, K, _ = cup
+    assert wall_ordering(mesh) is not None
+    assert wall_ordering(mesh, along_from="no_such_tag") is None
 
 
 def test_indefinite_tangent_is_reported(cup):
