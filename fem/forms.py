@@ -120,16 +120,28 @@ class Mechanics:
         """Assemble element vectors re[nel, 18]."""
         return np.bincount(self.kin.dofs.T.ravel(), weights=re.ravel(), minlength=self.kin.ndofs)
 
-    @cached_property
-    def _Bt(self) -> np.ndarray:
-        """The B-operator as [nel, nq, 18, 5] (contiguous, for batched products)."""
-        return np.ascontiguousarray(np.transpose(self.kin.B, (2, 3, 0, 1)))
+    @property
+    def _BtT(self) -> np.ndarray:
+        """B^T as [nel, nq * 5, 18] (`Kinematics.B_stacked`)."""
+        return self.kin.B_stacked
 
     @cached_property
-    def _BtT(self) -> np.ndarray:
-        """[nel, nq * 5, 18]: Bt with (q, k) stacked, the right factor of K_e."""
-        ne, nq, nb, _ = self._Bt.shape
-        return np.ascontiguousarray(np.transpose(self._Bt, (0, 1, 3, 2)).reshape(ne, nq * 5, nb))
+    def _Bt(self) -> np.ndarray:
+        """B as [nel, 18, nq * 5] (contiguous), the left factor of K_e."""
+        return np.ascontiguousarray(np.transpose(self._BtT, (0, 2, 1)))
+
+    def _element_forces(self, PdV: np.ndarray) -> np.ndarray:
+        """r_e,i = sum_q B_iq . P_q dV_q for P dV [5, nel, nq]: [nel, 18]."""
+        ne, nq = PdV.shape[1:]
+        return (np.transpose(PdV, (1, 2, 0)).reshape(ne, 1, nq * 5) @ self._BtT)[:, 0]
+
+    def _element_tangents(self, AdV: np.ndarray) -> np.ndarray:
+        """K_e = sum_q B_q^T (A_q dV_q) B_q for A dV [5, 5, nel, nq]: [nel, 18, 18], as two
+        batched products (the 5 x 5 blocks with B^T per point, then B over all points)."""
+        ne, nq = AdV.shape[2:]
+        nb = self._BtT.shape[2]
+        C = np.transpose(AdV, (2, 3, 0, 1)).copy() @ self._BtT.reshape(ne, nq, 5, nb)
+        return self._Bt @ C.reshape(ne, nq * 5, nb)
 
     # --- P1disc projection for the mixed formulation ---------------------------------------
     @cached_property
@@ -190,9 +202,7 @@ class Mechanics:
         f = self.kin.deformation_gradient(u)
         if np.any(jacobian(f) <= 0):
             raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
-        P = self.stress(f)
-        re = np.einsum("eqik,keq->ei", self._Bt, P * self.kin.dV)
-        return self._vector(re)
+        return self._vector(self._element_forces(self.stress(f) * self.kin.dV))
 
     def linearize(self, u: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
         """Internal force r(u) and consistent tangent K(u) = d2Pi/du2."""
@@ -220,17 +230,13 @@ class Mechanics:
             g = jacobian_gradient(f)
             P = P + p * g
             A = A + p * jacobian_hessian(f)
-        Bt = self._Bt                                            # [nel, nq, 18, 5]
-        re = np.einsum("eqik,keq->ei", Bt, P * dV)
-        # K_e = sum_q Bt_q (A_q dV_q) Bt_q^T as batched matrix products
-        AdV = np.transpose(A * dV, (2, 3, 0, 1))                 # [nel, nq, 5, 5]
-        BA = Bt @ AdV                                            # [nel, nq, 18, 5]
-        ne, nq, nb, _ = Bt.shape
-        Ke = BA.transpose(0, 2, 1, 3).reshape(ne, nb, nq * 5) @ self._BtT
+        re = self._element_forces(P * dV)
+        Ke = self._element_tangents(A * dV)
         if m.formulation == "mixed":
             q, Minv = self._p1
             d2U = m.volumetric(theta, np.log1p(theta - 1.0))[2]
-            dJ = np.einsum("eqik,keq->eqi", self._Bt, g * dV)       # dJ[v] dV at the points
+            ne, nq = dV.shape
+            dJ = np.einsum("keq,eqki->eqi", g * dV, self._BtT.reshape(ne, nq, 5, -1))  # dJ[v] dV
             G = np.einsum("aeq,eqi->eai", q, dJ)                     # [nel, 3, 18]
             D = np.einsum("aeq,beq,eq->eab", q, q, d2U * dV)
             C = Minv @ D @ Minv
