@@ -33,7 +33,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import dijkstra, reverse_cuthill_mckee
 from skfem import Mesh
 
-__all__ = ["BandedCholesky", "Factor", "NotPositiveDefinite", "strip_ordering", "wall_ordering"]
+__all__ = ["BandedCholesky", "BorderedFactor", "Factor", "NotPositiveDefinite", "strip_ordering", "wall_ordering"]
 
 
 class NotPositiveDefinite(np.linalg.LinAlgError):
@@ -129,7 +129,7 @@ class BandedCholesky:
             c = sla.cholesky_banded(ab, overwrite_ab=True, lower=False, check_finite=False)
         except np.linalg.LinAlgError as err:
             raise NotPositiveDefinite(str(err)) from None
-        return Factor(self, K, free, c)
+        return Factor(self, K, free, c, shift)
 
     def solve(self, K: sp.csr_matrix, rhs: np.ndarray, free: np.ndarray, du_fixed: np.ndarray,
               shift: float = 0.0) -> np.ndarray:
@@ -141,18 +141,67 @@ class BandedCholesky:
 class Factor:
     """A factored free block K_ff; `solve` for one or several right-hand sides."""
 
-    def __init__(self, owner: BandedCholesky, K: sp.csr_matrix, free: np.ndarray, c: np.ndarray):
-        self._owner, self._K, self.free, self._c = owner, K, free, c
+    def __init__(self, owner: BandedCholesky, K: sp.csr_matrix, free: np.ndarray, c: np.ndarray,
+                 shift: float = 0.0):
+        self._owner, self._K, self.free, self._c, self.shift = owner, K, free, c, shift
 
     def solve(self, rhs: np.ndarray, du_fixed: np.ndarray | None = None) -> np.ndarray:
         """x with K_ff x_f = rhs_f - K_fc du_fixed_c, x_c = du_fixed_c (0 if None); rhs [n] or [n, m]."""
-        fixed = ~self.free
-        mask = fixed if rhs.ndim == 1 else fixed[:, None]
-        if du_fixed is None:
-            b = np.where(mask, 0.0, rhs)
-        else:
-            b = rhs - self._K @ np.where(fixed, du_fixed, 0.0)
-            b = np.where(fixed, du_fixed, b)
+        b = _constrained_rhs(self._K, self.free, rhs, du_fixed)
         x = sla.cho_solve_banded((self._c, False), b[self._owner._perm], overwrite_b=True,
                                  check_finite=False)
         return x[self._owner._inv]
+
+    def freeing(self, dofs: np.ndarray) -> "BorderedFactor":
+        """The factor of the free block with the constrained `dofs` freed as well (e.g. contact
+        nodes let go), by the Schur complement on them: len(dofs) solves with this factor instead
+        of a new factorization. Raises `NotPositiveDefinite` if the larger block is not."""
+        return BorderedFactor(self, np.asarray(dofs))
+
+
+class BorderedFactor:
+    """The block [[K_ff, K_fT], [K_Tf, K_TT]] of a `Factor` bordered by the dofs T:
+    with Y = K_ff^-1 K_fT and the Schur complement S = K_TT - K_Tf Y (Cholesky, m x m),
+    x_T = S^-1 (b_T - K_Tf K_ff^-1 b_f) and x_f = K_ff^-1 b_f - Y x_T. The base factor's diagonal
+    shift is applied to K_TT as well."""
+
+    def __init__(self, base: Factor, dofs: np.ndarray):
+        if np.any(base.free[dofs]):
+            raise ValueError("BorderedFactor: the dofs to free must be constrained in the base factor")
+        K = base._K
+        self._base, self._dofs, self._K = base, dofs, K
+        self.free = base.free.copy()
+        self.free[dofs] = True
+        self._cols = K[:, dofs].toarray()                     # K_:T
+        self._cols[~base.free] = 0.0                           # K_fT
+        self._Y = base.solve(self._cols)                       # K_ff^-1 K_fT, zero off f
+        K_TT = K[dofs][:, dofs].toarray()
+        S = K_TT - self._cols.T @ self._Y
+        S[np.diag_indices_from(S)] += base.shift * np.abs(np.diag(K_TT))
+        try:
+            self._S = sla.cho_factor(S, check_finite=False)
+        except np.linalg.LinAlgError as err:
+            raise NotPositiveDefinite(f"Schur complement of the freed dofs: {err}") from None
+
+    def solve(self, rhs: np.ndarray, du_fixed: np.ndarray | None = None) -> np.ndarray:
+        """As `Factor.solve`, on the larger free block."""
+        b = _constrained_rhs(self._K, self.free, rhs, du_fixed)
+        x = self._base.solve(b)                                # K_ff^-1 b_f (b_T masked out)
+        xT = sla.cho_solve(self._S, b[self._dofs] - self._cols.T @ x, check_finite=False)
+        x -= self._Y @ xT
+        x[self._dofs] = xT
+        if du_fixed is not None:
+            fixed = ~self.free
+            x[fixed] = du_fixed[fixed] if rhs.ndim == 1 else du_fixed[fixed, None]
+        return x
+
+
+def _constrained_rhs(K: sp.csr_matrix, free: np.ndarray, rhs: np.ndarray,
+                     du_fixed: np.ndarray | None) -> np.ndarray:
+    """rhs - K du_fixed on the free dofs and du_fixed on the constrained ones (0 if None)."""
+    fixed = ~free
+    mask = fixed if rhs.ndim == 1 else fixed[:, None]
+    if du_fixed is None:
+        return np.where(mask, 0.0, rhs)
+    b = rhs - K @ np.where(fixed, du_fixed, 0.0)
+    return np.where(mask, du_fixed if rhs.ndim == 1 else du_fixed[:, None], b)

@@ -266,10 +266,13 @@ class _Step:
         tensile = self.state.active & ((self.res + K @ self.du)[zdof] < -self.tol)
         self.release = np.zeros_like(tensile)
         if tensile.any():
-            free = self.free.copy()
-            free[zdof[tensile]] = True
-            # without them K_ff may be indefinite (the contact held the structure): shifted
-            fac, shift = _factor(solver, K, free, 10.0 * shift, history)
+            try:        # bordered by the freed dofs (Schur complement): no new factorization
+                fac = fac.freeing(zdof[tensile])
+            except NotPositiveDefinite:
+                # without them K_ff is indefinite (the contact held the structure): shifted
+                free = self.free.copy()
+                free[zdof[tensile]] = True
+                fac, shift = _factor(solver, K, free, 10.0 * shift, history)
             self._constrained(fac, np.flatnonzero(tensile))
             self.release = tensile
         return shift
