@@ -113,9 +113,11 @@ def _half_bandwidth(pattern: sp.csr_matrix, perm: np.ndarray) -> int:
 class BandedCholesky:
     """Solver for K du = b with du prescribed on some dofs, K symmetric with a fixed CSR pattern."""
 
-    def __init__(self, pattern: sp.csr_matrix, coordinates: np.ndarray, mesh: Mesh | None = None):
+    def __init__(self, pattern: sp.csr_matrix, coordinates: np.ndarray | None, mesh: Mesh | None = None,
+                 *, perm: np.ndarray | None = None):
+        """`perm`: the dof ordering, if given; otherwise `strip_ordering` of the coordinates [2, nnodes]."""
         n = pattern.shape[0]
-        perm = strip_ordering(coordinates, pattern, mesh)
+        perm = strip_ordering(coordinates, pattern, mesh) if perm is None else np.asarray(perm)
         inv = np.empty_like(perm)
         inv[perm] = np.arange(n)
         rows = np.repeat(np.arange(n), np.diff(pattern.indptr))
@@ -133,9 +135,13 @@ class BandedCholesky:
         constrained dofs (~free) eliminated. Raises `NotPositiveDefinite` if it is not."""
         if K.nnz != len(self._indices) or K.shape[0] != self.n:
             raise ValueError("BandedCholesky: the matrix does not have the pattern it was built for")
+        return Factor(self, K, free, self.band_factor(K.data, free, shift), shift)
+
+    def band_factor(self, data: np.ndarray, free: np.ndarray, shift: float = 0.0) -> np.ndarray:
+        """The banded Cholesky factor of K_ff from the CSR `data` of K (the pattern's layout)."""
         keep = free[self._rows] & free[self._cols]
         ab = np.zeros((self.kd + 1) * self.n)
-        ab[self._band] = np.where(keep, K.data[self._sel], 0.0)
+        ab[self._band] = np.where(keep, data[self._sel], 0.0)
         ab = ab.reshape(self.kd + 1, self.n)
         diag = ab[self.kd]                                     # a view, in permuted order
         fixed_p = ~free[self._perm]
@@ -144,10 +150,15 @@ class BandedCholesky:
         diag[fixed_p] = 1.0
         try:
             with _one_thread():
-                c = sla.cholesky_banded(ab, overwrite_ab=True, lower=False, check_finite=False)
+                return sla.cholesky_banded(ab, overwrite_ab=True, lower=False, check_finite=False)
         except np.linalg.LinAlgError as err:
             raise NotPositiveDefinite(str(err)) from None
-        return Factor(self, K, free, c, shift)
+
+    def band_solve(self, c: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """x = K_ff^-1 b with a factor of `band_factor` (b zero on the constrained dofs)."""
+        with _one_thread():
+            x = sla.cho_solve_banded((c, False), b[self._perm], overwrite_b=True, check_finite=False)
+        return x[self._inv]
 
     def solve(self, K: sp.csr_matrix, rhs: np.ndarray, free: np.ndarray, du_fixed: np.ndarray,
               shift: float = 0.0) -> np.ndarray:
@@ -165,11 +176,7 @@ class Factor:
 
     def solve(self, rhs: np.ndarray, du_fixed: np.ndarray | None = None) -> np.ndarray:
         """x with K_ff x_f = rhs_f - K_fc du_fixed_c, x_c = du_fixed_c (0 if None); rhs [n] or [n, m]."""
-        b = _constrained_rhs(self._K, self.free, rhs, du_fixed)
-        with _one_thread():
-            x = sla.cho_solve_banded((self._c, False), b[self._owner._perm], overwrite_b=True,
-                                     check_finite=False)
-        return x[self._owner._inv]
+        return self._owner.band_solve(self._c, _constrained_rhs(self._K, self.free, rhs, du_fixed))
 
     def freeing(self, dofs: np.ndarray) -> "BorderedFactor":
         """The factor of the free block with the constrained `dofs` freed as well (e.g. contact

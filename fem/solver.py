@@ -47,7 +47,8 @@ from scipy.optimize import nnls
 
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
-from .linsolve import BandedCholesky, NotPositiveDefinite
+from .condensation import make_solver
+from .linsolve import NotPositiveDefinite
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
 
@@ -126,7 +127,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     u0 = np.zeros(n)
     state = plane.initial_state() if plane is not None else None
     r0 = mech.internal_force(u0)
-    solver = BandedCholesky(mech.linearize(u0)[1], mech.kin.node_coordinates(), mech.kin.mesh)
+    solver = make_solver(mech.linearize(u0)[1], mech.kin.node_coordinates(), mech.kin.mesh)
     if on_step:
         on_step(StepResult(0.0, u0, r0, state, 0))
     t, W0 = 0.0, mech.energy(u0)
