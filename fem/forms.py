@@ -208,8 +208,24 @@ class Mechanics:
         """Internal force r(u) and consistent tangent K(u) = d2Pi/du2."""
         return self.evaluate(u)[1:]
 
+    @cached_property
+    def _last(self) -> dict:
+        """The last evaluation (u and its results): a path solver evaluates the converged state
+        of a load step and then starts the next step from it."""
+        return {}
+
     def evaluate(self, u: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
-        """Stored energy Pi(u) [J], internal force r(u) and tangent K(u), from one evaluation of F."""
+        """Stored energy Pi(u) [J], internal force r(u) and tangent K(u), from one evaluation of F
+        (the previous call's results if u is the same; r and K's data are read-only)."""
+        last = self._last
+        if "u" in last and np.array_equal(last["u"], u):
+            return last["out"]
+        out = self._evaluate(u)
+        out[1].flags.writeable = out[2].data.flags.writeable = False     # shared with the memo
+        last.update(u=np.array(u, copy=True), out=out)
+        return out
+
+    def _evaluate(self, u: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
         h = self.kin.displacement_gradient(u)
         f = IDENTITY[:, None, None] + h
         J = jacobian(f)
