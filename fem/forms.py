@@ -32,9 +32,25 @@ import scipy.sparse as sp
 from skfem import BilinearForm, LinearForm, MeshQuad2
 
 from .kinematics import IDENTITY, Kinematics
-from .material import NeoHookean, jacobian, jacobian_gradient, jacobian_hessian, jacobian_minus_one
+from .material import (NeoHookean, jacobian, jacobian_gradient, jacobian_hessian, jacobian_hessian_entries,
+                       jacobian_minus_one)
 
 __all__ = ["Mechanics", "internal_force_form", "tangent_form", "energy_form"]
+
+
+def _tangent_at_points(f: np.ndarray, g: np.ndarray, c0: np.ndarray, a: np.ndarray,
+                       b: np.ndarray) -> np.ndarray:
+    """c0 1 + a g (x) g + b d2J/df2 at every point, [nel, nq, 5, 5] (the kernels' layout): the
+    neo-Hookean tangent (`NeoHookean.tangent_coefficients`) times dV, built in place."""
+    gp = np.moveaxis(g, 0, -1)                                        # [nel, nq, 5]
+    A = (a[..., None] * gp)[..., :, None] * gp[..., None, :]
+    diagonal = np.arange(5)
+    A[..., diagonal, diagonal] += c0[..., None]
+    for (i, j), v in jacobian_hessian_entries(f).items():
+        bv = b * v
+        A[..., i, j] += bv
+        A[..., j, i] += bv
+    return A
 
 
 # --------------------------------------------------------------------------------------------
@@ -136,11 +152,11 @@ class Mechanics:
         return (np.transpose(PdV, (1, 2, 0)).reshape(ne, 1, nq * 5) @ self._BtT)[:, 0]
 
     def _element_tangents(self, AdV: np.ndarray) -> np.ndarray:
-        """K_e = sum_q B_q^T (A_q dV_q) B_q for A dV [5, 5, nel, nq]: [nel, 18, 18], as two
+        """K_e = sum_q B_q^T (A_q dV_q) B_q for A dV [nel, nq, 5, 5]: [nel, 18, 18], as two
         batched products (the 5 x 5 blocks with B^T per point, then B over all points)."""
-        ne, nq = AdV.shape[2:]
+        ne, nq = AdV.shape[:2]
         nb = self._BtT.shape[2]
-        C = np.transpose(AdV, (2, 3, 0, 1)).copy() @ self._BtT.reshape(ne, nq, 5, nb)
+        C = np.ascontiguousarray(AdV) @ self._BtT.reshape(ne, nq, 5, nb)
         return self._Bt @ C.reshape(ne, nq * 5, nb)
 
     # --- P1disc projection for the mixed formulation ---------------------------------------
@@ -232,22 +248,21 @@ class Mechanics:
         if np.any(J <= 0):
             raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
         m, dV = self.material, self.kin.dV
+        g = jacobian_gradient(f)
         if m.formulation == "displacement":
-            W, P, A = m.isochoric(f, h)
-            U, dU, d2U = m.volumetric(J, np.log1p(jacobian_minus_one(h)))
-            g = jacobian_gradient(f)
-            W = W + U
-            P = P + dU * g
-            A = A + d2U * g[:, None] * g[None, :] + dU * jacobian_hessian(f)
+            lnJ = np.log1p(jacobian_minus_one(h))
+            W = m.isochoric_energy(h) + m.volumetric(J, lnJ)[0]
+            a, b = m.tangent_coefficients(J, lnJ)
+            P = m.mu * f + b * g
+            AdV = _tangent_at_points(f, g, m.mu * dV, a * dV, b * dV)
         else:
             theta, p = self.pressure_and_dilatation(f, h)
             W, P, A = m.isochoric(f, h)
             W = W + m.volumetric(theta, np.log1p(theta - 1.0))[0]
-            g = jacobian_gradient(f)
             P = P + p * g
-            A = A + p * jacobian_hessian(f)
+            AdV = np.transpose((A + p * jacobian_hessian(f)) * dV, (2, 3, 0, 1))
         re = self._element_forces(P * dV)
-        Ke = self._element_tangents(A * dV)
+        Ke = self._element_tangents(AdV)
         if m.formulation == "mixed":
             q, Minv = self._p1
             d2U = m.volumetric(theta, np.log1p(theta - 1.0))[2]
