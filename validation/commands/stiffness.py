@@ -84,6 +84,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"cupcheck stiffness: wrote {args.out} and {job['sidecar'].name}: {s.steps} steps, "
           f"{s.newton_iterations} Newton iterations, {s.dofs} dofs, {s.wall_time_s:.1f} s; "
           f"F0 = {response.F0_N[-1]:.4g} N at u = {1e3 * response.u_m[-1]:.4g} mm")
+    if response.folding_u_m is not None:
+        print(f"cupcheck stiffness: note: from u = {1e3 * response.folding_u_m:.4g} mm the wall is "
+              f"compressed beyond Biot's stretch 0.544 (smallest {response.min_stretch.min():.3f}): "
+              "a free surface may fold there, and the curve beyond depends on the mesh", file=sys.stderr)
     return 0
 
 
