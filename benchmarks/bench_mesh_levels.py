@@ -70,14 +70,14 @@ def run_level(level: str, contact: str, cache: Path | None) -> dict:
     out = {"spec": repr(spec), "dofs": int(resp.stats.dofs), "steps": int(resp.stats.steps),
            "time_s": time.perf_counter() - t0, "F0": sample(resp.F0_N, U_F0),
            "l_q": sample(resp.l_m, U_L), "l_m": sample(resp.l_median_m, U_L),
-           "u_td": _touchdown(u_fine, sample(resp.F0_N, u_fine))}
+           "u_td": touchdown(u_fine, sample(resp.F0_N, u_fine))}
     if file:
         file.parent.mkdir(parents=True, exist_ok=True)
         np.savez(file, **out)
     return out
 
 
-def _touchdown(u: np.ndarray, F0: np.ndarray) -> float:
+def touchdown(u: np.ndarray, F0: np.ndarray) -> float:
     """u/h1 of the smallest F0 on u >= 0.3 h1 if F0 falls there before it rises (the sticking
     wall's mid-wall touchdown); NaN if the smallest value is the first (F0 only grows)."""
     k = int(np.argmin(F0))
