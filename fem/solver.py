@@ -210,7 +210,7 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, fla
     except FloatingPointError as err:
         raise _StepFailure(f"{err} at the predictor; likely cause: the step is too large for "
                            "the deformation, or the mesh is too coarse", history) from None
-    it, shift, indefinite = 0, 0.0, False
+    it, shift, indefinite, radius = 0, 0.0, False, np.inf
     released = np.zeros(len(plane.nodes), bool) if plane is not None else None
     while True:
         res = r - fext
@@ -236,11 +236,25 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, fla
                                "structural instability (snap-through/buckling) that the step jumps "
                                "across, or a too-large step", history)
         u_prev = u
-        alpha, u, Pi, r, K, shift = _line_search(mech, solver, step, u_start, u, Pi, res, K, fext,
-                                                 shift, held, history)
+        alpha, u, Pi, r, K, shift, full = _line_search(mech, solver, step, u_start, u, Pi, res, K,
+                                                       fext, shift, held, history, radius)
+        radius = _trust_radius(radius, shift, full, np.max(np.abs(u - u_prev)), mech)
         if plane is not None:
             released |= step.release
             state = plane.hold(state, step.holds(alpha), u, u_start, u_prev + step.du0, released)
+
+
+def _trust_radius(radius: float, shift: float, full: bool, moved: float, mech) -> float:
+    """The largest max-norm step [m] of the next shifted iteration (a trust region on the
+    descent through an instability): it starts at 1e-3 of the body's size, doubles after every
+    step taken in full and shrinks to the step taken after a backtrack, so the iterate follows
+    the energy down a long unstable valley in O(log(distance)) iterations instead of creeping
+    with the shift's damping; unbounded (plain Newton) while the tangent is definite."""
+    if shift == 0.0:
+        return np.inf
+    if not np.isfinite(radius):
+        return 1e-3 * _size(mech)
+    return 2.0 * radius if full else max(moved, 1e-9 * _size(mech))
 
 
 class _Step:
@@ -348,35 +362,49 @@ def _evaluate(mech, u, fext):
 
 def _factor(solver, K, free, shift, history):
     """Factor K_ff; if it is not positive definite (the Newton direction would not descend in
-    energy: a structural instability), shift the diagonal, K_ff + s diag(K_ff), s = 1e-6, 1e-5,
-    ... (Levenberg-Marquardt); a shift that worked is reduced tenfold at the next iteration.
-    Returns (factor, shift)."""
-    shift = shift / 10.0 if shift > 1e-6 else 0.0
+    energy: a structural instability), shift the diagonal, K_ff + s diag(K_ff)
+    (Levenberg-Marquardt): a shift that worked is tried tenfold smaller at the next iteration
+    (down to _SHIFT_MIN, then 0), and raised tenfold while the factorization fails. So the shift
+    stays within a factor of ten of the smallest one that makes K_ff definite: near a bifurcation
+    the negative eigenvalue is tiny (below 1e-6 of the diagonal in the thin cones), and a larger
+    floor damps the unstable mode so much that the descent creeps (5 % longer steps per
+    iteration, ConvergenceError after 100); the step length is then bounded by the trust radius
+    of `_line_search`, not by the shift. Returns (factor, shift)."""
+    shift = shift / 10.0 if shift >= 10.0 * _SHIFT_MIN else 0.0
     while True:
         try:
             return solver.factor(K, free, shift), shift
         except NotPositiveDefinite:
-            shift = max(10.0 * shift, 1e-6)
+            shift = max(10.0 * shift, _SHIFT_MIN)
             if shift > 1e3:
                 raise _StepFailure("the tangent is not positive definite even with a diagonal shift "
                                    "of 1e3; likely cause: an unconstrained rigid-body mode", history) from None
 
 
+_SHIFT_MIN = 1e-10      # smallest diagonal shift (relative); cond(K_ff + s D) stays < ~1e12
+
+
 def _line_search(mech, solver, step, u_start, u, Pi, res, K, fext, shift, held, history,
-                 tries: int = 8):
+                 radius: float = np.inf, tries: int = 8):
     """The next iterate P(u + a du) (projected onto the admissible set) and its linearization.
 
     While prescribed values are still being imposed (not `held`), a = 1 unless an element would
-    invert (halve). Then a backtracks (quadratic interpolation, a in [0.1 a, 0.5 a]) until the
+    invert (halve). Then a starts at min(1, radius / max|du|) if the direction was shifted (an
+    instability: the trust radius of `_iterate` bounds the step, not the shift) and at 1
+    otherwise, and backtracks (quadratic interpolation, a in [0.1 a, 0.5 a]) until the
     Armijo condition Pi(P(u + a du)) <= Pi(u) + 1e-4 r . (P(u + a du) - u) holds (to round-off
     of Pi); if no a does, the direction is not one of descent: the diagonal shift is raised
-    (at most three times) and the direction recomputed. Returns (a, u, Pi, r, K, shift)."""
+    (at most three times) and the direction recomputed. Returns (a, u, Pi, r, K, shift, whether
+    the first trial was accepted)."""
     slack = 1e-12 * abs(Pi) + 1e-14 * np.linalg.norm(res) * np.max(np.abs(u))
     plane = step.plane
     for attempt in range(4):
         du = step.du
         s0 = du @ res
         alpha = 1.0
+        if held and shift > 0.0:
+            alpha = min(1.0, radius / max(np.max(np.abs(du)), 1e-300))
+        first = True
         for _ in range(tries):
             try:
                 trial = u + alpha * du
@@ -385,13 +413,15 @@ def _line_search(mech, solver, step, u_start, u, Pi, res, K, fext, shift, held, 
                 Pi1, r1, K1 = _evaluate(mech, trial, fext)
             except FloatingPointError:
                 alpha *= 0.5
+                first = False
                 continue
             if not held or Pi1 - Pi <= 1e-4 * (res @ (trial - u)) + slack:
-                return alpha, trial, Pi1, r1, K1, shift
+                return alpha, trial, Pi1, r1, K1, shift, first
             # quadratic model along the ray: Pi(a) ~ Pi + s0 a + c a^2
             curv = (Pi1 - Pi - s0 * alpha) / alpha**2
             a_min = -s0 / (2.0 * curv) if curv > 0 and s0 < 0 else 0.1 * alpha
             alpha = float(np.clip(a_min, 0.1 * alpha, 0.5 * alpha))
+            first = False
         if not held or attempt == 3:
             break
         shift = step.solve(solver, K, max(100.0 * shift, 1e-3), history)
