@@ -23,15 +23,26 @@ sticking law the frozen radial positions of the nodes held on the plane). Newton
   backtracking until the Armijo condition on Pi holds. The energy decreases at every iteration,
   so the contact set cannot cycle.
 * Instability: if K_ff is not positive definite (buckling, a wall lifting off the plane), the
-  diagonal is shifted, K_ff + s diag(K_ff) (Levenberg-Marquardt), the direction then descends,
-  and the iteration follows the energy down to the next stable state (this may take tens of
-  iterations, hence max_iterations = 100). When it still fails, the step is first enlarged (2x,
-  4x the last good step) to jump across the limit point, then halved. The energy such jumps lose,
-  W0 + work - W1 summed over the steps, is reported as `SolverStats.dissipated_J`.
+  diagonal is shifted, K_ff + s diag(K_ff) (Levenberg-Marquardt), by the smallest power of ten
+  that makes it definite (down to 1e-10), and the direction then descends. The shift only makes
+  the direction one of descent; the length of the step is bounded by a trust radius that starts
+  at 1e-3 of the body's size and doubles after every full step (`_trust_radius`), so the iterate
+  follows the energy down to the next stable state in tens of iterations however flat the
+  unstable mode (near a bifurcation its eigenvalue is below 1e-6 of the diagonal: a fixed shift
+  floor damped it until the descent crept). When a step still fails, it is first enlarged (2x,
+  4x the last good step) to jump across the limit point, then halved.
+* Jumps: the energy lost in a step, W0 + work - W1 (trapezoid work), is summed over the steps as
+  `SolverStats.dissipated_J`. For frictionless contact (conservative: only a snap loses
+  energy), a step across an instability that loses more than jump_tol = 0.5 % of W is redone
+  with half the step, down to jump_min_step: a large step's descent may land on another branch
+  than the one the load path reaches, a real snap keeps its loss as the step shrinks and is
+  then accepted, localized to one small step. Sticking contact dissipates in slips at any step
+  size, so its steps are not judged by their energy.
 
 The step has converged when the prescribed values hold, no held node pulls on the plane beyond
-the tolerance, ||r_f|| <= rtol * max(||reactions||, f_floor), and the energy norm of the next
-correction |du . r| <= etol * f_ref * max|u| (the work scale). A step that fails is cut back
+the tolerance, ||r_f|| <= rtol * max(||reactions||, f_floor) (or <= 10 times that at the
+round-off floor, where the Newton correction is below 1e-12 of u, `_balanced`), and the energy
+norm of the next correction |du . r| <= etol * f_ref * max|u| (the work scale). A step that fails is cut back
 (halved); when the step falls below ``min_step`` a `ConvergenceError` reports the step, the
 residual history and the likely cause. Nothing is accepted silently.
 """
