@@ -45,7 +45,12 @@ Per converged step, `CupResponse` holds (all SI):
   pressure (`postprocess.half_maximum_width`);
 * ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
   elastic energy), ``newton_iterations``, ``unstable`` (the tangent lost definiteness in the step
-  that ended there: buckling or a snap, across which the path may jump, `fem.solver`), and the pressure profiles ``pressure[i]``.
+  that ended there: buckling or a snap, across which the path may jump, `fem.solver`), and the pressure profiles ``pressure[i]``;
+* ``min_stretch``: the smallest principal stretch anywhere in the wall (`postprocess.smallest_stretch`
+  at the quadrature points). Below Biot's 0.544 (`postprocess.BIOT_STRETCH`) a compressed free
+  surface can fold, and the curve from there on (`CupResponse.folding_u_m`) depends on the mesh:
+  cup A reaches it at the outer face next to the clamped plate, at ~0.83 h1 with sticking contact
+  (where the fine level's path turns unstable) and just at 0.9 h1 frictionless.
 """
 
 from __future__ import annotations
@@ -60,8 +65,8 @@ from skfem import Mesh
 
 from .contact import PressureProfile, RigidPlane
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
-from .postprocess import (enclosed_volume, half_maximum_width, inner_contact_radius,
-                          median_force_width, quartile_width, weighted_width)
+from .postprocess import (BIOT_STRETCH, enclosed_volume, half_maximum_width, inner_contact_radius,
+                          median_force_width, quartile_width, smallest_stretch, weighted_width)
 from .forms import Mechanics
 from .kinematics import Kinematics
 from .material import NeoHookean
@@ -91,6 +96,7 @@ class CupResponse:
     energy_J: np.ndarray
     newton_iterations: np.ndarray
     unstable: np.ndarray
+    min_stretch: np.ndarray
     pressure: tuple[PressureProfile, ...]
     stats: SolverStats
     mesh: Mesh = field(repr=False)
@@ -101,6 +107,13 @@ class CupResponse:
     def h_m(self) -> np.ndarray:
         """Cup height h = h1 - u [m]."""
         return self.h1_m - self.u_m
+
+    @property
+    def folding_u_m(self) -> float | None:
+        """The first u [m] at which the wall is compressed beyond Biot's stretch (a free surface
+        may fold there: the curve beyond depends on the mesh), or None."""
+        beyond = np.flatnonzero(self.min_stretch < BIOT_STRETCH)
+        return float(self.u_m[beyond[0]]) if beyond.size else None
 
     def write_fields(self, path: str | Path, step: int | None = -1) -> Path:
         """Write displacement, Cauchy stress (element means) and contact pressure on the reference
@@ -166,7 +179,8 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
         h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
         F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l_q"),
         l_median_m=col("l_med"), l_weighted_m=col("l_w"), l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
-        newton_iterations=col("its").astype(int), unstable=col("unstable").astype(bool), pressure=tuple(st["p"] for st in steps),
+        newton_iterations=col("its").astype(int), unstable=col("unstable").astype(bool),
+        min_stretch=col("stretch"), pressure=tuple(st["p"] for st in steps),
         stats=stats,
         mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
         nodal_pressure_Pa=tuple(st["p_nodes"] for st in steps))
@@ -186,6 +200,7 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
             "V": enclosed_volume(x[0, path], x[1, path], on_path),
             "l_q": l_q, "l_w": contact_width(prof, r_c), "l_hm": l_hm, "l_med": l_med,
             "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations, "unstable": s.unstable,
+            "stretch": float(np.min(smallest_stretch(mech.kin.deformation_gradient(s.u)))),
             "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
 
 

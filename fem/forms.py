@@ -32,9 +32,25 @@ import scipy.sparse as sp
 from skfem import BilinearForm, LinearForm, MeshQuad2
 
 from .kinematics import IDENTITY, Kinematics
-from .material import NeoHookean, jacobian, jacobian_gradient, jacobian_hessian, jacobian_minus_one
+from .material import (NeoHookean, jacobian, jacobian_gradient, jacobian_hessian, jacobian_hessian_entries,
+                       jacobian_minus_one)
 
 __all__ = ["Mechanics", "internal_force_form", "tangent_form", "energy_form"]
+
+
+def _tangent_at_points(f: np.ndarray, g: np.ndarray, c0: np.ndarray, a: np.ndarray,
+                       b: np.ndarray) -> np.ndarray:
+    """c0 1 + a g (x) g + b d2J/df2 at every point, [nel, nq, 5, 5] (the kernels' layout): the
+    neo-Hookean tangent (`NeoHookean.tangent_coefficients`) times dV, built in place."""
+    gp = np.moveaxis(g, 0, -1)                                        # [nel, nq, 5]
+    A = (a[..., None] * gp)[..., :, None] * gp[..., None, :]
+    diagonal = np.arange(5)
+    A[..., diagonal, diagonal] += c0[..., None]
+    for (i, j), v in jacobian_hessian_entries(f).items():
+        bv = b * v
+        A[..., i, j] += bv
+        A[..., j, i] += bv
+    return A
 
 
 # --------------------------------------------------------------------------------------------
@@ -120,16 +136,28 @@ class Mechanics:
         """Assemble element vectors re[nel, 18]."""
         return np.bincount(self.kin.dofs.T.ravel(), weights=re.ravel(), minlength=self.kin.ndofs)
 
-    @cached_property
-    def _Bt(self) -> np.ndarray:
-        """The B-operator as [nel, nq, 18, 5] (contiguous, for batched products)."""
-        return np.ascontiguousarray(np.transpose(self.kin.B, (2, 3, 0, 1)))
+    @property
+    def _BtT(self) -> np.ndarray:
+        """B^T as [nel, nq * 5, 18] (`Kinematics.B_stacked`)."""
+        return self.kin.B_stacked
 
     @cached_property
-    def _BtT(self) -> np.ndarray:
-        """[nel, nq * 5, 18]: Bt with (q, k) stacked, the right factor of K_e."""
-        ne, nq, nb, _ = self._Bt.shape
-        return np.ascontiguousarray(np.transpose(self._Bt, (0, 1, 3, 2)).reshape(ne, nq * 5, nb))
+    def _Bt(self) -> np.ndarray:
+        """B as [nel, 18, nq * 5] (contiguous), the left factor of K_e."""
+        return np.ascontiguousarray(np.transpose(self._BtT, (0, 2, 1)))
+
+    def _element_forces(self, PdV: np.ndarray) -> np.ndarray:
+        """r_e,i = sum_q B_iq . P_q dV_q for P dV [5, nel, nq]: [nel, 18]."""
+        ne, nq = PdV.shape[1:]
+        return (np.transpose(PdV, (1, 2, 0)).reshape(ne, 1, nq * 5) @ self._BtT)[:, 0]
+
+    def _element_tangents(self, AdV: np.ndarray) -> np.ndarray:
+        """K_e = sum_q B_q^T (A_q dV_q) B_q for A dV [nel, nq, 5, 5]: [nel, 18, 18], as two
+        batched products (the 5 x 5 blocks with B^T per point, then B over all points)."""
+        ne, nq = AdV.shape[:2]
+        nb = self._BtT.shape[2]
+        C = np.ascontiguousarray(AdV) @ self._BtT.reshape(ne, nq, 5, nb)
+        return self._Bt @ C.reshape(ne, nq * 5, nb)
 
     # --- P1disc projection for the mixed formulation ---------------------------------------
     @cached_property
@@ -190,47 +218,56 @@ class Mechanics:
         f = self.kin.deformation_gradient(u)
         if np.any(jacobian(f) <= 0):
             raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
-        P = self.stress(f)
-        re = np.einsum("eqik,keq->ei", self._Bt, P * self.kin.dV)
-        return self._vector(re)
+        return self._vector(self._element_forces(self.stress(f) * self.kin.dV))
 
     def linearize(self, u: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
         """Internal force r(u) and consistent tangent K(u) = d2Pi/du2."""
         return self.evaluate(u)[1:]
 
+    @cached_property
+    def _last(self) -> dict:
+        """The last evaluation (u and its results): a path solver evaluates the converged state
+        of a load step and then starts the next step from it."""
+        return {}
+
     def evaluate(self, u: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
-        """Stored energy Pi(u) [J], internal force r(u) and tangent K(u), from one evaluation of F."""
+        """Stored energy Pi(u) [J], internal force r(u) and tangent K(u), from one evaluation of F
+        (the previous call's results if u is the same; r and K's data are read-only)."""
+        last = self._last
+        if "u" in last and np.array_equal(last["u"], u):
+            return last["out"]
+        out = self._evaluate(u)
+        out[1].flags.writeable = out[2].data.flags.writeable = False     # shared with the memo
+        last.update(u=np.array(u, copy=True), out=out)
+        return out
+
+    def _evaluate(self, u: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
         h = self.kin.displacement_gradient(u)
         f = IDENTITY[:, None, None] + h
         J = jacobian(f)
         if np.any(J <= 0):
             raise FloatingPointError("J <= 0 at a quadrature point (inverted element)")
         m, dV = self.material, self.kin.dV
+        g = jacobian_gradient(f)
         if m.formulation == "displacement":
-            W, P, A = m.isochoric(f, h)
-            U, dU, d2U = m.volumetric(J, np.log1p(jacobian_minus_one(h)))
-            g = jacobian_gradient(f)
-            W = W + U
-            P = P + dU * g
-            A = A + d2U * g[:, None] * g[None, :] + dU * jacobian_hessian(f)
+            lnJ = np.log1p(jacobian_minus_one(h))
+            W = m.isochoric_energy(h) + m.volumetric(J, lnJ)[0]
+            a, b = m.tangent_coefficients(J, lnJ)
+            P = m.mu * f + b * g
+            AdV = _tangent_at_points(f, g, m.mu * dV, a * dV, b * dV)
         else:
             theta, p = self.pressure_and_dilatation(f, h)
             W, P, A = m.isochoric(f, h)
             W = W + m.volumetric(theta, np.log1p(theta - 1.0))[0]
-            g = jacobian_gradient(f)
             P = P + p * g
-            A = A + p * jacobian_hessian(f)
-        Bt = self._Bt                                            # [nel, nq, 18, 5]
-        re = np.einsum("eqik,keq->ei", Bt, P * dV)
-        # K_e = sum_q Bt_q (A_q dV_q) Bt_q^T as batched matrix products
-        AdV = np.transpose(A * dV, (2, 3, 0, 1))                 # [nel, nq, 5, 5]
-        BA = Bt @ AdV                                            # [nel, nq, 18, 5]
-        ne, nq, nb, _ = Bt.shape
-        Ke = BA.transpose(0, 2, 1, 3).reshape(ne, nb, nq * 5) @ self._BtT
+            AdV = np.transpose((A + p * jacobian_hessian(f)) * dV, (2, 3, 0, 1))
+        re = self._element_forces(P * dV)
+        Ke = self._element_tangents(AdV)
         if m.formulation == "mixed":
             q, Minv = self._p1
             d2U = m.volumetric(theta, np.log1p(theta - 1.0))[2]
-            dJ = np.einsum("eqik,keq->eqi", self._Bt, g * dV)       # dJ[v] dV at the points
+            ne, nq = dV.shape
+            dJ = np.einsum("keq,eqki->eqi", g * dV, self._BtT.reshape(ne, nq, 5, -1))  # dJ[v] dV
             G = np.einsum("aeq,eqi->eai", q, dJ)                     # [nel, 3, 18]
             D = np.einsum("aeq,beq,eq->eab", q, q, d2U * dV)
             C = Minv @ D @ Minv

@@ -81,6 +81,13 @@ class Kinematics:
             out[i, 4] = value[0] / self.R   # hoop stretch from u_r / R
         return out
 
+    @cached_property
+    def B_stacked(self) -> np.ndarray:
+        """B as [nel, nq * 5, ndofs_per_element], row (q, k) = d f_k / d u at point q (contiguous,
+        the layout of the batched products in `displacement_gradient` and `fem.forms`)."""
+        nb, _, ne, nq = self.B.shape
+        return np.ascontiguousarray(np.transpose(self.B, (2, 3, 1, 0)).reshape(ne, nq * 5, nb))
+
     def local(self, u: np.ndarray) -> np.ndarray:
         """Element dof values [18, nel] of a global vector u."""
         return u[self.dofs]
@@ -91,7 +98,9 @@ class Kinematics:
 
     def displacement_gradient(self, u: np.ndarray) -> np.ndarray:
         """h(u) = f(u) - 1 at the quadrature points, [5, nel, nq] (exact for small u, unlike f - 1)."""
-        return np.einsum("ikeq,ie->keq", self.B, self.local(u))
+        ne, nq = self.R.shape
+        hq = self.B_stacked @ self.local(u).T[:, :, None]          # [nel, nq * 5, 1]
+        return np.ascontiguousarray(np.transpose(hq.reshape(ne, nq, 5), (2, 0, 1)))
 
     def node_coordinates(self) -> np.ndarray:
         """Reference coordinates of the mesh nodes [2, nnodes] (node n carries dofs 2n, 2n+1)."""

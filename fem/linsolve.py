@@ -20,6 +20,10 @@ columns are zeroed and the diagonal set to one, so the band keeps its size and t
 from the assembled CSR data to the band by a fixed index table; nothing is copied or converted
 per iteration but the data itself.
 
+The LAPACK calls run on one BLAS thread (threadpoolctl): a band of kd ~ 40-140 is too narrow for
+OpenBLAS's threads to pay, and when the other core is busy they spin: the medium cup A run took
+7.1 s with the default two threads against 2.0 s with one on the 2-core machine under load.
+
 Cholesky needs the free block K_ff positive definite, which is exactly the condition for the
 Newton direction to descend in energy. When it is not (a structural instability: buckling,
 snap-through), `NotPositiveDefinite` is raised and the caller may shift the diagonal.
@@ -27,17 +31,30 @@ snap-through), `NotPositiveDefinite` is raised and the caller may shift the diag
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.sparse.csgraph import dijkstra, reverse_cuthill_mckee
 from skfem import Mesh
+from threadpoolctl import ThreadpoolController
 
-__all__ = ["BandedCholesky", "Factor", "NotPositiveDefinite", "strip_ordering", "wall_ordering"]
+__all__ = ["BandedCholesky", "BorderedFactor", "Factor", "NotPositiveDefinite", "strip_ordering", "wall_ordering"]
 
 
 class NotPositiveDefinite(np.linalg.LinAlgError):
     """The free block of the tangent (plus the shift) is not positive definite."""
+
+
+@functools.cache
+def _blas() -> ThreadpoolController:
+    return ThreadpoolController()
+
+
+def _one_thread():
+    """A context that limits BLAS/LAPACK to one thread (~15 us to enter)."""
+    return _blas().limit(limits=1, user_api="blas")
 
 
 def strip_ordering(coordinates: np.ndarray, pattern: sp.csr_matrix,
@@ -96,9 +113,11 @@ def _half_bandwidth(pattern: sp.csr_matrix, perm: np.ndarray) -> int:
 class BandedCholesky:
     """Solver for K du = b with du prescribed on some dofs, K symmetric with a fixed CSR pattern."""
 
-    def __init__(self, pattern: sp.csr_matrix, coordinates: np.ndarray, mesh: Mesh | None = None):
+    def __init__(self, pattern: sp.csr_matrix, coordinates: np.ndarray | None, mesh: Mesh | None = None,
+                 *, perm: np.ndarray | None = None):
+        """`perm`: the dof ordering, if given; otherwise `strip_ordering` of the coordinates [2, nnodes]."""
         n = pattern.shape[0]
-        perm = strip_ordering(coordinates, pattern, mesh)
+        perm = strip_ordering(coordinates, pattern, mesh) if perm is None else np.asarray(perm)
         inv = np.empty_like(perm)
         inv[perm] = np.arange(n)
         rows = np.repeat(np.arange(n), np.diff(pattern.indptr))
@@ -116,9 +135,13 @@ class BandedCholesky:
         constrained dofs (~free) eliminated. Raises `NotPositiveDefinite` if it is not."""
         if K.nnz != len(self._indices) or K.shape[0] != self.n:
             raise ValueError("BandedCholesky: the matrix does not have the pattern it was built for")
+        return Factor(self, K, free, self.band_factor(K.data, free, shift), shift)
+
+    def band_factor(self, data: np.ndarray, free: np.ndarray, shift: float = 0.0) -> np.ndarray:
+        """The banded Cholesky factor of K_ff from the CSR `data` of K (the pattern's layout)."""
         keep = free[self._rows] & free[self._cols]
         ab = np.zeros((self.kd + 1) * self.n)
-        ab[self._band] = np.where(keep, K.data[self._sel], 0.0)
+        ab[self._band] = np.where(keep, data[self._sel], 0.0)
         ab = ab.reshape(self.kd + 1, self.n)
         diag = ab[self.kd]                                     # a view, in permuted order
         fixed_p = ~free[self._perm]
@@ -126,10 +149,16 @@ class BandedCholesky:
             diag += shift * np.where(fixed_p, 0.0, np.abs(diag))
         diag[fixed_p] = 1.0
         try:
-            c = sla.cholesky_banded(ab, overwrite_ab=True, lower=False, check_finite=False)
+            with _one_thread():
+                return sla.cholesky_banded(ab, overwrite_ab=True, lower=False, check_finite=False)
         except np.linalg.LinAlgError as err:
             raise NotPositiveDefinite(str(err)) from None
-        return Factor(self, K, free, c)
+
+    def band_solve(self, c: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """x = K_ff^-1 b with a factor of `band_factor` (b zero on the constrained dofs)."""
+        with _one_thread():
+            x = sla.cho_solve_banded((c, False), b[self._perm], overwrite_b=True, check_finite=False)
+        return x[self._inv]
 
     def solve(self, K: sp.csr_matrix, rhs: np.ndarray, free: np.ndarray, du_fixed: np.ndarray,
               shift: float = 0.0) -> np.ndarray:
@@ -141,18 +170,64 @@ class BandedCholesky:
 class Factor:
     """A factored free block K_ff; `solve` for one or several right-hand sides."""
 
-    def __init__(self, owner: BandedCholesky, K: sp.csr_matrix, free: np.ndarray, c: np.ndarray):
-        self._owner, self._K, self.free, self._c = owner, K, free, c
+    def __init__(self, owner: BandedCholesky, K: sp.csr_matrix, free: np.ndarray, c: np.ndarray,
+                 shift: float = 0.0):
+        self._owner, self._K, self.free, self._c, self.shift = owner, K, free, c, shift
 
     def solve(self, rhs: np.ndarray, du_fixed: np.ndarray | None = None) -> np.ndarray:
         """x with K_ff x_f = rhs_f - K_fc du_fixed_c, x_c = du_fixed_c (0 if None); rhs [n] or [n, m]."""
-        fixed = ~self.free
-        mask = fixed if rhs.ndim == 1 else fixed[:, None]
-        if du_fixed is None:
-            b = np.where(mask, 0.0, rhs)
-        else:
-            b = rhs - self._K @ np.where(fixed, du_fixed, 0.0)
-            b = np.where(fixed, du_fixed, b)
-        x = sla.cho_solve_banded((self._c, False), b[self._owner._perm], overwrite_b=True,
-                                 check_finite=False)
-        return x[self._owner._inv]
+        return self._owner.band_solve(self._c, _constrained_rhs(self._K, self.free, rhs, du_fixed))
+
+    def freeing(self, dofs: np.ndarray) -> "BorderedFactor":
+        """The factor of the free block with the constrained `dofs` freed as well (e.g. contact
+        nodes let go), by the Schur complement on them: len(dofs) solves with this factor instead
+        of a new factorization. Raises `NotPositiveDefinite` if the larger block is not."""
+        return BorderedFactor(self, np.asarray(dofs))
+
+
+class BorderedFactor:
+    """The block [[K_ff, K_fT], [K_Tf, K_TT]] of a `Factor` bordered by the dofs T:
+    with Y = K_ff^-1 K_fT and the Schur complement S = K_TT - K_Tf Y (Cholesky, m x m),
+    x_T = S^-1 (b_T - K_Tf K_ff^-1 b_f) and x_f = K_ff^-1 b_f - Y x_T. The base factor's diagonal
+    shift is applied to K_TT as well."""
+
+    def __init__(self, base: Factor, dofs: np.ndarray):
+        if np.any(base.free[dofs]):
+            raise ValueError("BorderedFactor: the dofs to free must be constrained in the base factor")
+        K = base._K
+        self._base, self._dofs, self._K = base, dofs, K
+        self.free = base.free.copy()
+        self.free[dofs] = True
+        self._cols = K[:, dofs].toarray()                     # K_:T
+        self._cols[~base.free] = 0.0                           # K_fT
+        self._Y = base.solve(self._cols)                       # K_ff^-1 K_fT, zero off f
+        K_TT = K[dofs][:, dofs].toarray()
+        S = K_TT - self._cols.T @ self._Y
+        S[np.diag_indices_from(S)] += base.shift * np.abs(np.diag(K_TT))
+        try:
+            self._S = sla.cho_factor(S, check_finite=False)
+        except np.linalg.LinAlgError as err:
+            raise NotPositiveDefinite(f"Schur complement of the freed dofs: {err}") from None
+
+    def solve(self, rhs: np.ndarray, du_fixed: np.ndarray | None = None) -> np.ndarray:
+        """As `Factor.solve`, on the larger free block."""
+        b = _constrained_rhs(self._K, self.free, rhs, du_fixed)
+        x = self._base.solve(b)                                # K_ff^-1 b_f (b_T masked out)
+        xT = sla.cho_solve(self._S, b[self._dofs] - self._cols.T @ x, check_finite=False)
+        x -= self._Y @ xT
+        x[self._dofs] = xT
+        if du_fixed is not None:
+            fixed = ~self.free
+            x[fixed] = du_fixed[fixed] if rhs.ndim == 1 else du_fixed[fixed, None]
+        return x
+
+
+def _constrained_rhs(K: sp.csr_matrix, free: np.ndarray, rhs: np.ndarray,
+                     du_fixed: np.ndarray | None) -> np.ndarray:
+    """rhs - K du_fixed on the free dofs and du_fixed on the constrained ones (0 if None)."""
+    fixed = ~free
+    mask = fixed if rhs.ndim == 1 else fixed[:, None]
+    if du_fixed is None:
+        return np.where(mask, 0.0, rhs)
+    b = rhs - K @ np.where(fixed, du_fixed, 0.0)
+    return np.where(mask, du_fixed if rhs.ndim == 1 else du_fixed[:, None], b)

@@ -85,16 +85,26 @@ class NeoHookean:
         g = jacobian_gradient(f)
         mu = self.mu
         h = _displacement_gradient(f) if h is None else h
-        j = jacobian_minus_one(h)
-        # tr h - j = -(h0 h3 - h1 h2) - a h4 with a = J_2D - 1 (exact algebra, no cancellation)
-        a = _planar_jacobian_minus_one(h)
-        W = mu * (-(h[0] * h[3] - h[1] * h[2]) - a * h[4] + _x_minus_log1p(j)) \
-            + 0.5 * mu * np.sum(h**2, axis=0)
+        W = self.isochoric_energy(h)
         dW, d2W = -mu / J, mu / J**2
         P = mu * f + dW * g
         A = d2W * g[:, None] * g[None, :] + dW * jacobian_hessian(f)
         A[np.arange(5), np.arange(5)] += mu
         return W, P, A
+
+    def isochoric_energy(self, h: np.ndarray) -> np.ndarray:
+        """W_iso from the displacement gradient h = f - 1, without cancellation (`isochoric`)."""
+        mu = self.mu
+        # tr h - j = -(h0 h3 - h1 h2) - a h4 with a = J_2D - 1 (exact algebra, no cancellation)
+        a = _planar_jacobian_minus_one(h)
+        return mu * (-(h[0] * h[3] - h[1] * h[2]) - a * h[4] + _x_minus_log1p(jacobian_minus_one(h))) \
+            + 0.5 * mu * np.sum(h**2, axis=0)
+
+    def tangent_coefficients(self, J: np.ndarray, lnJ: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The whole law (displacement formulation) as P = mu f + b g and
+        A = mu 1 + a g (x) g + b H (module docstring): a = d2W/dJ2 = (mu + lambda (1 - ln J)) / J^2
+        and b = dW/dJ = (lambda ln J - mu) / J."""
+        return (self.mu + self.lam * (1.0 - lnJ)) / J**2, (self.lam * lnJ - self.mu) / J
 
     def energy(self, f: np.ndarray, h: np.ndarray | None = None) -> np.ndarray:
         """W(F) per unit reference volume [J/m^3] (pointwise, all terms; h = f - 1 if known)."""
@@ -157,11 +167,15 @@ def jacobian_gradient(f: np.ndarray) -> np.ndarray:
 def jacobian_hessian(f: np.ndarray) -> np.ndarray:
     """d2J/df2 [5, 5, ...]: J is trilinear in f, so H is linear in f."""
     H = np.zeros((5, 5) + f.shape[1:])
-    for (a, b), v in {(0, 3): f[4], (1, 2): -f[4], (0, 4): f[3], (3, 4): f[0],
-                      (1, 4): -f[2], (2, 4): -f[1]}.items():
+    for (a, b), v in jacobian_hessian_entries(f).items():
         H[a, b] = v
         H[b, a] = v
     return H
+
+
+def jacobian_hessian_entries(f: np.ndarray) -> dict[tuple[int, int], np.ndarray]:
+    """The nonzero entries (a, b), a < b, of the symmetric d2J/df2 (its diagonal is zero)."""
+    return {(0, 3): f[4], (1, 2): -f[4], (0, 4): f[3], (3, 4): f[0], (1, 4): -f[2], (2, 4): -f[1]}
 
 
 def cauchy_stress(f: np.ndarray, P: np.ndarray) -> np.ndarray:

@@ -27,7 +27,29 @@ import numpy as np
 
 __all__ = ["enclosed_volume", "inner_contact_radius", "pressure_weighted_width", "weighted_width",
            "half_maximum_width", "median_force_width", "quartile_width", "contact_zones", "contact_force",
-           "Richardson", "richardson"]
+           "Richardson", "richardson", "smallest_stretch", "BIOT_STRETCH", "CREASE_STRETCH"]
+
+#: the smallest principal stretch at which a compressed neo-Hookean surface stays smooth: Biot's
+#: wrinkling bifurcation of an incompressible half-space in plane strain (M. A. Biot, Appl. Sci.
+#: Res. A 12, 168 (1963): lambda = 0.544); creases nucleate earlier, near 0.65 (Hohlfeld &
+#: Mahadevan, PRL 106, 105702 (2011)). Beyond them a compressed free surface folds on a length
+#: scale the model does not fix, so the refined mesh follows folds the coarser ones cannot.
+BIOT_STRETCH = 0.544
+CREASE_STRETCH = 0.65
+
+
+def smallest_stretch(f: np.ndarray) -> np.ndarray:
+    """The smallest principal stretch at each point of the axisymmetric deformation gradient
+    f = (F_rR, F_rZ, F_zR, F_zZ, F_tt) [5, ...]: min(sqrt(smallest eigenvalue of the in-plane
+    C = F^T F), |F_tt|)."""
+    c11 = f[0] ** 2 + f[2] ** 2
+    c22 = f[1] ** 2 + f[3] ** 2
+    c12 = f[0] * f[1] + f[2] * f[3]
+    half_trace = 0.5 * (c11 + c22)
+    radius = np.sqrt(0.25 * (c11 - c22) ** 2 + c12**2)
+    det = (f[0] * f[3] - f[1] * f[2]) ** 2
+    smallest = det / (half_trace + radius)          # the small eigenvalue without cancellation
+    return np.minimum(np.sqrt(smallest), np.abs(f[4]))
 
 
 def enclosed_volume(r_m: np.ndarray, z_m: np.ndarray, in_contact: np.ndarray | None = None) -> float:

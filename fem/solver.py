@@ -57,7 +57,8 @@ from scipy.optimize import nnls
 
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
-from .linsolve import BandedCholesky, NotPositiveDefinite
+from .condensation import make_solver
+from .linsolve import NotPositiveDefinite
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
 
@@ -139,7 +140,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     u0 = np.zeros(n)
     state = plane.initial_state() if plane is not None else None
     r0 = mech.internal_force(u0)
-    solver = BandedCholesky(mech.linearize(u0)[1], mech.kin.node_coordinates(), mech.kin.mesh)
+    solver = make_solver(mech.linearize(u0)[1], mech.kin.node_coordinates(), mech.kin.mesh)
     if on_step:
         on_step(StepResult(0.0, u0, r0, state, 0))
     t, W0 = 0.0, mech.energy(u0)
@@ -317,10 +318,13 @@ class _Step:
         tensile = self.state.active & ((self.res + K @ self.du)[zdof] < -self.tol)
         self.release = np.zeros_like(tensile)
         if tensile.any():
-            free = self.free.copy()
-            free[zdof[tensile]] = True
-            # without them K_ff may be indefinite (the contact held the structure): shifted
-            fac, shift = _factor(solver, K, free, 10.0 * shift, history)
+            try:        # bordered by the freed dofs (Schur complement): no new factorization
+                fac = fac.freeing(zdof[tensile])
+            except NotPositiveDefinite:
+                # without them K_ff is indefinite (the contact held the structure): shifted
+                free = self.free.copy()
+                free[zdof[tensile]] = True
+                fac, shift = _factor(solver, K, free, 10.0 * shift, history)
             self._constrained(fac, np.flatnonzero(tensile))
             self.release = tensile
         return shift

@@ -43,12 +43,12 @@ def test_fem_stiffness_is_a_direct_compress_cup_run(example):
 
     curve = StiffnessCurve.from_csv(example / "stiffness_fem.csv")
     g = cup_geometry("A")
-    direct = compress_cup(cup_mesh(g, "coarse"), NeoHookean(E_Pa=4e6, nu=0.49), contact="sticking",
+    direct = compress_cup(cup_mesh(g, "medium"), NeoHookean(E_Pa=4e6, nu=0.49), contact="sticking",
                           u_max_m=0.9 * g.h1_m)
     # the CSV keeps 10 significant digits; the run is deterministic
     np.testing.assert_allclose(curve.u_m, direct.u_m, rtol=1e-9, atol=1e-15)
     np.testing.assert_allclose(curve.F0_N, direct.F0_N, rtol=1e-9, atol=1e-12)
-    assert curve.provenance["contact"] == "sticking" and curve.provenance["fidelity"] == "coarse"
+    assert curve.provenance["contact"] == "sticking" and curve.provenance["fidelity"] == "medium"
 
 
 @pytest.mark.parametrize("argv,message", [

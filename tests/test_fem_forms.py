@@ -140,3 +140,22 @@ def test_equibiaxial_with_hoop_patch_solve(formulation):
     sr = closed_form_cauchy(mat, [lr, lz, lr])[0]
     F_outer = np.sum(r_int[2 * outer])
     assert F_outer == pytest.approx(sr * 2 * np.pi * b * lr * H * lz, rel=1e-8)
+
+
+def test_evaluate_reuses_only_the_same_state():
+    """The one-entry memo of `Mechanics.evaluate` returns the previous results for an equal u
+    (read-only, so they cannot be spoiled), and recomputes when u changes, also in place."""
+    from fem.geometry import cup_geometry
+    from fem.mesh import cup_mesh
+
+    mech = Mechanics(Kinematics.of(cup_mesh(cup_geometry("A"), "coarse")), NeoHookean())
+    u = np.zeros(mech.kin.ndofs)
+    W0, r0, K0 = mech.evaluate(u)
+    assert mech.evaluate(u.copy())[1] is r0
+    with pytest.raises(ValueError):
+        r0[0] = 1.0
+    u[1::2] = -1e-6 * mech.kin.node_coordinates()[1]          # a uniform vertical squeeze, in place
+    W1, r1, K1 = mech.evaluate(u)
+    assert W1 > W0 and r1 is not r0
+    fresh = Mechanics(mech.kin, mech.material).evaluate(u)
+    assert W1 == fresh[0] and np.array_equal(r1, fresh[1]) and np.array_equal(K1.data, fresh[2].data)

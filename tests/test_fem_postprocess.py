@@ -291,3 +291,21 @@ def test_median_force_width_counts_no_load_inside_the_edge():
     assert median_force_width(r, p, r_c) == pytest.approx(l, rel=1e-9)
     one = np.array([r_c - h, r_c, r_c + 1e-9, r_c + h])             # one loaded node, then free
     assert 0.0 <= median_force_width(one, np.array([0.0, 1e4, 0.0, 0.0]), r_c) < 1e-9
+
+
+def test_smallest_stretch_of_closed_form_states():
+    """Uniaxial compression, simple shear (stretches (sqrt(1 + k^2/4) -+ k/2)) and a hoop
+    contraction: the smallest principal stretch in closed form, also for a rotated state."""
+    from fem.postprocess import smallest_stretch
+    lam, k, c = 0.6, 0.8, 0.3
+    uniaxial = np.array([1.0 / np.sqrt(lam), 0.0, 0.0, lam, 1.0 / np.sqrt(lam)])
+    shear = np.array([1.0, k, 0.0, 1.0, 1.0])
+    hoop = np.array([1.1, 0.0, 0.0, 1.05, 0.7])
+    R = np.array([[np.cos(c), -np.sin(c)], [np.sin(c), np.cos(c)]])
+    F = R @ np.array([[1.0 / np.sqrt(lam), 0.0], [0.0, lam]])
+    rotated = np.array([F[0, 0], F[0, 1], F[1, 0], F[1, 1], 1.0 / np.sqrt(lam)])
+    f = np.stack([uniaxial, shear, hoop, rotated], axis=1)
+    expected = [lam, np.sqrt(1 + k**2 / 4) - k / 2, 0.7, lam]
+    np.testing.assert_allclose(smallest_stretch(f), expected, rtol=1e-14)
+    # small strain: no cancellation (1 - 1e-9 resolved)
+    assert smallest_stretch(np.array([1.0, 0.0, 0.0, 1.0 - 1e-9, 1.0]))[()] == pytest.approx(1 - 1e-9, rel=1e-15)

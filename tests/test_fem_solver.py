@@ -153,3 +153,43 @@ def test_thin_steep_cone_loses_no_energy(thin_steep_cone):
     budget of 1 % is twice the largest loss a single accepted step may carry plus that error)."""
     _, r = thin_steep_cone
     assert abs(r.stats.dissipated_J) < 0.01 * r.energy_J[-1]
+
+
+def test_bordered_factor_equals_a_new_factorization(cup):
+    """Freeing constrained dofs by the Schur complement (`Factor.freeing`) solves the larger free
+    block exactly as factoring it anew: one and several right-hand sides, with prescribed values,
+    with and without a diagonal shift (to round-off relative to the solution; K's condition is ~1e6)."""
+    mesh, K, top = cup
+    n = K.shape[0]
+    rng = np.random.default_rng(3)
+    fixed = np.concatenate([2 * top, 2 * top + 1, [11, 41, 97]])
+    free = np.ones(n, bool)
+    free[fixed] = False
+    freed = np.array([11, 41, 97])
+    larger = free.copy()
+    larger[freed] = True
+    du_fixed = np.where(free, 0.0, rng.normal(size=n) * 1e-6)
+    solver = BandedCholesky(K, mesh.doflocs, mesh)
+    for shift in (0.0, 1e-3):
+        bordered = solver.factor(K, free, shift).freeing(freed)
+        direct = solver.factor(K, larger, shift)
+        rhs = rng.normal(size=(n, 3))
+        for b, d in ((rhs[:, 0], du_fixed), (rhs, None)):
+            x, ref = bordered.solve(b, d), direct.solve(b, d)
+            assert np.max(np.abs(x - ref)) <= 1e-9 * np.max(np.abs(ref))
+
+
+def test_bordered_factor_refuses_an_indefinite_block(cup):
+    """A freed dof that makes the block indefinite raises NotPositiveDefinite (the solver then
+    factors anew with a shift)."""
+    mesh, K, top = cup
+    n = K.shape[0]
+    free = np.ones(n, bool)
+    free[np.concatenate([2 * top, 2 * top + 1])] = False
+    solver = BandedCholesky(K, mesh.doflocs, mesh)
+    K_neg = K.copy()
+    K_neg.data = K_neg.data.copy()
+    d = 2 * top[0] + 1
+    K_neg[d, d] = -abs(K[d, d])          # same pattern (the entry exists), negative pivot
+    with pytest.raises(NotPositiveDefinite):
+        solver.factor(K_neg, free).freeing(np.array([d]))

@@ -81,6 +81,8 @@ def sidecar(response: CupResponse, provenance: Mapping[str, Any]) -> dict[str, A
     stats["largest_penetration_m"] = float(np.max(np.abs(response.penetration_m), initial=0.0))
     stats["largest_F0_mismatch_N"] = float(np.max(np.abs(response.F0_N - response.F0_contact_N),
                                                   initial=0.0))
+    folding = response.folding_u_m
+    stats["folding_u_mm"] = None if folding is None else folding * 1e3
     steps = {
         "u_mm": response.u_m * 1e3,
         "F0_N": response.F0_N,
@@ -91,6 +93,7 @@ def sidecar(response: CupResponse, provenance: Mapping[str, Any]) -> dict[str, A
         "penetration_mm": response.penetration_m * 1e3,
         "energy_J": response.energy_J,
         "newton_iterations": response.newton_iterations,
+        "min_stretch": response.min_stretch,
     }
     return {"provenance": dict(provenance), "h1_mm": response.h1_m * 1e3, "solver": stats,
             "steps": {k: np.asarray(v).tolist() for k, v in steps.items()}}

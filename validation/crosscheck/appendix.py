@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from reduced.appendix_a import appendix_a_force, appendix_a_small_u_slope
-from validation.crosscheck.context import DEFAULT_FIDELITY, Context
+from validation.crosscheck.context import CROSSCHECK_FIDELITY, Context
 from validation.crosscheck.report import new_figure
 from validation.crosscheck.runs import FemRun
 
@@ -34,7 +34,7 @@ E_PA, D0_PAPER_M, R0_M, R1_M = 4e6, 2e-3, 5e-3, 19e-3
 
 def requests(quick: bool) -> tuple[FemRun, ...]:
     cups = ("A",) if quick else ("A", "B")
-    runs = [FemRun(cup=c, contact=k, fidelity=DEFAULT_FIDELITY) for c in cups for k in CONTACTS]
+    runs = [FemRun(cup=c, contact=k, fidelity=CROSSCHECK_FIDELITY) for c in cups for k in CONTACTS]
     if not quick:
         runs += [FemRun(cup="A", contact=k, alpha_deg=a, d_root_mm=d)
                  for a in SWEEP_ALPHA_DEG for d in SWEEP_D0_MM for k in CONTACTS]
@@ -75,7 +75,7 @@ def run(ctx: Context) -> None:
     rows, curves = [], {}
     for cup in cups:
         for contact in CONTACTS:
-            req = FemRun(cup=cup, contact=contact, fidelity=DEFAULT_FIDELITY)
+            req = FemRun(cup=cup, contact=contact, fidelity=CROSSCHECK_FIDELITY)
             res = ctx.fem(req)
             alpha = req.geometry().alpha_deg
             u = U_OVER_H1 * res.h1_m
@@ -88,10 +88,10 @@ def run(ctx: Context) -> None:
                              within_intervals(U_OVER_H1, ratio)])
     rep.table(S, "appendix_a_ratio", ["cup", "contact", "appendix_a_reading", "ratio_at_u_0.1h1",
                                       "ratio_at_u_0.5h1", "ratio_at_u_0.9h1", "u_over_h1_within_20pct"],
-              rows, "FEM / Appendix A over u (default fidelity)")
+              rows, "FEM / Appendix A over u (coarse mesh)")
 
     # the headline: cup A small-u stiffness, F0(1 mm) / 1 mm
-    reqA = {k: FemRun(cup="A", contact=k, fidelity=DEFAULT_FIDELITY) for k in CONTACTS}
+    reqA = {k: FemRun(cup="A", contact=k, fidelity=CROSSCHECK_FIDELITY) for k in CONTACTS}
     fem_slope = {k: float(ctx.fem(r).F0_at(1e-3)) for k, r in reqA.items()}
     tangent = appendix_a_small_u_slope(33.0, E_PA, D0_PAPER_M, R0_M, R1_M) * 1e-3
     sec_paper = float(appendix_a(1e-3, 33.0, "paper"))

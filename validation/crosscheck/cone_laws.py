@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from reduced.cup import cup_by_name
-from validation.crosscheck.context import DEFAULT_FIDELITY, Context
+from validation.crosscheck.context import CROSSCHECK_FIDELITY, Context
 from validation.crosscheck.report import new_figure
 from validation.crosscheck.runs import FemRun
 
@@ -25,7 +25,7 @@ U_OVER_H1 = np.round(np.linspace(0.25, 0.9, 27), 4)
 
 def requests(quick: bool) -> tuple[FemRun, ...]:
     cups = ("A",) if quick else ("A", "B")
-    return tuple(FemRun(cup=c, contact=k, fidelity=DEFAULT_FIDELITY) for c in cups for k in CONTACTS)
+    return tuple(FemRun(cup=c, contact=k, fidelity=CROSSCHECK_FIDELITY) for c in cups for k in CONTACTS)
 
 
 def cone_laws(cup_name: str, h_m: np.ndarray) -> dict[str, np.ndarray]:
@@ -42,7 +42,7 @@ def run(ctx: Context) -> None:
     rows, plots = [], []
     for cup in cups:
         for contact in CONTACTS:
-            res = ctx.fem(FemRun(cup=cup, contact=contact, fidelity=DEFAULT_FIDELITY))
+            res = ctx.fem(FemRun(cup=cup, contact=contact, fidelity=CROSSCHECK_FIDELITY))
             u = U_OVER_H1 * res.h1_m
             h = res.h1_m - u
             law = cone_laws(cup, h)

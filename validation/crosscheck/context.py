@@ -9,12 +9,13 @@ from dataclasses import dataclass
 from validation.crosscheck.report import Report
 from validation.crosscheck.runs import FemRun, RunMemo
 
-__all__ = ["Context", "SURFACE", "pmma_uc_table", "DEFAULT_FIDELITY"]
+__all__ = ["Context", "SURFACE", "pmma_uc_table", "CROSSCHECK_FIDELITY"]
 
 #: the calibrated surface of the lifetime sections (Sec. 5: sandblasted PMMA, 1.89 um rms)
 SURFACE = "pmma-1.89"
-#: the FEM level the cross-checks use unless a section studies the level itself
-DEFAULT_FIDELITY = "coarse"
+#: the FEM level the cross-checks use unless a section studies the level itself: they sweep designs and laws (80 FEM runs): the coarse level, ~2 % in F0 (section 4
+#: of the report measures it); `cupcheck stiffness` defaults to `fem.mesh.DEFAULT_FIDELITY`
+CROSSCHECK_FIDELITY = "coarse"
 
 
 @functools.lru_cache(maxsize=4)

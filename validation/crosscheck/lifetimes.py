@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from reduced.cup import CUP_A
-from validation.crosscheck.context import DEFAULT_FIDELITY, SURFACE, Context, pmma_uc_table
+from validation.crosscheck.context import CROSSCHECK_FIDELITY, SURFACE, Context, pmma_uc_table
 from validation.crosscheck.report import new_figure
 from validation.crosscheck.runs import FemRun
 
@@ -36,7 +36,7 @@ QUICK_FORCES_N = (10.0, 40.0)
 
 
 def requests(quick: bool) -> tuple[FemRun, ...]:
-    return tuple(FemRun(cup="A", contact=k, fidelity=DEFAULT_FIDELITY) for k in ("frictionless", "sticking"))
+    return tuple(FemRun(cup="A", contact=k, fidelity=CROSSCHECK_FIDELITY) for k in ("frictionless", "sticking"))
 
 
 def leakage_model(stiffness, geometry: str, uc, label: str):
@@ -47,7 +47,7 @@ def leakage_model(stiffness, geometry: str, uc, label: str):
     return replace(reference_model(CUP_A, uc), stiffness=stiffness, geometry=geometry, label=label)
 
 
-def sources(ctx: Context, fidelity: str = DEFAULT_FIDELITY) -> dict[str, tuple]:
+def sources(ctx: Context, fidelity: str = CROSSCHECK_FIDELITY) -> dict[str, tuple]:
     """label -> (StiffnessCurve, geometry) of the four sources."""
     from reduced.appendix_a import appendix_a_curve
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from validation.crosscheck.context import DEFAULT_FIDELITY, Context
+from validation.crosscheck.context import CROSSCHECK_FIDELITY, Context
 from validation.crosscheck.runs import FemRun
 
 
@@ -15,7 +15,7 @@ def deformed_cup_scene(ctx: Context) -> None:
         ctx.report.text("scene", f"Scene skipped: {probe.message}")
         ctx.report.summary["scene"] = f"skipped: {probe.message}"
         return
-    res = ctx.fem(FemRun(cup="A", contact="sticking", fidelity=DEFAULT_FIDELITY))
+    res = ctx.fem(FemRun(cup="A", contact="sticking", fidelity=CROSSCHECK_FIDELITY))
     path = render_cup(res.outline_r_m, res.outline_z_m, ctx.report.root / "deformed_cup.png",
                       scalar=res.outline_p_Pa / 1e3, scalar_name="contact pressure (kPa)",
                       title=f"cup A, sticking, u = {1e3 * res.u_m[-1]:.2f} mm")
