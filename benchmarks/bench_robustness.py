@@ -4,15 +4,21 @@ Cases (cup A's r0 = 5, r1 = 19 mm; the thickness line of cup A scaled to the roo
 `validation.crosscheck.runs.FemRun` builds it; coarse mesh, E = 4 MPa, nu = 0.49):
 
 * sweep: the alpha-d0 sweep of the Appendix A cross-check (u to 0.9 h1, max_step 0.05) cases that
-  failed with ConvergenceError before the projected-Newton contact solver (13 of 40);
+  failed with ConvergenceError before the projected-Newton contact solver (13 of 40; 10 of them
+  still failed before the robustness work of issue 3);
 * extremes: the alpha x root-thickness grid of the extremes section (frictionless, u to h1,
   max_step 0.01) cases that failed or missed the energy check.
 
-Per case it prints: outcome (ok / the first line of the error), load steps, Newton iterations,
-cut-backs, wall time, and two checks of a converged path: the energy balance (the largest
-|int F0 du - W| / W where W > 1 % of its final value; frictionless only, sticking dissipates) and
-the dissipated energy reported by the solver (`SolverStats.dissipated_J`) over the final stored
-energy. Run from the repository:
+Per case it prints: outcome (ok, or the step where it failed, the likely cause and the first and
+last relative residual of its history), load steps, Newton iterations, cut-backs (including the
+steps redone because they jumped off the path, `fem.solver`), wall time, and the checks of a
+converged path: the energy balance (the largest |int F0 du - W| / W where W > 1 % of its final
+value; frictionless only, sticking dissipates), the dissipated energy the solver reports
+(`SolverStats.dissipated_J`) over the final stored energy, and that dissipation split by step:
+snaps/W, the sum of W0 + work - W1 over the steps flagged unstable (the energy the snaps lose),
+and quad./W, the sum of its absolute values over the stable steps (for frictionless contact the
+trapezoid's error on F0(u), largest at u -> h1 where the wall is squeezed flat; for sticking
+also the slips). Run from the repository:
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_robustness.py [--only sweep|extremes]
 """
@@ -62,15 +68,31 @@ def run(req: FemRun) -> dict:
         r = compress_cup(mesh, req.material(), contact=req.contact,
                          u_max_m=req.u_max_over_h1 * geometry.h1_m, max_step=req.max_step)
     except RuntimeError as exc:
-        return {"outcome": f"{type(exc).__name__}: {str(exc)[:150]}", "time": time.perf_counter() - t0}
+        return {"outcome": _short(exc), "time": time.perf_counter() - t0}
     wall = time.perf_counter() - t0
     work = cumulative_trapezoid(r.F0_N, r.u_m, initial=0.0)
     big = r.energy_J > 0.01 * r.energy_J[-1]
     energy = float(np.max(np.abs(work[big] / r.energy_J[big] - 1.0)))
-    dissipated = getattr(r.stats, "dissipated_J", float("nan")) / r.energy_J[-1]
+    W_end = r.energy_J[-1]
+    dissipated = getattr(r.stats, "dissipated_J", float("nan")) / W_end
+    # per step: W0 + trapezoid work - W1; a snap across an instability (unstable steps) or the
+    # trapezoid's error on F0(u) (stable steps, largest where F0 rises steeply at u -> h1)
+    defect = r.energy_J[:-1] + np.diff(work) - r.energy_J[1:]
+    unstable = np.asarray(r.unstable[1:], bool)
     return {"outcome": "ok", "time": wall, "steps": r.stats.steps, "its": r.stats.newton_iterations,
             "cutbacks": r.stats.cutbacks, "energy": energy, "dissipated": dissipated,
+            "snaps": float(np.sum(defect[unstable]) / W_end),
+            "quadrature": float(np.sum(np.abs(defect[~unstable])) / W_end),
             "u_end": r.u_m[-1] / r.h1_m}
+
+
+def _short(exc: Exception) -> str:
+    """Where a solver failure happened and its likely cause (without the residual history)."""
+    text = str(exc)
+    where = text.split(" did not converge")[0]
+    cause = text.split("): ", 1)[-1].split("; residual history")[0]
+    history = text.split("residual history ")[-1].split(", ")
+    return f"{type(exc).__name__}: {where}: {cause} (residual {history[0]} ... {history[-1]})"
 
 
 def main() -> int:
@@ -79,20 +101,23 @@ def main() -> int:
     parser.add_argument("--fidelity", default="coarse")
     args = parser.parse_args()
     print(f"{'set':8} {'case':34} {'steps':>5} {'Newton':>6} {'cuts':>4} {'time/s':>7} "
-          f"{'|W-int F du|/W':>14} {'dissip./W':>9}  outcome")
+          f"{'|W-int F du|/W':>14} {'dissip./W':>9} {'snaps/W':>8} {'quad./W':>8}  outcome")
     total, failed = 0.0, 0
-    for kind, req in cases(args.only, args.fidelity):
+    todo = cases(args.only, args.fidelity)
+    total_cases = len(todo)
+    for kind, req in todo:
         res = run(req)
         total += res["time"]
         label = f"{req.contact[:5]} a{req.alpha_deg:g} d0 {req.d_root_mm:g} u<={req.u_max_over_h1:g}h1"
         if res["outcome"] != "ok":
             failed += 1
-            print(f"{kind:8} {label:34} {'':>5} {'':>6} {'':>4} {res['time']:7.2f} {'':>14} {'':>9}  "
-                  f"{res['outcome']}", flush=True)
+            print(f"{kind:8} {label:34} {'':>5} {'':>6} {'':>4} {res['time']:7.2f} {'':>14} {'':>9} "
+                  f"{'':>8} {'':>8}  {res['outcome']}", flush=True)
             continue
         print(f"{kind:8} {label:34} {res['steps']:5d} {res['its']:6d} {res['cutbacks']:4d} "
-              f"{res['time']:7.2f} {res['energy']:14.2e} {res['dissipated']:9.2e}  ok", flush=True)
-    print(f"{failed} failed; total wall time {total:.1f} s")
+              f"{res['time']:7.2f} {res['energy']:14.2e} {res['dissipated']:9.2e} "
+              f"{res['snaps']:8.1e} {res['quadrature']:8.1e}  ok", flush=True)
+    print(f"{failed} failed of {total_cases}; total wall time {total:.1f} s")
     return 0
 
 

@@ -143,13 +143,16 @@ def test_thin_steep_cone_is_followed(thin_steep_cone):
     assert work == pytest.approx(r.energy_J[-1] + r.stats.dissipated_J, rel=1e-9)
 
 
-@pytest.mark.xfail(reason="measured on the 36x4 coarse level: the energy defect is 1.8 % of W with "
-                          "the default steps (0.76 % in one step near 0.41 h1), and with steps of "
-                          "0.025 u_max it is -2 % (energy created) and the path then fails at "
-                          "u = 5.3 mm: the instability handling is not yet robust for thin steep "
-                          "walls", strict=False)
 def test_thin_steep_cone_loses_no_energy(thin_steep_cone):
-    """Frictionless contact does no work: int F0 du = W up to the trapezoid error (< 1 % of W)."""
+    """Frictionless contact does no work: int F0 du = W up to the trapezoid error (< 1 % of W).
+
+    Measured before the robustness work: 1.8 % (a descent from a large step landed on another
+    branch). A step across an instability that loses more than 0.5 % of W is now redone with
+    half the step (`SolverOptions.jump_tol`); the loss left is 0.31 % of W on the 36x4 coarse
+    level: 0.17 % in the unstable steps and 0.14 % in the stable ones, whose trapezoid errors
+    on F0(u) (kinked where the wall's nodes land) are 0.9 % in absolute sum but alternate in
+    sign (benchmarks/bench_robustness.py). The budget of 1 % is the 0.5 % an unstable step may
+    keep before it is refined, plus that trapezoid error."""
     _, r = thin_steep_cone
     assert abs(r.stats.dissipated_J) < 0.01 * r.energy_J[-1]
 
