@@ -203,3 +203,24 @@ def test_a_snap_may_lose_energy_but_not_create_it():
 def dataclasses_replace(obj, **kw):
     import dataclasses
     return dataclasses.replace(obj, **kw)
+
+
+def test_deformed_outline_is_the_closed_cross_section():
+    """The scene's outline (cavity -> rim -> outer -> plate) of the undeformed cup closes on itself
+    without doubling back: its shoelace area equals the mesh's cross-section area (each side is
+    oriented from the corner the previous side ended at)."""
+    from types import SimpleNamespace
+
+    from fem.geometry import cup_geometry
+    from fem.mesh import cup_mesh
+    from skfem import Basis, ElementQuad2
+    from validation.crosscheck.runs import _deformed_outline
+
+    mesh = cup_mesh(cup_geometry("A"), "coarse")
+    n = mesh.doflocs.shape[1]
+    x, z, _ = _deformed_outline(SimpleNamespace(mesh=mesh, displacements=[np.zeros(2 * n)],
+                                                nodal_pressure_Pa=[np.zeros(n)]))
+    assert (x[0], z[0]) == (x[-1], z[-1])
+    shoelace = 0.5 * np.sum(x[:-1] * z[1:] - x[1:] * z[:-1])
+    area = Basis(mesh, ElementQuad2()).dx.sum()
+    assert abs(shoelace) == pytest.approx(area, rel=1e-3)     # straight chords vs exact edges

@@ -178,12 +178,13 @@ def _deformed_outline(resp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     x = mesh.doflocs + np.stack([u[0::2], u[1::2]])
     pn = np.asarray(resp.nodal_pressure_Pa[-1]) if hasattr(resp, "nodal_pressure_Pa") else None
     loop = []
-    for name, reverse in (("cavity", False), ("rim", False), ("outer", True), ("top_plate", True)):
+    for name in ("cavity", "rim", "outer", "top_plate"):
         try:
             path = boundary_path(mesh, name)
         except Exception:          # a tag the mesh does not have: skip that side
             continue
-        path = path[::-1] if reverse else path
+        if loop and path[-1] == loop[-1]:      # each side continues from the corner the last ended at
+            path = path[::-1]
         loop.extend(path if not loop or path[0] != loop[-1] else path[1:])
     nodes = np.asarray(loop)
     p = pn[nodes] if pn is not None and pn.size == x.shape[1] else np.zeros(nodes.size)
