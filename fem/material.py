@@ -104,7 +104,8 @@ class NeoHookean:
         """The whole law (displacement formulation) as P = mu f + b g and
         A = mu 1 + a g (x) g + b H (module docstring): a = d2W/dJ2 = (mu + lambda (1 - ln J)) / J^2
         and b = dW/dJ = (lambda ln J - mu) / J."""
-        return (self.mu + self.lam * (1.0 - lnJ)) / J**2, (self.lam * lnJ - self.mu) / J
+        _, dU, d2U = self.volumetric(J, lnJ)
+        return self.mu / J**2 + d2U, -self.mu / J + dU
 
     def energy(self, f: np.ndarray, h: np.ndarray | None = None) -> np.ndarray:
         """W(F) per unit reference volume [J/m^3] (pointwise, all terms; h = f - 1 if known)."""
