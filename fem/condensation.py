@@ -117,11 +117,6 @@ class CondensedCholesky:
         inner = self._inner.band_factor(S, free[self._B])
         return CondensedFactor(self, K, free, shift, inner, inv, K_IB, W)
 
-    def solve(self, K: sp.csr_matrix, rhs: np.ndarray, free: np.ndarray, du_fixed: np.ndarray,
-              shift: float = 0.0) -> np.ndarray:
-        """As `BandedCholesky.solve`."""
-        return self.factor(K, free, shift).solve(rhs, du_fixed)
-
 
 class CondensedFactor:
     """A factored K_ff with the interior nodes condensed; `solve` for one or several right-hand sides."""

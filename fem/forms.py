@@ -32,25 +32,10 @@ import scipy.sparse as sp
 from skfem import BilinearForm, LinearForm, MeshQuad2
 
 from .kinematics import IDENTITY, Kinematics
-from .material import (NeoHookean, jacobian, jacobian_gradient, jacobian_hessian, jacobian_hessian_entries,
-                       jacobian_minus_one)
+from .material import (NeoHookean, jacobian, jacobian_gradient, jacobian_hessian, jacobian_minus_one,
+                       tangent_points_first)
 
 __all__ = ["Mechanics", "internal_force_form", "tangent_form", "energy_form"]
-
-
-def _tangent_at_points(f: np.ndarray, g: np.ndarray, c0: np.ndarray, a: np.ndarray,
-                       b: np.ndarray) -> np.ndarray:
-    """c0 1 + a g (x) g + b d2J/df2 at every point, [nel, nq, 5, 5] (the kernels' layout): the
-    neo-Hookean tangent (`NeoHookean.tangent_coefficients`) times dV, built in place."""
-    gp = np.moveaxis(g, 0, -1)                                        # [nel, nq, 5]
-    A = (a[..., None] * gp)[..., :, None] * gp[..., None, :]
-    diagonal = np.arange(5)
-    A[..., diagonal, diagonal] += c0[..., None]
-    for (i, j), v in jacobian_hessian_entries(f).items():
-        bv = b * v
-        A[..., i, j] += bv
-        A[..., j, i] += bv
-    return A
 
 
 # --------------------------------------------------------------------------------------------
@@ -202,7 +187,7 @@ class Mechanics:
             W = m.energy(f, h)
         else:
             theta, _ = self.pressure_and_dilatation(f, h)
-            W = m.isochoric(f, h)[0] + m.volumetric(theta, np.log1p(theta - 1.0))[0]
+            W = m.isochoric_energy(h) + m.volumetric(theta, np.log1p(theta - 1.0))[0]
         return float(np.sum(W * self.kin.dV))
 
     def stress(self, f: np.ndarray) -> np.ndarray:
@@ -253,8 +238,8 @@ class Mechanics:
             lnJ = np.log1p(jacobian_minus_one(h))
             W = m.isochoric_energy(h) + m.volumetric(J, lnJ)[0]
             a, b = m.tangent_coefficients(J, lnJ)
-            P = m.mu * f + b * g
-            AdV = _tangent_at_points(f, g, m.mu * dV, a * dV, b * dV)
+            P = m.stress_with(f, g, b)
+            AdV = tangent_points_first(f, g, m.mu * dV, a * dV, b * dV)
         else:
             theta, p = self.pressure_and_dilatation(f, h)
             W, P, A = m.isochoric(f, h)

@@ -34,7 +34,7 @@ import numpy as np
 from .kinematics import IDENTITY
 
 __all__ = ["NeoHookean", "jacobian", "jacobian_minus_one", "jacobian_gradient", "jacobian_hessian",
-           "cauchy_stress"]
+           "jacobian_hessian_entries", "tangent_points_first", "cauchy_stress"]
 
 Formulation = Literal["displacement", "mixed"]
 
@@ -87,9 +87,8 @@ class NeoHookean:
         h = _displacement_gradient(f) if h is None else h
         W = self.isochoric_energy(h)
         dW, d2W = -mu / J, mu / J**2
-        P = mu * f + dW * g
-        A = d2W * g[:, None] * g[None, :] + dW * jacobian_hessian(f)
-        A[np.arange(5), np.arange(5)] += mu
+        P = self.stress_with(f, g, dW)
+        A = np.moveaxis(tangent_points_first(f, g, mu, d2W, dW), (-2, -1), (0, 1))
         return W, P, A
 
     def isochoric_energy(self, h: np.ndarray) -> np.ndarray:
@@ -107,22 +106,40 @@ class NeoHookean:
         _, dU, d2U = self.volumetric(J, lnJ)
         return self.mu / J**2 + d2U, -self.mu / J + dU
 
+    def stress_with(self, f: np.ndarray, g: np.ndarray, dW_dJ: np.ndarray) -> np.ndarray:
+        """P = mu f + (dW/dJ) g with g = dJ/df: the stress of the whole law or of a part of it."""
+        return self.mu * f + dW_dJ * g
+
     def energy(self, f: np.ndarray, h: np.ndarray | None = None) -> np.ndarray:
         """W(F) per unit reference volume [J/m^3] (pointwise, all terms; h = f - 1 if known)."""
         h = _displacement_gradient(f) if h is None else h
-        return self.isochoric(f, h)[0] + self.volumetric(jacobian(f), np.log1p(jacobian_minus_one(h)))[0]
+        return self.isochoric_energy(h) + self.volumetric(jacobian(f), np.log1p(jacobian_minus_one(h)))[0]
 
     def stress(self, f: np.ndarray) -> np.ndarray:
         """First Piola-Kirchhoff stress P = dW/dF as a 5-vector [Pa] (pointwise, all terms)."""
-        _, P, _ = self.isochoric(f)
-        return P + self.volumetric(jacobian(f))[1] * jacobian_gradient(f)
+        J = jacobian(f)
+        return self.stress_with(f, jacobian_gradient(f), self.tangent_coefficients(J, np.log(J))[1])
 
     def tangent(self, f: np.ndarray) -> np.ndarray:
         """Material tangent A = d2W/dF2 as a 5x5 matrix [Pa] (pointwise, all terms)."""
-        _, _, A = self.isochoric(f)
-        J, g = jacobian(f), jacobian_gradient(f)
-        _, dU, d2U = self.volumetric(J)
-        return A + d2U * g[:, None] * g[None, :] + dU * jacobian_hessian(f)
+        J = jacobian(f)
+        a, b = self.tangent_coefficients(J, np.log(J))
+        return np.moveaxis(tangent_points_first(f, jacobian_gradient(f), self.mu, a, b), (-2, -1), (0, 1))
+
+
+def tangent_points_first(f: np.ndarray, g: np.ndarray, c0, a, b) -> np.ndarray:
+    """c0 1 + a g (x) g + b d2J/df2 at every point, [..., 5, 5] (points first, the element kernels'
+    layout): the form of every tangent of this law (module docstring), with c0 = mu for the whole
+    law or its isochoric part (times dV if the kernels want it)."""
+    gp = np.moveaxis(g, 0, -1)                                        # [..., 5]
+    A = (np.asarray(a)[..., None] * gp)[..., :, None] * gp[..., None, :]
+    diagonal = np.arange(5)
+    A[..., diagonal, diagonal] += np.asarray(c0)[..., None]
+    for (i, j), v in jacobian_hessian_entries(f).items():
+        bv = b * v
+        A[..., i, j] += bv
+        A[..., j, i] += bv
+    return A
 
 
 def _displacement_gradient(f: np.ndarray) -> np.ndarray:
