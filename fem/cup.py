@@ -39,7 +39,7 @@ Per converged step, `CupResponse` holds (all SI):
   (one loaded node: the rim corner alone); ``l_median_m``: the median-force width 2 (r_half - r_c)
   (`postprocess.median_force_width`, scatters by the jumps of r_c);
 * ``l_weighted_m``: the pressure-weighted width (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
-  (`contact_width`, the integrals over the Gauss-point projection), l (1 + l / 2 r_c) for a uniform
+  (the integrals over the Gauss-point projection), l (1 + l / 2 r_c) for a uniform
   strip; its int p^2 reacts to the singular rim-corner pressure, so it scatters 10-30 % between
   mesh levels (kept for comparison); ``l_half_max_m``: the width at half maximum of the lumped nodal
   pressure (`postprocess.half_maximum_width`);
@@ -56,7 +56,7 @@ Per converged step, `CupResponse` holds (all SI):
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Literal
 
@@ -72,7 +72,7 @@ from .kinematics import Kinematics
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["compress_cup", "CupResponse", "cup_height", "contact_width", "REQUIRED_BOUNDARIES"]
+__all__ = ["compress_cup", "CupResponse", "cup_height", "REQUIRED_BOUNDARIES"]
 
 
 
@@ -167,27 +167,51 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     def dirichlet(u):
         return top_dofs, np.concatenate([np.zeros(len(top)), np.full(len(top), -u)])
 
-    steps: list[dict[str, Any]] = []
+    steps: list[_StepOutputs] = []
 
     def on_step(s: StepResult) -> None:
         steps.append(_measure(s, mech, plane, top, path))
+        if progress and s.t > 0.0:
+            progress(s.t / u_max, f"step {len(steps) - 1}: u = {s.t * 1e3:.4g} mm of {u_max * 1e3:.4g} mm, "
+                                  f"{s.iterations} Newton iterations")
 
     stats = follow_path(mech, dirichlet, u_max, plane=plane, options=options, on_step=on_step,
-                        progress=progress, name="u [m]")
-    col = lambda k: np.array([st[k] for st in steps])       # noqa: E731
-    return CupResponse(
-        h1_m=h1, contact=contact, material=material, u_m=col("u"), F0_N=col("F0"),
-        F0_contact_N=col("Fc"), r_c_m=col("r_c"), V_m3=col("V"), l_m=col("l_q"),
-        l_median_m=col("l_med"), l_weighted_m=col("l_w"), l_half_max_m=col("l_hm"), penetration_m=col("pen"), energy_J=col("W"),
-        newton_iterations=col("its").astype(int), unstable=col("unstable").astype(bool),
-        min_stretch=col("stretch"), pressure=tuple(st["p"] for st in steps),
-        stats=stats,
-        mesh=mesh, displacements=tuple(st["u_vec"] for st in steps),
-        nodal_pressure_Pa=tuple(st["p_nodes"] for st in steps))
+                        name="u [m]")
+    per_step = {f.name: np.array([getattr(st, f.name) for st in steps])
+                for f in fields(_StepOutputs) if f.name not in _PER_STEP_OBJECTS}
+    return CupResponse(h1_m=h1, contact=contact, material=material, stats=stats, mesh=mesh,
+                       **per_step, **{name: tuple(getattr(st, name) for st in steps)
+                                      for name in _PER_STEP_OBJECTS})
+
+
+@dataclass(frozen=True, eq=False)
+class _StepOutputs:
+    """The outputs of one converged state (module docstring); fields named as in `CupResponse`."""
+
+    u_m: float
+    F0_N: float
+    F0_contact_N: float
+    r_c_m: float
+    V_m3: float
+    l_m: float
+    l_median_m: float
+    l_weighted_m: float
+    l_half_max_m: float
+    penetration_m: float
+    energy_J: float
+    newton_iterations: int
+    unstable: bool
+    min_stretch: float
+    pressure: PressureProfile
+    displacements: np.ndarray
+    nodal_pressure_Pa: np.ndarray
+
+
+_PER_STEP_OBJECTS = ("pressure", "displacements", "nodal_pressure_Pa")     # tuples, not arrays
 
 
 def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
-             path: np.ndarray) -> dict[str, Any]:
+             path: np.ndarray) -> _StepOutputs:
     """The per-step outputs of a converged state (module docstring)."""
     prof, p_nodes = plane.pressure(s.u, s.contact, s.r_int)
     active = plane.nodes[s.contact.active]
@@ -195,16 +219,18 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
     on_path = np.isin(path, active)
     on_path[-1] |= not on_path.any()          # u = 0: the rim corner rests on the plane
     r_c, l_q, l_hm, l_med = _edge_and_widths(prof, x[0, path[-1]])
-    return {"u": s.t, "F0": -float(np.sum(s.r_int[2 * top + 1])),
-            "Fc": float(np.sum(prof.p_gauss_Pa * prof.w_m2)), "r_c": r_c,
-            "V": enclosed_volume(x[0, path], x[1, path], on_path),
-            "l_q": l_q, "l_w": contact_width(prof, r_c), "l_hm": l_hm, "l_med": l_med,
-            "pen": plane.largest_penetration(s.u), "W": mech.energy(s.u), "its": s.iterations, "unstable": s.unstable,
-            "stretch": float(np.min(smallest_stretch(mech.kin.deformation_gradient(s.u)))),
-            "p": prof, "u_vec": s.u, "p_nodes": p_nodes}
+    return _StepOutputs(
+        u_m=s.t, F0_N=-float(np.sum(s.r_int[2 * top + 1])),
+        F0_contact_N=float(np.sum(prof.p_gauss_Pa * prof.w_m2)), r_c_m=r_c,
+        V_m3=enclosed_volume(x[0, path], x[1, path], on_path),
+        l_m=l_q, l_median_m=l_med, l_weighted_m=_weighted_width(prof, r_c), l_half_max_m=l_hm,
+        penetration_m=plane.largest_penetration(s.u), energy_J=mech.energy(s.u),
+        newton_iterations=s.iterations, unstable=s.unstable,
+        min_stretch=float(np.min(smallest_stretch(mech.kin.deformation_gradient(s.u)))),
+        pressure=prof, displacements=s.u, nodal_pressure_Pa=p_nodes)
 
 
-def contact_width(profile: PressureProfile, r_c_m: float) -> float:
+def _weighted_width(profile: PressureProfile, r_c_m: float) -> float:
     """Pressure-weighted strip width l = (int p dA)^2 / (2 pi r_c int p^2 dA) [m], dA = 2 pi r dr
     (the definition of `postprocess.pressure_weighted_width`), with the integrals taken over the
     consistent L2 projection at the boundary Gauss points (0 without contact)."""

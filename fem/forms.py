@@ -8,7 +8,7 @@ dV = 2 pi R dA. Its first and second variations are
 
 with dF[v] = d f / d u . v (see `fem.kinematics`). The readable scikit-fem forms
 `internal_force_form` and `tangent_form` are the reference; `Mechanics` evaluates the same
-integrals as einsum contractions of the precomputed B-operator (one call per assembly instead of
+integrals as batched matrix products of the precomputed B-operator (two per assembly instead of
 18 x 18 form calls per element), and the tests check that both agree.
 
 Mixed (nearly incompressible) formulation, ``material.formulation == "mixed"``: the volumetric

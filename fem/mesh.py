@@ -143,8 +143,11 @@ class MeshSpec:
 #: plane). Full cosine clustering was as accurate but made the medium level's sticking active set
 #: cycle at 0.67 h1. Measured (tests/test_fem_convergence.py, against Richardson extrapolations):
 #: frictionless, the coarse F0 within 0.8 % up to 0.85 h1 (1.7 % at 0.9 h1), the medium within
-#: 0.3 % (1.0 %); sticking, the coarse 1-3 % off, the medium within 0.8 %; the strip width
-#: (`postprocess.quartile_width`) of the medium level within 2 % from 0.7 h1 on.
+#: 0.3 % (1.0 %); sticking, the coarse 1-3 % off, the medium within 0.8 % up to the folding
+#: stretch (~0.83 h1, `CupResponse.folding_u_m`; beyond it the fine level follows a fold the
+#: coarser ones cannot); the frictionless strip width (`postprocess.quartile_width`) of the
+#: medium level within 2 % from 0.7 h1 on (the sticking strip converges at first order only:
+#: README, stiffness section).
 _GRADING = dict(along_grading=-0.5, plate_refinement=10.0, plate_width=0.02, rim_refinement=3.0,
                 rim_width=0.05, through_clustering=0.5, through_ratio=1.0)
 FIDELITIES: dict[str, MeshSpec] = {
@@ -153,8 +156,9 @@ FIDELITIES: dict[str, MeshSpec] = {
     "fine": MeshSpec(n_along=144, n_through=16, **_GRADING),
 }
 
-#: the level that keeps F0 within 1 % of the converged curve for both contact laws up to 0.9 h1
-#: (benchmarks/bench_mesh_levels.py); coarse is the sweep level (~2 %, four times cheaper)
+#: the level that keeps F0 within 1 % of the converged curve for both contact laws (up to 0.9 h1
+#: frictionless, up to the folding stretch ~0.83 h1 sticking; benchmarks/bench_mesh_levels.py);
+#: coarse is the sweep level (~2 %, four times cheaper)
 DEFAULT_FIDELITY = "medium"
 
 

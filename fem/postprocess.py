@@ -9,9 +9,10 @@ solver, each checked against closed forms in ``tests/test_fem_postprocess.py``.
 - `pressure_weighted_width`, `half_maximum_width`, `median_force_width` and `quartile_width`:
   four definitions of the contact-strip width l of eqs. (5)-(6), all exact for the paper's
   uniform strip. The median-force and the force-quartile widths rest on the cumulative line
-  force int p dr alone, over the innermost contact zone (`contact_zones`: the sealing strip next
-  to r_c, without a separate rim-corner contact); the quartile width also does without the
-  contact edge r_c, which jumps from node to node, and is the one that converges with the mesh.
+  force int p dr alone, over the innermost contact zone (the first of `contact_zones`: the
+  sealing strip next to r_c, without a separate rim-corner contact); the quartile width also does
+  without the contact edge r_c, which jumps from node to node, and is the one that converges with
+  the mesh (for frictionless contact; benchmarks/bench_mesh_levels.py).
   The other two react to a singular rim-corner pressure (benchmarks/bench_strip_width.py).
 
 Pressure profiles p(r) are sampled at increasing radii and taken piecewise-linear between the
@@ -116,8 +117,9 @@ def pressure_weighted_width(r_m: np.ndarray, p_Pa: np.ndarray, r_c_m: float | No
     pressure <p> = int p^2 dA / int p dA when F0 = int p dA. For a
     uniform pressure on r_c < r < r_c + l it is l (1 + l / (2 r_c)), i.e. l for a strip narrow
     compared with its radius; for a linear fall from the edge to zero over l (a triangle) it is
-    3 l / 4 in that limit. Insensitive to the exact position of the contact edge, so it converges
-    with the mesh. `r_c_m` defaults to `inner_contact_radius`.
+    3 l / 4 in that limit. Insensitive to the exact position of the contact edge, but int p^2
+    weights a singular pressure (a sharp rim corner) heavily, so it scatters 10-30 % between mesh
+    levels there (benchmarks/bench_strip_width.py). `r_c_m` defaults to `inner_contact_radius`.
     """
     r, p = _profile(r_m, p_Pa, increasing=True)
     if not np.any(p > 0):
