@@ -32,8 +32,9 @@ and the touchdown shift Delta u_td of each level is printed instead.
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_mesh_levels.py \\
         [--contact frictionless sticking] [--cache DIR] [--detail]
 
-The fine level dominates the cost (about 5 min per law on one core); --cache DIR keeps each
-level's sampled curves in DIR (an .npz per level and law) so that a second call only prints.
+The fine level dominates the cost (30-60 s per law on one core; --extra 288x16 about 2 min);
+--cache DIR keeps each level's sampled curves in DIR (an .npz per level and law) so that a second
+call only prints.
 """
 
 from __future__ import annotations

@@ -5,9 +5,9 @@ three fidelity levels (coarse, medium, fine: element counts doubled each time wi
 grading, so a constant refinement ratio of 2 and nested vertices) run from u = 0 to 0.9 h1 with
 load steps of at most 0.01 of the range and sampled at common u by PCHIP; where the three values
 do not converge monotonically the fine level is the reference. The fine level (19 074 DOFs) takes
-5-12 minutes per contact law on one core, too long for a test, so the extrapolated curves are
-stored below, as `benchmarks/bench_mesh_levels.py --detail` prints them (it reruns all three
-levels). The slow tests (``-m slow -s``, ~2-4 minutes) run the coarse and medium levels with the
+30-60 s per contact law on one core with these small steps, too long for the default suite, so
+the extrapolated curves are stored below, as `benchmarks/bench_mesh_levels.py --detail` prints
+them (it reruns all three levels). The slow tests (``-m slow -s``, about a minute) run the coarse and medium levels with the
 same load steps against that reference; the cheap default test compares coarse and medium up to
 0.6 h1.
 
@@ -30,8 +30,9 @@ U_STRIP = np.round(np.arange(0.30, 0.901, 0.05), 4)     # after the wall has tou
 MAX_STEP = 0.01                                         # load-step cap of the reference runs
 
 #: cup A, E = 4 MPa, nu = 0.49, max_step 0.01: F0 [N] at U_F0; r_c and force-quartile l_q [mm] at
-#: U_STRIP. Frictionless: Richardson extrapolation of the levels 36x4, 72x8, 144x16. Sticking: the
-#: fine level's path fails at 0.894 h1 (Newton, a snap at the steep end), so the reference is the
+#: U_STRIP. Frictionless: Richardson extrapolation of the levels 36x4, 72x8, 144x16. Sticking: when
+#: this reference was made the fine level's path failed at 0.894 h1 (it now reaches 0.9 h1, past
+#: the folding stretch, with F0 = 60.1 N, a fold the coarser levels cannot follow), so it is the
 #: Richardson extrapolation of an independent family, the former levels 32x3, 64x6, 128x12
 #: (`MeshSpec(32, 3, along_grading=-0.5)` and its refinements; 910-12 850 DOFs, uniform layers):
 #: where that family is not in the asymptotic range (u = 0.1, 0.2-0.3, 0.85-0.9 h1) its 128x12
