@@ -28,7 +28,7 @@ pointwise profile is the lumped projection p_a = lambda_a / sum_b M_ab, which is
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
@@ -57,7 +57,7 @@ class ContactState:
     """Which candidate nodes are held on the plane, and (sticking) their frozen radial displacement."""
 
     active: np.ndarray         # bool [ncand]
-    u_r_stick: np.ndarray      # float [ncand], meaningful where active
+    u_r_stick_m: np.ndarray      # float [ncand], meaningful where active
 
 
 @dataclass(frozen=True)
@@ -88,6 +88,8 @@ class RigidPlane:
     facets: np.ndarray            # candidate boundary facets (global facet indices)
     law: ContactLaw = "frictionless"
     exclude: np.ndarray | None = None   # nodes that are never candidates (e.g. clamped ones)
+    nodes: np.ndarray = field(init=False, repr=False)           # the candidate nodes
+    _facet_nodes: np.ndarray = field(init=False, repr=False)    # [3, nfacets]: vertices, midpoint
 
     def __post_init__(self) -> None:
         if self.law not in ("frictionless", "sticking"):
@@ -130,7 +132,7 @@ class RigidPlane:
         vals = [-self.kin.node_coordinates()[1, self.nodes[a]]]
         if self.law == "sticking":
             dofs.append(2 * self.nodes[a])
-            vals.append(state.u_r_stick[a])
+            vals.append(state.u_r_stick_m[a])
         return np.concatenate(dofs), np.concatenate(vals)
 
     def reactions(self, r_int: np.ndarray) -> np.ndarray:
@@ -151,7 +153,7 @@ class RigidPlane:
         out[2 * nodes[on_plane | land] + 1] = -Z[on_plane | land]
         if self.law == "sticking":
             held = on_plane & state.active
-            out[2 * nodes[held]] = state.u_r_stick[held]
+            out[2 * nodes[held]] = state.u_r_stick_m[held]
             if np.any(land):
                 g0 = self.gap(u_start)[land]
                 t = np.where(g0 > 0.0, g0 / np.maximum(g0 - g[land], 1e-300), 1.0)
@@ -169,7 +171,7 @@ class RigidPlane:
         friction can hold it) lands again where u puts it: it has slipped. If its free flight
         does not reach the plane, a node lands where u puts it."""
         new = active & ~state.active
-        stick = state.u_r_stick.copy()
+        stick = state.u_r_stick_m.copy()
         if self.law == "sticking" and np.any(new):
             nodes = self.nodes[new]
             g0, g1 = self.gap(u_start)[new], self.gap(u_free)[new]

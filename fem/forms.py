@@ -77,7 +77,7 @@ def tangent_form(material: NeoHookean) -> BilinearForm:
     return tangent
 
 
-def energy_form(material: NeoHookean):
+def energy_form(material: NeoHookean) -> "skfem.Functional":
     """Pi(u) = int W(F(u)) 2 pi R dA as a scikit-fem Functional."""
     from skfem import Functional
 
@@ -122,27 +122,28 @@ class Mechanics:
         return np.bincount(self.kin.dofs.T.ravel(), weights=re.ravel(), minlength=self.kin.ndofs)
 
     @property
-    def _BtT(self) -> np.ndarray:
-        """B^T as [nel, nq * 5, 18] (`Kinematics.B_stacked`)."""
+    def _B(self) -> np.ndarray:
+        """B, the linearized deformation gradient per dof, stacked over the points: [nel, nq * 5, 18]
+        (`Kinematics.B_stacked`)."""
         return self.kin.B_stacked
 
     @cached_property
-    def _Bt(self) -> np.ndarray:
-        """B as [nel, 18, nq * 5] (contiguous), the left factor of K_e."""
-        return np.ascontiguousarray(np.transpose(self._BtT, (0, 2, 1)))
+    def _BT(self) -> np.ndarray:
+        """B^T as [nel, 18, nq * 5] (contiguous), the left factor of K_e."""
+        return np.ascontiguousarray(np.transpose(self._B, (0, 2, 1)))
 
     def _element_forces(self, PdV: np.ndarray) -> np.ndarray:
         """r_e,i = sum_q B_iq . P_q dV_q for P dV [5, nel, nq]: [nel, 18]."""
         ne, nq = PdV.shape[1:]
-        return (np.transpose(PdV, (1, 2, 0)).reshape(ne, 1, nq * 5) @ self._BtT)[:, 0]
+        return (np.transpose(PdV, (1, 2, 0)).reshape(ne, 1, nq * 5) @ self._B)[:, 0]
 
     def _element_tangents(self, AdV: np.ndarray) -> np.ndarray:
         """K_e = sum_q B_q^T (A_q dV_q) B_q for A dV [nel, nq, 5, 5]: [nel, 18, 18], as two
         batched products (the 5 x 5 blocks with B^T per point, then B over all points)."""
         ne, nq = AdV.shape[:2]
-        nb = self._BtT.shape[2]
-        C = np.ascontiguousarray(AdV) @ self._BtT.reshape(ne, nq, 5, nb)
-        return self._Bt @ C.reshape(ne, nq * 5, nb)
+        nb = self._B.shape[2]
+        C = np.ascontiguousarray(AdV) @ self._B.reshape(ne, nq, 5, nb)
+        return self._BT @ C.reshape(ne, nq * 5, nb)
 
     # --- P1disc projection for the mixed formulation ---------------------------------------
     @cached_property
@@ -168,7 +169,8 @@ class Mechanics:
         return np.einsum("ea,aeq->eq", coef, q)
 
     # --- the three quantities -------------------------------------------------------------
-    def pressure_and_dilatation(self, f: np.ndarray, h: np.ndarray | None = None):
+    def pressure_and_dilatation(self, f: np.ndarray, h: np.ndarray | None = None
+                                ) -> tuple[np.ndarray, np.ndarray]:
         """For the mixed form: Theta = Pi_h J, p = Pi_h U'(Theta) at the points (h = f - 1 if known)."""
         # project J - 1 rather than J: the projection of the constant 1 carries round-off that
         # lambda would amplify into a spurious pressure (~1e-6 Pa at nu = 0.49)
@@ -252,7 +254,7 @@ class Mechanics:
             q, Minv = self._p1
             d2U = m.volumetric(theta, np.log1p(theta - 1.0))[2]
             ne, nq = dV.shape
-            dJ = np.einsum("keq,eqki->eqi", g * dV, self._BtT.reshape(ne, nq, 5, -1))  # dJ[v] dV
+            dJ = np.einsum("keq,eqki->eqi", g * dV, self._B.reshape(ne, nq, 5, -1))  # dJ[v] dV
             G = np.einsum("aeq,eqi->eai", q, dJ)                     # [nel, 3, 18]
             D = np.einsum("aeq,beq,eq->eab", q, q, d2U * dV)
             C = Minv @ D @ Minv

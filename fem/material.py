@@ -127,7 +127,8 @@ class NeoHookean:
         return np.moveaxis(tangent_points_first(f, jacobian_gradient(f), self.mu, a, b), (-2, -1), (0, 1))
 
 
-def tangent_points_first(f: np.ndarray, g: np.ndarray, c0, a, b) -> np.ndarray:
+def tangent_points_first(f: np.ndarray, g: np.ndarray, c0: float | np.ndarray, a: np.ndarray,
+                         b: np.ndarray) -> np.ndarray:
     """c0 1 + a g (x) g + b d2J/df2 at every point, [..., 5, 5] (points first, the element kernels'
     layout): the form of every tangent of this law (module docstring), with c0 = mu for the whole
     law or its isochoric part (times dV if the kernels want it)."""
