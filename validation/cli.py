@@ -1,8 +1,11 @@
 """`cupcheck` command line: one subcommand per module in `validation.commands`.
 
 Each command module defines ``NAME``, ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``.
-Bad input (a ``ValueError`` whose message names the field and its allowed range) prints one line
-and exits with status 2; a solver that fails (``RuntimeError``) prints where and why and exits 1.
+Every error is one line on stderr, ``cupcheck <command>: error: <what>``, with exit status 2 for
+bad input, whether argparse finds it (an unknown choice, a value that is not a number, a missing
+required option) or the command does (a ``ValueError`` whose message names the field and its
+allowed range); a solver that fails (``RuntimeError``) prints where and why and exits 1.
+``--help`` prints the full usage as usual.
 """
 
 from __future__ import annotations
@@ -11,13 +14,25 @@ import argparse
 import importlib
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 #: subcommand modules, in the order `cupcheck --help` lists them
 COMMANDS = ("example", "lifetime", "stiffness", "uc", "validate")
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An `argparse.ArgumentParser` whose errors are one line (no usage block) and exit 2.
+
+    `add_subparsers` makes the subcommands' parsers of the same class, so the line names the
+    subcommand: ``cupcheck stiffness: error: argument --cup: invalid choice: 'C' (choose from 'A', 'B')``.
+    """
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {_one_line(message)}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="cupcheck",
         description="Suction-cup cross-checks: axisymmetric FEM stiffness and the Tiwari-Persson "
                     "leakage model (Soft Matter 2019, arXiv:1906.01459). SI units inside; every "
@@ -33,19 +48,20 @@ def build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(module.NAME, help=module.HELP, description=module.__doc__,
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         module.add_arguments(p)
-        p.set_defaults(_run=module.run)
+        p.set_defaults(_run=module.run, _parser=p)
     return parser
 
 
-
-
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run one subcommand; return its exit status (argparse errors and --help raise SystemExit)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:                              # said by the subcommand, not by `cupcheck`
+        args._parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     try:
         return int(args._run(args) or 0)
     except ValueError as exc:
-        print(f"cupcheck {args.command}: error: {exc}", file=sys.stderr)
+        print(f"cupcheck {args.command}: error: {_one_line(str(exc))}", file=sys.stderr)
         return 2
     except RuntimeError as exc:
         print(f"cupcheck {args.command}: failed: {exc}", file=sys.stderr)
@@ -53,6 +69,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"cupcheck {args.command}: interrupted", file=sys.stderr)
         return 130
+
+
+def _one_line(message: str) -> str:
+    return " ".join(line.strip() for line in message.splitlines() if line.strip())
 
 
 if __name__ == "__main__":

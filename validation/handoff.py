@@ -3,9 +3,19 @@
 The CSV carries only the hand-off columns (``u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3``; l is the
 force-quartile width of the sealing strip, `fem.cup`), so that `cupcheck lifetime --stiffness`
 reads it as it reads a measured curve. Everything else a run knows goes to the sidecar
-``<out>.json``: the provenance, the solver statistics, and per step the plate reaction and the
-integrated contact force, the median-force, pressure-weighted and half-maximum strip widths, the
-largest penetration, the stored energy and the Newton iterations.
+``<out>.json`` (every key names its unit; lengths in mm like the CSV):
+
+* ``provenance``: geometry, material, contact, fidelity, mesh, the definition of l, versions;
+* ``h1_mm``; ``solver``: the path's `fem.solver.SolverStats` (steps, newton_iterations, cutbacks,
+  wall_time_s, dofs, unstable_steps, dissipated_J), ``largest_penetration_mm``,
+  ``largest_F0_mismatch_N`` (max |F0 - 2 pi int p r dr|) and ``folding_u_mm`` (or null);
+* ``steps``: per converged step ``u_mm``, ``F0_N``, ``F0_contact_N``, the median-force,
+  pressure-weighted and half-maximum strip widths ``l_median_mm``, ``l_weighted_mm``,
+  ``l_half_max_mm``, ``penetration_mm``, ``energy_J``, ``newton_iterations``, ``unstable`` (the
+  tangent lost definiteness in the step that ended there), ``min_stretch``, and the contact
+  pressure profile p(r) as the lumped nodal pressures of the contact nodes sorted by deformed
+  radius (`fem.contact.PressureProfile.r_m`, ``p_Pa``): ``pressure_r_mm[i]`` and
+  ``pressure_kPa[i]``, one list per step (empty where nothing touches).
 """
 
 from __future__ import annotations
@@ -78,7 +88,7 @@ def stiffness_curve(response: CurveArrays, provenance: Mapping[str, Any]) -> Sti
 def sidecar(response: CupResponse, provenance: Mapping[str, Any]) -> dict[str, Any]:
     """The JSON sidecar: provenance, solver statistics and the per-step extras (units in keys)."""
     stats = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in asdict(response.stats).items()}
-    stats["largest_penetration_m"] = float(np.max(np.abs(response.penetration_m), initial=0.0))
+    stats["largest_penetration_mm"] = float(np.max(np.abs(response.penetration_m), initial=0.0)) * 1e3
     stats["largest_F0_mismatch_N"] = float(np.max(np.abs(response.F0_N - response.F0_contact_N),
                                                   initial=0.0))
     folding = response.folding_u_m
@@ -93,10 +103,14 @@ def sidecar(response: CupResponse, provenance: Mapping[str, Any]) -> dict[str, A
         "penetration_mm": response.penetration_m * 1e3,
         "energy_J": response.energy_J,
         "newton_iterations": response.newton_iterations,
+        "unstable": response.unstable,
         "min_stretch": response.min_stretch,
     }
+    steps = {k: np.asarray(v).tolist() for k, v in steps.items()}
+    steps["pressure_r_mm"] = [(p.r_m * 1e3).tolist() for p in response.pressure]
+    steps["pressure_kPa"] = [(p.p_Pa * 1e-3).tolist() for p in response.pressure]
     return {"provenance": dict(provenance), "h1_mm": response.h1_m * 1e3, "solver": stats,
-            "steps": {k: np.asarray(v).tolist() for k, v in steps.items()}}
+            "steps": steps}
 
 
 def write_sidecar(data: Mapping[str, Any], path: str | Path) -> Path:

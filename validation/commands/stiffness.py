@@ -4,7 +4,12 @@ The cup's top plate is pressed onto the rigid plane z = 0 (displacement control,
 --u-max-mm, default 0.9 h1); the wall is a compressible neo-Hookean solid, in frictionless or
 sticking contact with the plane. Writes the hand-off CSV (u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3; l is
 the force-quartile width of the sealing strip) and a JSON sidecar next to it (same name, .json) with the
-provenance, the solver statistics and per-step extras. Both appear together or not at all.
+provenance, the solver statistics and per step the contact-pressure profile p(r), the instability
+flags and the other widths (lengths in mm). All files appear together or not at all.
+
+Every input is checked before the solve: a bad value, an output path that cannot be written, or
+--nu above 0.495 with the displacement formulation (which locks there: use --formulation mixed)
+stops with one line and exit status 2; a solve that fails exits 1. Neither leaves a file behind.
 
 examples:
   cupcheck stiffness --cup A --contact sticking --out out/cupA_sticking.csv
@@ -16,13 +21,22 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import os
+import re
 import sys
+from collections.abc import Callable
 from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
 NAME = "stiffness"
 HELP = "FEM stiffness curve F0(h), r_c, l, V of cup A, B or your own design (CSV + JSON sidecar)"
+
+#: above this Poisson's ratio the displacement (Q2) formulation locks: refused without --formulation mixed
+LOCKING_NU = 0.495
+#: --fields-out suffixes (any case): .vtu, .vtk hold the last step, .xdmf every step; meshio's
+#: other formats drop the 9-node cells or the fields
+FIELD_SUFFIXES = (".vtu", ".vtk", ".xdmf")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -46,7 +60,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="Young's modulus E [MPa] (default 4)")
     m.add_argument("--nu", type=float, default=0.49, help="Poisson's ratio [-] (default 0.49)")
     m.add_argument("--formulation", choices=("displacement", "mixed"), default="displacement",
-                   help="displacement (default) or mixed u-p (nearly incompressible, nu up to 0.4999)")
+                   help="displacement (default; nu <= 0.495, it locks above) or mixed u-p (nearly "
+                        "incompressible, nu up to 0.4999)")
     m.add_argument("--contact", choices=("frictionless", "sticking"), default="frictionless",
                    help="contact with the plane: frictionless, or sticking (a touching point stops "
                         "sliding) (default frictionless)")
@@ -58,9 +73,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="largest plate displacement u [mm], in (0, h1] (default 0.9 h1; at h1 the plate edge reaches the plane)")
     r.add_argument("--fields-out", type=Path, metavar="FILE",
                    help="also write the fields (displacement, Cauchy stress, contact pressure): "
-                        "the last step as .vtu, or every step as an .xdmf time series over u")
+                        "the last step as .vtu (or .vtk), or every step as an .xdmf time series "
+                        "over u [m]; a missing directory is created")
     r.add_argument("--out", type=Path, required=True, metavar="CSV",
-                   help="the stiffness curve (.csv); the sidecar goes to the same name with .json")
+                   help="the stiffness curve (.csv); the sidecar goes to the same name with .json "
+                        "(a missing directory is created)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -69,8 +86,8 @@ def run(args: argparse.Namespace) -> int:
     from validation import handoff
     from validation.output import atomic_file, terminal_progress
 
-    response = compress_cup(job["mesh"], job["material"], contact=args.contact,
-                            u_max_m=job["u_max_m"], progress=terminal_progress("stiffness"))
+    response = compress_cup(job["mesh"], job["material"], contact=args.contact, u_max_m=job["u_max_m"],
+                            progress=progress_in_mm(terminal_progress("stiffness")))
     prov = handoff.provenance(response, geometry=job["geometry"], mesh=job["mesh_info"],
                               fidelity=job["fidelity"])
     curve = handoff.stiffness_curve(response, prov)
@@ -79,7 +96,8 @@ def run(args: argparse.Namespace) -> int:
         handoff.write_sidecar(handoff.sidecar(response, prov), tmp_json)
         if args.fields_out is not None:
             with atomic_file(args.fields_out) as tmp_fields:
-                response.write_fields(tmp_fields, step=None if tmp_fields.suffix == ".xdmf" else -1)
+                every_step = tmp_fields.suffix.lower() == ".xdmf"
+                response.write_fields(tmp_fields, step=None if every_step else -1)
     s = response.stats
     print(f"cupcheck stiffness: wrote {args.out} and {job['sidecar'].name}: {s.steps} steps, "
           f"{s.newton_iterations} Newton iterations, {s.dofs} dofs, {s.wall_time_s:.1f} s; "
@@ -100,14 +118,21 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
 
     out = Path(args.out)
     if out.suffix.lower() != ".csv":
-        raise ValueError(f"out: the stiffness curve must be a .csv file, got '{out}'")
-    if out.is_dir():
-        raise ValueError(f"out: '{out}' is a directory; give a .csv file name")
-    if args.fields_out is not None and Path(args.fields_out).suffix not in (".vtu", ".xdmf"):
-        raise ValueError(f"fields_out: must end in .vtu (last step) or .xdmf (every step), "
-                         f"got '{args.fields_out}'")
+        raise ValueError(f"out: the stiffness curve must be a .csv file (any case), got '{out}'")
+    _writable(out, "out")
+    _writable(out.with_suffix(".json"), "out", "its sidecar")
+    if args.fields_out is not None:
+        fields = Path(args.fields_out)
+        if fields.suffix.lower() not in FIELD_SUFFIXES:
+            raise ValueError(f"fields_out: must end in .vtu or .vtk (the last step) or .xdmf (every "
+                             f"step), in any case, got '{fields}'")
+        _writable(fields, "fields_out")
     material = NeoHookean(E_Pa=_positive(args.E_MPa, "E_MPa", "Young's modulus") * 1e6,
                           nu=args.nu, formulation=args.formulation)
+    if material.formulation == "displacement" and material.nu > LOCKING_NU:
+        raise ValueError(f"nu: with the displacement formulation Poisson's ratio must be <= "
+                         f"{LOCKING_NU} (above, its elements lock and stiffen F0); use "
+                         f"--formulation mixed for nu up to 0.4999, got {args.nu:g}")
     fidelity = args.fidelity or DEFAULT_FIDELITY
     if args.mesh is not None:
         given = [o for o, v in (("--geometry", args.geometry), ("--fidelity", args.fidelity),
@@ -140,6 +165,32 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         u_max = min(u_max, h1)
     return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
             "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json")}
+
+
+def _writable(path: Path, name: str, what: str = "") -> None:
+    """Refuse, before the solve, an output path that is a directory or whose directory can be
+    neither found nor created (the writers create missing parent directories)."""
+    label = f"{what} '{path}'" if what else f"'{path}'"
+    if path.is_dir():
+        raise ValueError(f"{name}: {label} is a directory; give a file name")
+    ancestor = path.parent
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    if not ancestor.is_dir():
+        raise ValueError(f"{name}: cannot create the directory of {label}: '{ancestor}' is a file")
+    if not os.access(ancestor, os.W_OK | os.X_OK):
+        raise ValueError(f"{name}: cannot write {label}: no write permission in '{ancestor}'")
+
+
+_METRES = re.compile(r"\[m\] = ([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
+
+
+def progress_in_mm(progress: Callable[[float, str], None]) -> Callable[[float, str], None]:
+    """`progress` with lengths in mm, like the options: a "u [m] = 0.0007421" in a message
+    becomes "u [mm] = 0.7421"; any other message passes unchanged."""
+    def report(fraction: float, message: str) -> None:
+        progress(fraction, _METRES.sub(lambda m: f"[mm] = {1e3 * float(m.group(1)):.4g}", message))
+    return report
 
 
 def _positive(value: float, name: str, what: str) -> float:
