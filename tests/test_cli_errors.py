@@ -8,7 +8,6 @@ import pytest
 
 import fem.cup
 from validation.cli import main
-from validation.commands.stiffness import progress_in_mm
 
 
 def _files(directory: Path) -> list[str]:
@@ -127,17 +126,3 @@ def test_failure_while_writing_leaves_none_of_the_files(tmp_path, monkeypatch, c
                  "--out", str(tmp_path / "curve.csv"), "--fields-out", str(tmp_path / "f.vtu")]) == 1
     assert capsys.readouterr().err.splitlines()[-1] == "cupcheck stiffness: failed: fields: disk full"
     assert _files(tmp_path) == []
-
-
-# --- progress in the CLI's unit ---------------------------------------------------------------------
-
-def test_progress_speaks_mm_whatever_the_library_says():
-    seen = []
-    report = progress_in_mm(lambda fraction, message: seen.append((fraction, message)))
-    report(0.25, "step 3: u [m] = 0.0007421, 4 Newton iterations")
-    report(0.5, "step 4: u [m] = 1.5e-03, 5 Newton iterations")
-    report(0.75, "step 5: u [mm] = 2.25, 3 Newton iterations")       # already mm: unchanged
-    report(1.0, "done")
-    assert seen == [(0.25, "step 3: u [mm] = 0.7421, 4 Newton iterations"),
-                    (0.5, "step 4: u [mm] = 1.5, 5 Newton iterations"),
-                    (0.75, "step 5: u [mm] = 2.25, 3 Newton iterations"), (1.0, "done")]

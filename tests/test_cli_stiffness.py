@@ -46,7 +46,7 @@ def test_writes_a_curve_the_reduced_model_reads_and_its_sidecar(tmp_path, capsys
     assert curve.V_m3[0] == pytest.approx(np.pi / 3 * curve.h1_m * (25 + 95 + 361) * 1e-6, rel=1e-9)
     out_err = capsys.readouterr()
     assert "F0 =" in out_err.out
-    assert "u [mm] = " in out_err.err and "[m]" not in out_err.err      # progress in the CLI's unit
+    assert " mm of " in out_err.err and "[m]" not in out_err.err      # progress in the CLI's unit
     n = len(curve.u_m)
     assert len(steps["unstable"]) == n and all(isinstance(f, bool) for f in steps["unstable"])
     assert side["solver"]["largest_penetration_mm"] == pytest.approx(max(map(abs, steps["penetration_mm"])))

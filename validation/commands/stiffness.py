@@ -22,9 +22,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import os
-import re
 import sys
-from collections.abc import Callable
 from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
@@ -87,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import atomic_file, terminal_progress
 
     response = compress_cup(job["mesh"], job["material"], contact=args.contact, u_max_m=job["u_max_m"],
-                            progress=progress_in_mm(terminal_progress("stiffness")))
+                            progress=terminal_progress("stiffness"))
     prov = handoff.provenance(response, geometry=job["geometry"], mesh=job["mesh_info"],
                               fidelity=job["fidelity"])
     curve = handoff.stiffness_curve(response, prov)
@@ -180,17 +178,6 @@ def _writable(path: Path, name: str, what: str = "") -> None:
         raise ValueError(f"{name}: cannot create the directory of {label}: '{ancestor}' is a file")
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise ValueError(f"{name}: cannot write {label}: no write permission in '{ancestor}'")
-
-
-_METRES = re.compile(r"\[m\] = ([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
-
-
-def progress_in_mm(progress: Callable[[float, str], None]) -> Callable[[float, str], None]:
-    """`progress` with lengths in mm, like the options: a "u [m] = 0.0007421" in a message
-    becomes "u [mm] = 0.7421"; any other message passes unchanged."""
-    def report(fraction: float, message: str) -> None:
-        progress(fraction, _METRES.sub(lambda m: f"[mm] = {1e3 * float(m.group(1)):.4g}", message))
-    return report
 
 
 def _positive(value: float, name: str, what: str) -> float:
