@@ -86,7 +86,7 @@ def lame_errors(formulation: str, nu: float, n_r: int) -> tuple[float, float, fl
                 for R in (A, B))
     f = kin.deformation_gradient(u)
     sigma = cauchy_stress(f, mech.stress(f))
-    r = kin.R + kin.basis.interpolate(u).value[0]           # deformed radius of each point
+    r = kin.R + np.asarray(kin.basis.interpolate(u))[0]           # deformed radius of each point
     exact = lame_stress(r, p, nu)
     err = sigma - exact
     tensor = np.array([1.0, 1.0, 1.0, 2.0])[:, None, None]  # |s|^2 with s_rz counted twice
