@@ -5,7 +5,9 @@ solver, each checked against closed forms in ``tests/test_fem_postprocess.py``.
 
 - `enclosed_volume`: the cavity volume V of eq. (4), by the divergence theorem on the deformed
   cavity-facing polyline.
-- `inner_contact_radius`: r_c, the inner edge of the contact (cf. eq. 3).
+- `inner_contact_radius`: r_c, the inner edge of the contact (cf. eq. 3); `outer_contact_radius`:
+  the outer edge of a contact whose pressure falls to zero outwards (a square-root edge fitted
+  through the samples near it; the verification against Hertz).
 - `pressure_weighted_width`, `half_maximum_width`, `median_force_width` and `quartile_width`:
   four definitions of the contact-strip width l of eqs. (5)-(6), all exact for the paper's
   uniform strip. The median-force and the force-quartile widths rest on the cumulative line
