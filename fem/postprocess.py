@@ -5,7 +5,9 @@ solver, each checked against closed forms in ``tests/test_fem_postprocess.py``.
 
 - `enclosed_volume`: the cavity volume V of eq. (4), by the divergence theorem on the deformed
   cavity-facing polyline.
-- `inner_contact_radius`: r_c, the inner edge of the contact (cf. eq. 3).
+- `inner_contact_radius`: r_c, the inner edge of the contact (cf. eq. 3); `outer_contact_radius`:
+  the outer edge of a contact whose pressure falls to zero outwards (a square-root edge fitted
+  through the samples near it; the verification against Hertz).
 - `pressure_weighted_width`, `half_maximum_width`, `median_force_width` and `quartile_width`:
   four definitions of the contact-strip width l of eqs. (5)-(6), all exact for the paper's
   uniform strip. The median-force and the force-quartile widths rest on the cumulative line
@@ -26,9 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["enclosed_volume", "inner_contact_radius", "pressure_weighted_width", "weighted_width",
-           "half_maximum_width", "median_force_width", "quartile_width", "contact_zones", "contact_force",
-           "Richardson", "richardson", "smallest_stretch", "BIOT_STRETCH", "CREASE_STRETCH"]
+__all__ = ["enclosed_volume", "inner_contact_radius", "outer_contact_radius", "pressure_weighted_width",
+           "weighted_width", "half_maximum_width", "median_force_width", "quartile_width",
+           "contact_zones", "contact_force", "Richardson", "richardson", "smallest_stretch",
+           "BIOT_STRETCH", "CREASE_STRETCH"]
 
 #: the smallest principal stretch at which a compressed neo-Hookean surface stays smooth: Biot's
 #: wrinkling bifurcation of an incompressible half-space in plane strain (M. A. Biot, Appl. Sci.
@@ -102,6 +105,34 @@ def inner_contact_radius(r_m: np.ndarray, p_Pa: np.ndarray, threshold_Pa: float 
     q0, q1 = p[k] ** 2, p[k + 1] ** 2
     edge = r[k] - (r[k + 1] - r[k]) * q0 / (q1 - q0)
     return float(np.clip(edge, r[k - 1], r[k]))
+
+
+def outer_contact_radius(r_m: np.ndarray, p_Pa: np.ndarray, band_m: float) -> float:
+    """Outer edge a [m] of a contact whose pressure falls to zero outwards (Hertz's, say), from
+    nodal pressures at increasing radii, without assuming the shape of the profile inside.
+
+    Near a smooth contact edge the pressure is a square root, p^2 = (a - r) g(r) with g smooth,
+    so p^2 is a quadratic in r up to O((a - r)^3). The quadratic is fitted (least squares) to p^2
+    of the loaded samples (p > 0) within `band_m` of the outermost one, and a is its root
+    nearest that sample. The fit averages the sample-to-sample scatter of a lumped nodal
+    pressure, so a is resolved to a fraction of the sample spacing; for Hertz's profile p^2 is
+    exactly quadratic in r and the fit has no model error. Needs >= 4 samples in the band.
+    """
+    r, p = _profile(r_m, p_Pa, increasing=True)
+    loaded = np.flatnonzero(p > 0)
+    if loaded.size == 0:
+        raise ValueError("p_Pa: no positive contact pressure, the contact edge is undefined")
+    edge = r[loaded[-1]]
+    band = loaded[r[loaded] >= edge - band_m]
+    if band.size < 4:
+        raise ValueError(f"band_m: {band_m:.3g} m holds {band.size} loaded samples, the fit needs "
+                         ">= 4 (widen the band)")
+    x, y = r[band] / edge - 1.0, (p[band] / p[band].max()) ** 2     # scaled: a well-posed fit
+    roots = np.roots(np.polyfit(x, y, 2))
+    real = roots[np.abs(roots.imag) <= 1e-12 * np.abs(roots).max()].real
+    if real.size == 0:
+        raise ValueError("p_Pa: the pressure does not fall to zero at the edge (no real root)")
+    return float(edge * (1.0 + real[np.argmin(np.abs(real))]))
 
 
 def contact_force(r_m: np.ndarray, p_Pa: np.ndarray) -> float:

@@ -1,6 +1,16 @@
 """The cup job: conservation and consistency laws, contact enforcement, locking, bad input.
 
-All on the coarse cup A mesh of `fem.mesh` (36 x 4 Q2 elements), E = 4 MPa, nu = 0.49."""
+All on the coarse cup A mesh of `fem.mesh` (36 x 4 Q2 elements), E = 4 MPa, nu = 0.49. The
+frictionless and sticking paths are module fixtures, each run once here (the frictionless one
+with load steps of 0.01 u_max, for the energy quadrature and the finite differences).
+
+Which checks are independent of what: F0 against dW/du (central differences of the stored
+energy) and int F0 du against W compare the plate reaction with the energy functional, which the
+solver never differentiates numerically; the triangle mesh is a second discretization. F0
+against 2 pi int p r dr is global equilibrium of the converged state, the z-sum of the free
+residual: it is bounded by the Newton tolerance and checks the bookkeeping of reactions and
+pressure, not the physics.
+"""
 
 import meshio
 import numpy as np
@@ -45,10 +55,40 @@ def test_energy_balance_frictionless(frictionless):
     assert np.all(np.diff(r.energy_J) > 0)
 
 
+def test_plate_reaction_is_the_derivative_of_the_stored_energy(frictionless):
+    """Frictionless contact is workless, so along the equilibrium path F0(u) = dW/du, with W the
+    stored energy (`Mechanics.energy`, the integral of the strain-energy density; F0 is the
+    internal force summed over the plate). Where the contact set stays the same over the stencil
+    u - 2h .. u + 2h (h = 0.01 u_max, uniform; only the rim corner touches for u < 0.19 h1) W(u)
+    is smooth and the central differences D_h = (W(u+h) - W(u-h)) / 2h and D_2h differ from
+    F0 by the truncation error -h^2 F0''/6 and four times that: measured ratio 4.00. Their
+    Richardson value (4 D_h - D_2h) / 3 leaves O(h^4) and the Newton tolerance (1e-6 of the
+    reaction in F0): measured <= 1.9e-6 relative, checked at 1e-5. Where nodes land F0(u) has
+    kinks and the differences are O(h) off (1e-3): those stencils are left out."""
+    r = frictionless
+    u, W, F = r.u_m, r.energy_J, r.F0_N
+    touching = [frozenset(np.flatnonzero(p > 0)) for p in r.nodal_pressure_Pa]
+    h = np.diff(u)
+    checked = 0
+    for i in range(2, len(u) - 2):
+        uniform = np.allclose(h[i - 2:i + 2], h[i], rtol=1e-9, atol=0)
+        if not uniform or len(set(touching[i - 2:i + 3])) > 1 or r.unstable[i - 1:i + 3].any():
+            continue
+        d1 = (W[i + 1] - W[i - 1]) / (2 * h[i])
+        d2 = (W[i + 2] - W[i - 2]) / (4 * h[i])
+        assert (d2 - F[i]) / (d1 - F[i]) == pytest.approx(4.0, abs=0.1)    # O(h^2) truncation
+        assert (4 * d1 - d2) / 3 == pytest.approx(F[i], rel=1e-5)
+        checked += 1
+    assert checked >= 10
+
+
 @pytest.mark.parametrize("law", ["frictionless", "sticking"])
 def test_plate_reaction_equals_contact_force(law, frictionless, sticking):
     """Global equilibrium: F0 (top-plate reaction) = 2 pi int p r dr of the projected pressure
-    within 0.1 % (spec); only the Newton residual (rtol 1e-6 of the reactions) separates them."""
+    within 0.1 % (spec). Not an independent check: the consistent projection integrates to
+    sum lambda exactly, so F0 - F0_contact is the z-sum of the residual at the free dofs, which
+    the Newton tolerance (1e-6 of the reactions) bounds (measured ~1e-7). It catches a reaction
+    or a pressure that is booked wrongly; the physics is checked against dW/du above."""
     r = frictionless if law == "frictionless" else sticking
     assert np.all(r.F0_N[1:] > 0)
     assert np.allclose(r.F0_contact_N, r.F0_N, rtol=1e-3, atol=0)
@@ -67,16 +107,53 @@ def test_contact_geometry_and_penetration(law, frictionless, sticking):
     assert np.all(r.l_m >= 0) and r.l_m[-1] > 0 and r.l_half_max_m[-1] > 0
 
 
+def _lumped_weights(mesh, x: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """int N_a 2 pi r ds over the deformed boundary facets touching `nodes` (x: deformed node
+    positions [2, nnodes]), for every mesh node: 6-point Gauss on each quadratic facet, written
+    here rather than taken from `fem.contact` (4 points there)."""
+    nv = int(mesh.t.max()) + 1
+    f = mesh.boundary_facets()
+    fn = np.vstack([mesh.facets[:, f], nv + f])                 # vertex, vertex, midpoint
+    fn = fn[:, np.any(np.isin(fn, nodes), axis=0)]
+    s, w = np.polynomial.legendre.leggauss(6)
+    s, w = 0.5 * (s + 1), 0.5 * w
+    N = np.stack([(1 - s) * (1 - 2 * s), s * (2 * s - 1), 4 * s * (1 - s)])
+    dN = np.stack([4 * s - 3, 4 * s - 1, 4 - 8 * s])
+    xe = x[:, fn]                                               # [2, 3, nf]
+    r_g = np.einsum("ag,an->gn", N, xe[0])
+    ds = np.hypot(np.einsum("ag,an->gn", dN, xe[0]), np.einsum("ag,an->gn", dN, xe[1]))
+    m = np.zeros(x.shape[1])
+    np.add.at(m, fn, np.einsum("ag,gn,g->an", N, 2 * np.pi * r_g * ds, w))
+    return m
+
+
 @pytest.mark.parametrize("law", ["frictionless", "sticking"])
-def test_pressure_profile(law, frictionless, sticking):
+def test_pressure_profile(law, frictionless, sticking, mesh):
     """The lumped nodal pressure is >= 0 (Signorini at the active nodes) and 0 at the free
-    neighbours; its lumped integral sum p_a int N_a dA is the contact force, like the Gauss
-    integral of the consistent projection (both equal sum lambda, to round-off)."""
+    neighbours. Two routes to the contact force at several steps: the lumped integral
+    sum_a p_a int N_a dA of the profile's p_a (the boundary mass row sums recomputed here on the
+    deformed facets) and sum_a lambda_a, the internal force at the contact nodes recomputed from
+    the displacement. Since p_a = lambda_a / int N_a dA they differ by the quadrature of the
+    weights only: on a facet that lifts off (sticking) |dx/ds| is a square root, not a polynomial,
+    and the 4-point rule of `fem.contact` is off by up to 1.1e-8 of the force along the path
+    (6- and 10-point rules agree to 3e-13; frictionless, flat facets: 7e-13), so 1e-7. This
+    checks the profile's bookkeeping (which node, which weight), not the physics."""
+    from fem.forms import Mechanics
+    from fem.kinematics import Kinematics
     r = frictionless if law == "frictionless" else sticking
     for prof in r.pressure[1:]:
         assert np.all(prof.p_Pa >= 0) and prof.p_Pa.min() == 0.0
+    mech = Mechanics(Kinematics.of(mesh), r.material)
+    for k in (len(r.u_m) // 4, len(r.u_m) // 2, len(r.u_m) - 1):
+        p_nodes, u = r.nodal_pressure_Pa[k], r.displacements[k]
+        loaded = np.flatnonzero(p_nodes > 0)
+        profile = r.pressure[k].p_Pa
+        assert np.array_equal(np.sort(p_nodes[loaded]), np.sort(profile[profile > 0]))
+        x = mesh.doflocs + np.stack([u[0::2], u[1::2]])
+        lumped = np.sum(p_nodes[loaded] * _lumped_weights(mesh, x, loaded)[loaded])
+        lam = mech.internal_force(u)[2 * loaded + 1]
+        assert lumped == pytest.approx(np.sum(lam), rel=1e-7)
     prof = r.pressure[-1]
-    assert np.sum(prof.p_gauss_Pa * prof.w_m2) == pytest.approx(r.F0_contact_N[-1], rel=1e-12)
     assert r.r_c_m[-1] >= prof.r_m[0] and r.r_c_m[-1] <= prof.r_m[np.argmax(prof.p_Pa > 0)]
 
 
@@ -100,16 +177,6 @@ def test_sticking_nodes_do_not_slide(sticking, mesh):
     loading = 1 + int(np.argmax(np.diff(p) <= 0))        # steps 0 .. loading-1: p rises
     assert loading >= 4 and p[loading - 1] > 1e5         # a real loading phase (~0.1 h1)
     assert np.all(u_r[:loading] == 0.0)
-
-
-def test_results_do_not_depend_on_the_path_parameters(mesh):
-    """No enforcement parameter: the contact conditions hold exactly at the nodes. The parameter
-    that remains (the load-step size) changes the path, not the result: the final F0 agrees to
-    the Newton tolerance (1e-6)."""
-    runs = [compress_cup(mesh, NeoHookean(), "frictionless", u_max_m=0.5 * H1, **opts)
-            for opts in ({}, {"max_step": 0.02})]
-    assert runs[0].F0_N[-1] == pytest.approx(runs[1].F0_N[-1], rel=1e-6)
-    assert runs[0].r_c_m[-1] == pytest.approx(runs[1].r_c_m[-1], rel=1e-6)
 
 
 def _F0(mesh, nu, formulation, u):
@@ -167,13 +234,16 @@ def test_a_step_that_cannot_converge_is_reported(mesh):
                      initial_step=1.0, max_step=1.0)
 
 
-def test_triangle_mesh_agrees_with_quadrilaterals(mesh):
-    """A second discretization of the same cup (6-node triangles, two per quad): F0 at u = h1/2
-    agrees with the Q2 result within 3 %, the coarse level's discretization error (benchmark);
-    measured 0.15 %."""
+def test_triangle_mesh_agrees_with_quadrilaterals(frictionless):
+    """A second discretization of the same cup (6-node triangles, two per quad): F0 at u ~ h1/2
+    (a step of the frictionless fixture; the frictionless state does not depend on the path)
+    agrees with the Q2 result within 0.3 %: measured +0.07 % here and at most 0.11 % at u = 0.2,
+    0.3, 0.5, 0.7, 0.85 h1, so a margin of ~3 (the coarse level's own discretization error is
+    ~1 %, benchmarks/bench_mesh_levels.py: the two element families share most of it)."""
+    k = int(np.argmin(np.abs(frictionless.u_m - 0.5 * H1)))
     tri = cup_mesh(GEOMETRY, "coarse", element="tri")
-    F = [compress_cup(m, NeoHookean(), u_max_m=0.5 * H1, max_step=0.1).F0_N[-1] for m in (mesh, tri)]
-    assert F[1] == pytest.approx(F[0], rel=0.03)
+    F_tri = compress_cup(tri, NeoHookean(), u_max_m=frictionless.u_m[k], max_step=0.1).F0_N[-1]
+    assert F_tri == pytest.approx(frictionless.F0_N[k], rel=3e-3)
 
 
 def test_the_whole_path_is_written_as_an_xdmf_time_series(frictionless, tmp_path):

@@ -309,3 +309,37 @@ def test_smallest_stretch_of_closed_form_states():
     np.testing.assert_allclose(smallest_stretch(f), expected, rtol=1e-14)
     # small strain: no cancellation (1 - 1e-9 resolved)
     assert smallest_stretch(np.array([1.0, 0.0, 0.0, 1.0 - 1e-9, 1.0]))[()] == pytest.approx(1 - 1e-9, rel=1e-15)
+
+
+# ------------------------------------------------------------ outer contact edge
+def test_outer_edge_of_a_hertz_profile_is_exact():
+    """Hertz's p^2 = p0^2 (1 - r^2/a^2) is a quadratic in r: the fit recovers a to round-off,
+    with the edge between samples and free samples (p = 0) beyond it."""
+    from fem.postprocess import outer_contact_radius
+    a = 0.1137 * MM
+    r = np.linspace(0, 0.2, 41) * MM
+    p = 3e7 * np.sqrt(np.clip(1 - (r / a) ** 2, 0, None))
+    assert outer_contact_radius(r, p, band_m=0.3 * a) == pytest.approx(a, rel=1e-10)
+
+
+def test_outer_edge_of_a_general_square_root_edge_converges_with_the_band():
+    """p^2 = (a - r) exp((a - r) / a): a square-root edge whose p^2 is not a quadratic; the fit's
+    model error is the cubic remainder, so the edge error falls like band^3 (densely sampled)."""
+    from fem.postprocess import outer_contact_radius
+    a = 1.0 * MM
+    r = np.linspace(0, 1.5, 3001) * MM
+    x = np.clip(a - r, 0, None)
+    p = 1e5 * np.sqrt(x * np.exp(x / a))
+    errors = [abs(outer_contact_radius(r, p, band_m=w * a) - a) for w in (0.4, 0.2, 0.1)]
+    assert errors[0] < 1e-2 * a
+    assert np.all(np.log2(np.array(errors[:-1]) / np.array(errors[1:])) > 2.5)
+
+
+def test_outer_edge_needs_enough_loaded_samples():
+    from fem.postprocess import outer_contact_radius
+    r = np.linspace(0, 1, 11) * MM
+    p = np.where(r < 0.45 * MM, 1e5, 0.0)
+    with pytest.raises(ValueError, match="band_m"):
+        outer_contact_radius(r, p, band_m=0.15 * MM)
+    with pytest.raises(ValueError, match="no positive contact pressure"):
+        outer_contact_radius(r, 0 * r, band_m=1 * MM)
