@@ -104,6 +104,8 @@ class SolverStats:
     unstable_steps: int = 0     # steps whose tangent was not positive definite on the way (buckling)
     dissipated_J: float = 0.0   # sum over steps of W0 + work - W1: jumps across instabilities
     #                             (snap-through), sticking-law slips, and the O(dt^3) trapezoid error
+    factorizations: int = 0     # Cholesky factorizations of K_ff attempted, and those of them that
+    failed_factorizations: int = 0   # failed (not positive definite: the shift search, `_factor`)
 
 
 @dataclass(frozen=True, eq=False)
@@ -197,7 +199,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             dt = min(dt * options.growth, options.max_step * t_max)
         dt = min(dt, options.max_step * t_max)
     return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n), unstable,
-                       float(dissipated))
+                       float(dissipated), policy.factorizations, policy.failed)
 
 
 def _jumped_too_far(indefinite: bool, defect: float, W0: float, W1: float, dt: float, jumps: int,
@@ -406,10 +408,21 @@ def _evaluate(mech, u, fext):
 
 class _ShiftPolicy:
     """The memory of the diagonal shift across the iterations of a path (`_factor`): the shift
-    that worked first in the last unstable episode, where the search of the next one starts."""
+    that worked first in the last unstable episode, where the search of the next one starts;
+    and the count of factorizations (attempted, failed)."""
 
     def __init__(self) -> None:
         self.onset = 0.0
+        self.factorizations = self.failed = 0
+
+    def factor(self, solver, K, free, shift):
+        """solver.factor(K, free, shift), counted."""
+        self.factorizations += 1
+        try:
+            return solver.factor(K, free, shift)
+        except NotPositiveDefinite:
+            self.failed += 1
+            raise
 
 
 def _factor(solver, K, free, shift, history, policy=None, lower=True):
@@ -431,14 +444,14 @@ def _factor(solver, K, free, shift, history, policy=None, lower=True):
     if lower:
         trial = shift / 10.0 if shift >= 10.0 * _SHIFT_MIN else 0.0
     try:
-        return solver.factor(K, free, trial), trial
+        return policy.factor(solver, K, free, trial), trial
     except NotPositiveDefinite:
         pass
     lo = max(trial, 0.1 * _SHIFT_MIN)
     hi = next((c for c in (shift, policy.onset) if c > lo), max(1e3 * lo, _SHIFT_MIN))
     while True:                              # bracket: lo fails, hi works
         try:
-            fac = solver.factor(K, free, hi)
+            fac = policy.factor(solver, K, free, hi)
             break
         except NotPositiveDefinite:
             lo, hi = hi, 1e3 * hi
@@ -448,7 +461,7 @@ def _factor(solver, K, free, shift, history, policy=None, lower=True):
     while hi > 10.0 * lo * (1 + 1e-9):       # bisect in log-space
         mid = float(np.sqrt(lo * hi))
         try:
-            fac, hi = solver.factor(K, free, mid), mid
+            fac, hi = policy.factor(solver, K, free, mid), mid
         except NotPositiveDefinite:
             lo = mid
     if trial == 0.0:
