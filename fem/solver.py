@@ -21,15 +21,24 @@ sticking law the frozen radial positions of the nodes held on the plane). Newton
   nodes the LCP lets go are released.
 * Line search: along the projected path P(u + a du) (penetrating nodes put back on the plane),
   backtracking until the Armijo condition on Pi holds. The energy decreases at every iteration,
-  so the contact set cannot cycle.
+  so the contact set cannot cycle. A full step of a shifted (indefinite) iteration is
+  extrapolated: a = 2, 4, ... up to 1024 while Pi keeps falling by Armijo (energies only; the
+  last such point is evaluated), because the shifted quadratic model does not see the floor of
+  the unstable valley it descends into.
 * Instability: if K_ff is not positive definite (buckling, a wall lifting off the plane), the
-  diagonal is shifted, K_ff + s diag(K_ff) (Levenberg-Marquardt), by the smallest power of ten
-  that makes it definite (down to 1e-10), the direction then descends, and the iteration follows
-  the energy down to the next stable state. Near a bifurcation the unstable eigenvalue is tiny
-  (below 1e-6 of the diagonal in the thin cones): a larger shift floor damps that mode so much
-  that the descent creeps (each step ~5 % longer than the last) until max_iterations. When a
-  step still fails, it is first enlarged (2x, 4x the last good step) to jump across the limit
-  point, then halved.
+  diagonal is shifted, K_ff + s diag(K_ff) (Levenberg-Marquardt), by a shift within a factor of
+  ten of the smallest that makes it definite (`_factor`): the last working shift is tried
+  tenfold smaller at the next iteration (below 1e-10: 0); when that fails, the critical shift is
+  bracketed from the last working shift (or, at the start of an unstable episode, the shift
+  that opened the previous one) and the bracket bisected in log-space. The direction then
+  descends, and the iteration follows the energy down to the next stable state. Near a
+  bifurcation the unstable eigenvalue is tiny (below 1e-6 of the diagonal in the thin cones): a
+  larger shift damps that mode so much that the descent creeps. When a step still fails, it is
+  first enlarged (2x, 4x the last good step) to jump across the limit point, then halved.
+  Not solved: a snap in which a thin wall leaves the plane and turns over (45 deg / 0.5 mm and
+  60 deg / 1 mm cones on the medium mesh, sticking 60 deg / 0.5 mm on the coarse one) is a
+  descent with a definite tangent along a curved valley whose accepted steps stay ~0.05 mm
+  (a cycle of a ~ 0.1, 0.3, 1): it needs thousands of iterations.
 * Jumps: the energy lost in a step, W0 + work - W1 (trapezoid work), is summed over the steps as
   `SolverStats.dissipated_J`. For frictionless contact (conservative: only a snap loses
   energy), a step across an instability that loses more than jump_tol = 0.5 % of W is redone
