@@ -489,7 +489,8 @@ def _line_search(mech, solver, policy, step, u_start, u, Pi, res, K, fext, shift
     invert (halve). Then a backtracks (quadratic interpolation, a in [0.1 a, 0.5 a]) until the
     Armijo condition Pi(P(u + a du)) <= Pi(u) + 1e-4 r . (P(u + a du) - u) holds (to round-off
     of Pi); if no a does, the direction is not one of descent: the diagonal shift is raised
-    (at most three times) and the direction recomputed. Returns (a, u, Pi, r, K, shift)."""
+    (at most three times) and the direction recomputed. A full step with a shift is extrapolated
+    (`_extrapolate`). Returns (a, u, Pi, r, K, shift)."""
     slack = 1e-12 * abs(Pi) + 1e-14 * np.linalg.norm(res) * np.max(np.abs(u))
     plane = step.plane
     for attempt in range(4):
@@ -541,10 +542,12 @@ def _extrapolate(mech, step, u_start, u, Pi, res, fext, trial, Pi1, r1, K1, slac
         if not np.isfinite(P) or P >= best[1] or P - Pi > 1e-4 * (res @ (t - u)) + slack:
             break
         best, alpha = (t, P), a
-    if alpha == 1.0:
-        return 1.0, trial, Pi1, r1, K1
-    Pi_a, r_a, K_a = _evaluate(mech, best[0], fext)
-    return alpha, best[0], Pi_a, r_a, K_a
+    if alpha > 1.0:
+        try:                 # the full evaluation also checks every quadrature point's J > 0
+            return (alpha, best[0]) + _evaluate(mech, best[0], fext)
+        except FloatingPointError:
+            pass
+    return 1.0, trial, Pi1, r1, K1
 
 
 _EXTRAPOLATE_MAX = 1024.0
