@@ -87,10 +87,7 @@ class CondensedCholesky:
         self._sub = sub
         sub_position = _positions(sub)
         lb = local[Bb]
-        self._update_flat = sub_position(lb[:, :, None], lb[:, None, :]).ravel()   # [nb m m]
-        # the sum over the elements of their boundary rows, as a sparse operator [nB, nb m]
-        self._gather = sp.csr_matrix((np.ones(lb.size), (lb.ravel(), np.arange(lb.size))),
-                                     shape=(len(B), lb.size))
+        self._update = sub_position(lb[:, :, None], lb[:, None, :])          # [nb, m, m]
         perm = strip_ordering(coordinates, pattern, mesh)
         self._inner = BandedCholesky(sub, None, perm=local[perm[is_B[perm]]])
         self._diag = sub_position(np.arange(len(B)), np.arange(len(B)))
@@ -115,12 +112,8 @@ class CondensedCholesky:
             raise NotPositiveDefinite("an element-interior 2x2 block is not positive definite")
         inv = np.stack([np.stack([d, -b], -1), np.stack([-b, a], -1)], -2) / det[:, None, None]
         K_IB = np.where(free[self._Bb][:, None, :], data[self._IB], 0.0)     # fixed columns dropped
-        k_r, k_z = K_IB[:, 0], K_IB[:, 1]                                    # [nb, m] rows of K_IB
-        W = np.stack([(d[:, None] * k_r - b[:, None] * k_z) / det[:, None],   # K_II^-1 K_IB
-                      (a[:, None] * k_z - b[:, None] * k_r) / det[:, None]], 1)
-        # K_BI K_II^-1 K_IB as the sum of two outer products per element (2 x 2 K_II)
-        update = k_r[:, :, None] * W[:, None, 0] + k_z[:, :, None] * W[:, None, 1]
-        S = K_BB - np.bincount(self._update_flat, weights=update.ravel(), minlength=self._sub.nnz)
+        W = inv @ K_IB                                                       # K_II^-1 K_IB
+        S = K_BB - _scatter(self._update, np.transpose(K_IB, (0, 2, 1)) @ W, self._sub.nnz)
         inner = self._inner.band_factor(S, free[self._B])
         return CondensedFactor(self, K, free, shift, inner, inv, K_IB, W)
 
@@ -138,8 +131,7 @@ class CondensedFactor:
         b = _constrained_rhs(self._K, self.free, rhs, du_fixed)
         b2 = b.reshape(len(b), -1)                                           # [n, m] columns
         b_I = b2[o._I]                                                       # [nb, 2, m]
-        WTb = self._W[:, 0, :, None] * b_I[:, 0, None, :] + self._W[:, 1, :, None] * b_I[:, 1, None, :]
-        g = b2[o._B] - o._gather @ WTb.reshape(-1, b2.shape[1])                 # [nb, m, k] summed
+        g = b2[o._B] - _scatter(o._Bb_local, np.transpose(self._W, (0, 2, 1)) @ b_I, len(o._B))
         g[~self.free[o._B]] = 0.0
         x_B = o._inner.band_solve(self._inner, g)                            # S x_B = g
         x = np.empty_like(b2)
@@ -154,6 +146,15 @@ class CondensedFactor:
     def freeing(self, dofs: np.ndarray) -> BorderedFactor:
         """As `Factor.freeing`."""
         return BorderedFactor(self, np.asarray(dofs))
+
+
+def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
+    """The sums of `values` [*index.shape, (m)] into `size` slots by `index` (column by column)."""
+    flat = index.ravel()
+    if values.ndim == index.ndim:
+        return np.bincount(flat, weights=values.ravel(), minlength=size)
+    cols = values.reshape(flat.size, -1)
+    return np.stack([np.bincount(flat, weights=c, minlength=size) for c in cols.T], axis=1)
 
 
 def _positions(csr: sp.csr_matrix):

@@ -127,8 +127,7 @@ class BandedCholesky:
         self._indptr, self._indices = pattern.indptr, pattern.indices
         self._sel = np.flatnonzero(upper)
         self._rows, self._cols = rows[self._sel], pattern.indices[self._sel]
-        # flat index into the band storage ab [kd + 1, n], Fortran-ordered as LAPACK takes it
-        self._band = pj[upper] * (self.kd + 1) + (self.kd + pi[upper] - pj[upper])
+        self._band = (self.kd + pi[upper] - pj[upper]) * n + pj[upper]     # flat index into ab
         self._perm, self._inv = perm, inv
 
     def factor(self, K: sp.csr_matrix, free: np.ndarray, shift: float = 0.0) -> "Factor":
@@ -143,7 +142,7 @@ class BandedCholesky:
         keep = free[self._rows] & free[self._cols]
         ab = np.zeros((self.kd + 1) * self.n)
         ab[self._band] = np.where(keep, data[self._sel], 0.0)
-        ab = ab.reshape(self.n, self.kd + 1).T                 # Fortran order: pbtrf works in place
+        ab = ab.reshape(self.kd + 1, self.n)
         diag = ab[self.kd]                                     # a view, in permuted order
         fixed_p = ~free[self._perm]
         if shift:
