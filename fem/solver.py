@@ -10,11 +10,7 @@ sticking law the frozen radial positions of the nodes held on the plane). Newton
 
 * Predictor: the converged state u0; the first iteration imposes the prescribed increment
   through the tangent (a tangent predictor, which sees the contact; a secant extrapolation of u
-  pushed the contact front through the plane and then released it node by node). If the
-  tangent is indefinite there, its shift is at least 1e-6 (`_PREDICTOR_SHIFT`): the response
-  along the unstable mode grows like 1 / (s - s_critical), so a shift just above the critical
-  one throws the wall an arbitrary distance along it, and the descent that follows may end in
-  a far state (a turned-over wall) instead of the neighbouring one.
+  pushed the contact front through the plane and then released it node by node).
 * Step: the quadratic model of Pi minimized on the free dofs (prescribed and held contact dofs
   eliminated, K_ff factored once, `fem.linsolve`) subject to the linearized contact conditions
   g_a + du_z,a >= 0 of the free nodes the unconstrained step would push through the plane, and
@@ -277,11 +273,6 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
             raise _StepFailure("the residual is not finite", history)
         step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref)
         shift = step.solve(solver, K, shift, history, policy)
-        if 0.0 < shift < _PREDICTOR_SHIFT and np.any(du_fixed):
-            # the tangent predictor of an unstable state: its response along the unstable mode
-            # grows like 1 / (s - s_critical), so a shift just above the critical one throws the
-            # wall an arbitrary distance along it and the descent starts wherever it lands
-            shift = step.solve(solver, K, _PREDICTOR_SHIFT, history, policy, lower=False)
         indefinite |= shift > 0.0
         flags["indefinite"] = indefinite
         energy = abs(step.du @ res)
@@ -487,11 +478,6 @@ def _factor(solver, K, free, shift, history, policy=None, lower=True):
     return fac, hi
 
 
-_PREDICTOR_SHIFT = 1e-6  # least shift of an indefinite tangent predictor (the iteration that
-#                          imposes the increment): sticking 60 deg / 0.5 mm coarse at u = 9.49 mm
-#                          descended 452 iterations to the turned-over wall (72 % of W lost) or 24
-#                          to the neighbouring state, depending on a shift of 1.3e-8 or 5.6e-8
-#                          there; with this floor, 26-28 iterations whatever the shift history
 _SHIFT_MIN = 1e-10      # smallest diagonal shift (relative); cond(K_ff + s D) stays < ~1e12
 
 
