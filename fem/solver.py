@@ -38,7 +38,11 @@ sticking law the frozen radial positions of the nodes held on the plane). Newton
   Not solved: a snap in which a thin wall leaves the plane and turns over (45 deg / 0.5 mm and
   60 deg / 1 mm cones on the medium mesh, sticking 60 deg / 0.5 mm on the coarse one) is a
   descent with a definite tangent along a curved valley whose accepted steps stay ~0.05 mm
-  (a cycle of a ~ 0.1, 0.3, 1): it needs thousands of iterations.
+  (a cycle of a ~ 0.1, 0.3, 1): it needs thousands of iterations. Where such a descent starts
+  can hang on the shift of an indefinite tangent predictor, whose response along the unstable
+  mode grows like 1 / (s - s_critical) (sticking 60 deg / 0.5 mm at u = 9.49 mm: 452 iterations
+  to the turned-over wall with s = 1.3e-8, 24 to the neighbouring state with 5.6e-8); a floor
+  of 1e-6 on that shift removed this, but cost ~10 % more iterations over the robustness cases.
 * Jumps: the energy lost in a step, W0 + work - W1 (trapezoid work), is summed over the steps as
   `SolverStats.dissipated_J`. For frictionless contact (conservative: only a snap loses
   energy), a step across an instability that loses more than jump_tol = 0.5 % of W is redone
