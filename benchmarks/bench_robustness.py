@@ -11,7 +11,8 @@ Cases (cup A's r0 = 5, r1 = 19 mm; the thickness line of cup A scaled to the roo
 
 Per case it prints: outcome (ok, or the step where it failed, the likely cause and the first and
 last relative residual of its history), load steps, Newton iterations, cut-backs (including the
-steps redone because they jumped off the path, `fem.solver`), wall time, and the checks of a
+steps redone because they jumped off the path, `fem.solver`), the Cholesky factorizations
+attempted and failed (the diagonal shift search of unstable steps), wall time, and the checks of a
 converged path: the energy balance (the largest |int F0 du - W| / W where W > 1 % of its final
 value; frictionless only, sticking dissipates), the dissipated energy the solver reports
 (`SolverStats.dissipated_J`) over the final stored energy, and that dissipation split by step:
@@ -20,7 +21,11 @@ and quad./W, the sum of its absolute values over the stable steps (for frictionl
 trapezoid's error on F0(u), largest at u -> h1 where the wall is squeezed flat; for sticking
 also the slips). Run from the repository:
 
-    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_robustness.py [--only sweep|extremes]
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_robustness.py \
+        [--only sweep|extremes] [--fidelity coarse|medium|fine] [--case frictionless/45/0.5 ...]
+
+(--case: only the sweep cases named contact/alpha_deg/d_root_mm, e.g. the two medium-level
+frictionless cases of issue 3: --fidelity medium --case frictionless/45/0.5 frictionless/60/1.)
 """
 
 from __future__ import annotations
@@ -48,7 +53,11 @@ EXTREMES = [(5.0, 0.1), (15.0, 0.1), (45.0, 0.1), (70.0, 0.1), (45.0, 0.5), (70.
             (70.0, 5.0), (5.0, 0.5), (15.0, 0.5)]
 
 
-def cases(only: str | None, fidelity: str) -> list[tuple[str, FemRun]]:
+def cases(only: str | None, fidelity: str, named: list[str] | None = None) -> list[tuple[str, FemRun]]:
+    if named:
+        picked = [c.split("/") for c in named]
+        return [("sweep", FemRun(cup="A", contact=c, fidelity=fidelity, alpha_deg=float(a),
+                                 d_root_mm=float(d))) for c, a, d in picked]
     out = []
     if only in (None, "sweep"):
         out += [("sweep", FemRun(cup="A", contact=c, fidelity=fidelity, alpha_deg=a, d_root_mm=d))
@@ -81,6 +90,7 @@ def run(req: FemRun) -> dict:
     unstable = np.asarray(r.unstable[1:], bool)
     return {"outcome": "ok", "time": wall, "steps": r.stats.steps, "its": r.stats.newton_iterations,
             "cutbacks": r.stats.cutbacks, "energy": energy, "dissipated": dissipated,
+            "fact": r.stats.factorizations, "failed": r.stats.failed_factorizations,
             "snaps": float(np.sum(defect[unstable]) / W_end),
             "quadrature": float(np.sum(np.abs(defect[~unstable])) / W_end),
             "u_end": r.u_m[-1] / r.h1_m}
@@ -98,12 +108,14 @@ def _short(exc: Exception) -> str:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--only", choices=("sweep", "extremes"))
-    parser.add_argument("--fidelity", default="coarse")
+    parser.add_argument("--fidelity", default="coarse", choices=("coarse", "medium", "fine"))
+    parser.add_argument("--case", nargs="+", metavar="CONTACT/ALPHA_DEG/D_ROOT_MM",
+                        help="only these cases, e.g. frictionless/45/0.5")
     args = parser.parse_args()
-    print(f"{'set':8} {'case':34} {'steps':>5} {'Newton':>6} {'cuts':>4} {'time/s':>7} "
+    print(f"{'set':8} {'case':34} {'steps':>5} {'Newton':>6} {'cuts':>4} {'fact.':>6} {'failed':>6} {'time/s':>7} "
           f"{'|W-int F du|/W':>14} {'dissip./W':>9} {'snaps/W':>8} {'quad./W':>8}  outcome")
     total, failed = 0.0, 0
-    todo = cases(args.only, args.fidelity)
+    todo = cases(args.only, args.fidelity, args.case)
     total_cases = len(todo)
     for kind, req in todo:
         res = run(req)
@@ -111,11 +123,11 @@ def main() -> int:
         label = f"{req.contact[:5]} a{req.alpha_deg:g} d0 {req.d_root_mm:g} u<={req.u_max_over_h1:g}h1"
         if res["outcome"] != "ok":
             failed += 1
-            print(f"{kind:8} {label:34} {'':>5} {'':>6} {'':>4} {res['time']:7.2f} {'':>14} {'':>9} "
+            print(f"{kind:8} {label:34} {'':>5} {'':>6} {'':>4} {'':>6} {'':>6} {res['time']:7.2f} {'':>14} {'':>9} "
                   f"{'':>8} {'':>8}  {res['outcome']}", flush=True)
             continue
         print(f"{kind:8} {label:34} {res['steps']:5d} {res['its']:6d} {res['cutbacks']:4d} "
-              f"{res['time']:7.2f} {res['energy']:14.2e} {res['dissipated']:9.2e} "
+              f"{res['fact']:6d} {res['failed']:6d} {res['time']:7.2f} {res['energy']:14.2e} {res['dissipated']:9.2e} "
               f"{res['snaps']:8.1e} {res['quadrature']:8.1e}  ok", flush=True)
     print(f"{failed} failed of {total_cases}; total wall time {total:.1f} s")
     return 0

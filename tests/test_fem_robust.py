@@ -10,7 +10,8 @@ different reason, run to the end and are checked against laws the solver does no
   reproduce is accepted), for sticking it is >= 0 (slip and snaps can only lose energy).
 
 The parts are tested on small matrices: the diagonal shift stays within a factor of ten of the
-smallest one that makes the tangent definite, and the round-off acceptance of the residual.
+smallest one that makes the tangent definite, and is found in few factorizations; the line search
+extrapolates a shifted step down an energy valley; and the round-off acceptance of the residual.
 """
 
 import numpy as np
@@ -21,7 +22,7 @@ from fem.cup import compress_cup
 from fem.linsolve import BandedCholesky
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
-from fem.solver import SolverOptions, _balanced, _factor
+from fem.solver import SolverOptions, _ShiftPolicy, _balanced, _extrapolate, _factor
 from validation.crosscheck.runs import FemRun
 
 
@@ -111,3 +112,70 @@ def test_round_off_residual_is_accepted_only_with_a_vanishing_correction():
 def test_jump_options_are_validated():
     with pytest.raises(ValueError, match="jump_tol"):
         SolverOptions(jump_tol=0.0)
+
+
+def _indefinite(critical: float, n: int = 8, seed: int = 3):
+    """A symmetric matrix with unit diagonal, definite but for one eigenvalue -critical, and its
+    banded solver."""
+    rng = np.random.default_rng(seed)
+    Q, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    lam = np.linspace(1.0, 2.0, n)
+    lam[0] = -critical
+    A = Q @ np.diag(lam) @ Q.T
+    A /= np.sqrt(np.outer(np.diag(A), np.diag(A)))
+    coords = np.vstack([np.arange(n // 2, dtype=float), np.zeros(n // 2)])
+    K = sp.csr_matrix(A)
+    return K, BandedCholesky(K, coords), -np.linalg.eigvalsh(A)[0]
+
+
+def test_shift_search_is_short_and_remembers_the_last_episode():
+    """An unstable episode that needs a shift of ~1e-2 (sticking cup A's episodes need 1e-3 to
+    1e-1): the search from 0 brackets and bisects in log-space, <= 8 factorizations, where a
+    tenfold ladder from 1e-10 takes 11. The next episode starts from the shift that opened this
+    one: <= 6 factorizations. Both end within the factor of ten above the critical shift."""
+    K, solver, crit = _indefinite(1e-2)
+    free = np.ones(K.shape[0], bool)
+    policy = _ShiftPolicy()
+    _, shift = _factor(solver, K, free, 0.0, [], policy)
+    assert crit < shift <= 10.0 * crit
+    assert policy.factorizations <= 8 and policy.failed >= 1
+    first = policy.factorizations
+    K2, solver2, crit2 = _indefinite(3e-3, seed=5)      # the next episode, a little milder
+    _, shift2 = _factor(solver2, K2, free, 0.0, [], policy)
+    assert crit2 < shift2 <= 10.0 * crit2
+    assert policy.factorizations - first <= 6
+
+
+class _Valley:
+    """Pi(u) = k/2 (u0 - 6)^2 on one dof (a minimum six unit steps away) that inverts an element
+    (FloatingPointError) beyond u0 = `wall`; `evaluate` as `fem.forms.Mechanics`."""
+
+    def __init__(self, wall=np.inf):
+        self.wall = wall
+
+    def energy(self, u):
+        if u[0] > self.wall:
+            raise FloatingPointError("inverted element")
+        return 0.5 * (u[0] - 6.0) ** 2
+
+    def evaluate(self, u):
+        return self.energy(u), np.array([u[0] - 6.0]), sp.csr_matrix(np.eye(1))
+
+
+class _UnitStep:
+    plane, du = None, np.array([1.0])
+
+
+@pytest.mark.parametrize("wall, expected", [(np.inf, 4.0), (3.0, 2.0)])
+def test_shifted_step_is_extrapolated_down_the_valley(wall, expected):
+    """After a full shifted step u = 1 is accepted, the step doubles while the energy falls by
+    Armijo: 2 and 4 do, 8 does not (Pi(8) = Pi(4)), so u = 4; an element inverting beyond u = 3
+    stops it at 2. The state returned is evaluated there (energy and residual of that u)."""
+    mech, u = _Valley(wall), np.zeros(1)
+    Pi, r, _ = mech.evaluate(u)
+    trial = np.array([1.0])
+    Pi1, r1, K1 = mech.evaluate(trial)
+    alpha, u1, Pi_a, r_a, _ = _extrapolate(mech, _UnitStep(), u, u, Pi, r, np.zeros(1), trial,
+                                           Pi1, r1, K1, 0.0)
+    assert alpha == expected and u1[0] == expected
+    assert Pi_a == mech.energy(u1) < Pi1 and r_a[0] == expected - 6.0
