@@ -20,8 +20,10 @@ sticking law the frozen radial positions of the nodes held on the plane). Newton
   contact front moves in one iteration. Nodes pressed (lambda > 0) are held afterwards; held
   nodes the LCP lets go are released.
 * Line search: along the projected path P(u + a du) (penetrating nodes put back on the plane),
-  backtracking until the Armijo condition on Pi holds. The energy decreases at every iteration,
-  so the contact set cannot cycle. A full step of a shifted (indefinite) iteration is
+  backtracking until the Armijo condition on Pi holds. With frictionless contact the energy
+  decreases at every iteration, so the contact set cannot cycle; with sticking contact a node
+  that lands is moved to its stick point (`RigidPlane.project`), which is not an energy
+  minimization, so a cycle is possible in principle (max_iterations ends it). A full step of a shifted (indefinite) iteration is
   extrapolated: a = 2, 4, ... up to 1024 while Pi keeps falling by Armijo (energies only; the
   last such point is evaluated), because the shifted quadratic model does not see the floor of
   the unstable valley it descends into.
