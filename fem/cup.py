@@ -224,7 +224,7 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
         F0_contact_N=float(np.sum(prof.p_gauss_Pa * prof.w_m2)), r_c_m=r_c,
         V_m3=enclosed_volume(x[0, path], x[1, path], on_path),
         l_m=l_q, l_median_m=l_med, l_weighted_m=_weighted_width(prof, r_c), l_half_max_m=l_hm,
-        penetration_m=plane.largest_penetration(s.u), energy_J=mech.energy(s.u),
+        penetration_m=plane.largest_penetration(s.u), energy_J=s.energy_J,
         newton_iterations=s.iterations, unstable=s.unstable,
         min_stretch=float(np.min(smallest_stretch(mech.kin.deformation_gradient(s.u)))),
         pressure=prof, displacements=s.u, nodal_pressure_Pa=p_nodes)

@@ -128,11 +128,13 @@ class SolverStats:
 
 @dataclass(frozen=True, eq=False)
 class StepResult:
-    """A converged state: load parameter, displacement, internal force, contact state."""
+    """A converged state: load parameter, displacement, internal force, stored energy W(u) [J]
+    (the path evaluates it for its energy balance), contact state."""
 
     t: float
     u: np.ndarray
     r_int: np.ndarray
+    energy_J: float
     contact: ContactState | None
     iterations: int
     unstable: bool = False    # the tangent lost definiteness in this step (buckling, snap-through)
@@ -162,9 +164,9 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     r0 = mech.internal_force(u0)
     solver = make_solver(mech.linearize(u0)[1], mech.kin.node_coordinates(), mech.kin.mesh)
     policy = _ShiftPolicy()
-    if on_step:
-        on_step(StepResult(0.0, u0, r0, state, 0))
     t, W0 = 0.0, mech.energy(u0)
+    if on_step:
+        on_step(StepResult(0.0, u0, r0, W0, state, 0))
     dt = dt_ok = options.initial_step * t_max
     steps = iterations = cutbacks = unstable = jumps = 0
     dissipated = 0.0
@@ -210,7 +212,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         dt_ok = t1 - t
         u0, r0, W0, state, t, jumps = u1, r1, W1, state1, t1, 0
         if on_step:
-            on_step(StepResult(t, u1, r1, state1, its, bool(indefinite)))
+            on_step(StepResult(t, u1, r1, W1, state1, its, bool(indefinite)))
         if progress:
             progress(t / t_max, f"step {steps}: {name} = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:

@@ -81,6 +81,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     job = _prepare(args)                     # every check happens here, before the solve
     from fem.cup import compress_cup
+    from fem.postprocess import BIOT_STRETCH
     from validation import handoff
     from validation.output import atomic_file, terminal_progress
 
@@ -102,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
           f"F0 = {response.F0_N[-1]:.4g} N at u = {1e3 * response.u_m[-1]:.4g} mm")
     if response.folding_u_m is not None:
         print(f"cupcheck stiffness: note: from u = {1e3 * response.folding_u_m:.4g} mm the wall is "
-              f"compressed beyond Biot's stretch 0.544 (smallest {response.min_stretch.min():.3f}): "
+              f"compressed beyond Biot's stretch {BIOT_STRETCH} (smallest {response.min_stretch.min():.3f}): "
               "a free surface may fold there, and the curve beyond depends on the mesh", file=sys.stderr)
     return 0
 
