@@ -181,3 +181,18 @@ def test_shifted_step_is_extrapolated_down_the_valley(wall, expected):
                                            Pi1, r1, K1, 0.0)
     assert alpha == expected and u1[0] == expected
     assert Pi_a == mech.energy(u1) < Pi1 and r_a[0] == expected - 6.0
+
+
+@pytest.mark.slow
+def test_sticking_rim_does_not_snap_on_the_fine_level():
+    """Sticking contact dissipates in slips, so its line search does not extrapolate a shifted
+    step down the energy (`fem.solver._line_search`): on the fine level with default steps the
+    extrapolated descent made the rim slip, F0 falling from 2.08 to 0.60 N at u = 0.063 h1.
+    With small steps (the reference runs) F0 rises monotonically up to its peak near 0.3 h1; so
+    must the default-step path, up to 0.2 h1 (~30 s)."""
+    from fem.geometry import cup_geometry
+    geometry = cup_geometry("A")
+    r = compress_cup(cup_mesh(geometry, "fine"), NeoHookean(), "sticking", u_max_m=0.9 * geometry.h1_m)
+    early = r.u_m <= 0.2 * geometry.h1_m
+    assert np.all(np.diff(r.F0_N[early]) > 0)
+    assert r.F0_N[early][-1] > 4.5          # 4.81 N at 0.18 h1 (small steps: 4.92 at 0.2 h1)
