@@ -66,6 +66,7 @@ residual history and the likely cause. Nothing is accepted silently.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -82,7 +83,17 @@ __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "S
 
 
 class ConvergenceError(RuntimeError):
-    """A load step could not be converged even with the smallest allowed step."""
+    """A load step could not be converged even with the smallest allowed step.
+
+    The message is one line; the attributes say where (the step, its load range t_from -> t_to)
+    and why (`cause`, with the likely cause), and keep the residual `history` of the last attempt.
+    """
+
+    def __init__(self, message: str, *, step: int = 0, t_from: float = math.nan,
+                 t_to: float = math.nan, cause: str = "", history: tuple[float, ...] = ()):
+        super().__init__(message)
+        self.step, self.t_from, self.t_to = step, t_from, t_to
+        self.cause, self.history = cause, tuple(history)
 
 
 @dataclass(frozen=True)
@@ -188,11 +199,12 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
                 continue
             dt = (dt if not fail.indefinite else min(dt, dt_ok)) * 0.5
             if dt < options.min_step * t_max:
+                last = f"{fail.history[-1]:.3e}" if fail.history else "n/a"
                 raise ConvergenceError(
                     f"load step {steps + 1} from {name} = {t:.6g} to {t1:.6g} did not converge "
-                    f"(step halved below min_step = {options.min_step:g} of the range; "
-                    f"{cutbacks} cut-backs in this run): "
-                    f"{fail.cause}; residual history {', '.join(f'{h:.3e}' for h in fail.history)}"
+                    f"(step halved below min_step = {options.min_step:g} of the range, last "
+                    f"residual {last} after {len(fail.history)} iterations): {fail.cause}",
+                    step=steps + 1, t_from=t, t_to=t1, cause=fail.cause, history=fail.history,
                 ) from None
             continue
         W1 = mech.energy(u1)

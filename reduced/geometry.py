@@ -4,7 +4,9 @@ One mechanism with two sources, both answering `at(h) -> (r, dr/dh, V, dV/dh, l)
 
 - `ConeGeometry`: the rigid-cone laws of the paper, eqs (3), (4) and (5).
 - `CurveGeometry`: the inner contact radius, cavity volume and strip width that a stiffness curve
-  carries (e.g. from the FEM), interpolated by PCHIP over u = h1 - h.
+  carries (e.g. from the FEM), interpolated by PCHIP over u = h1 - h. A strip width of 0 is a
+  line contact (the FEM resolves no strip there): eq (6) then gives an unbounded pressure, and
+  the lifetime model treats the interface there as sealed.
 
 The cup detaches when r reaches r1, i.e. at the undeformed height (u = 0): `h_detach_m`. The plate
 displacement u = h_ref_m - h is measured from `h_ref_m`, the source's undeformed height.
@@ -26,6 +28,7 @@ class ConeGeometry:
     """r(h) eq (3), V(h) eq (4), l(h) eq (5) of a rigid truncated cone."""
 
     name = "cone"
+    line_contact = False          # eq (5) gives l > 0 on (0, h1]
 
     def __init__(self, cup: CupParameters):
         self.cup = cup
@@ -62,16 +65,8 @@ class CurveGeometry:
             raise ValueError(f"geometry: 'curve' needs the stiffness curve's columns r_c_mm, l_mm, "
                              f"V_mm3; '{curve.provenance.get('source', '?')}' lacks "
                              f"{', '.join(m[:-2] + '_mm' for m in missing)}")
-        if np.any(curve.l_m <= 0):
-            zero_u = 1e3 * curve.u_m[curve.l_m <= 0]
-            where = (f"{zero_u[0]:.4g} mm" if zero_u.size == 1 else
-                     f"{zero_u.size} samples in [{zero_u.min():.4g}, {zero_u.max():.4g}] mm")
-            raise ValueError(
-                f"l_mm: the stiffness curve's strip width is 0 at u = {where} (no contact strip "
-                f"there), but eq (6) needs l > 0 wherever "
-                f"the cup may go, up to detachment at r1; take l from eq (5) (geometry 'cone') or "
-                f"give a curve with l > 0")
         self.cup = cup
+        self.line_contact = bool(np.any(curve.l_m <= 0))     # somewhere l = 0: sealed there
         self.h1 = self.h_ref_m = curve.h1_m
         self._r = ScalarPchip(curve.u_m, curve.r_c_m, "stiffness curve (u for r_c)")
         self._V = ScalarPchip(curve.u_m, curve.V_m3, "stiffness curve (u for V)")

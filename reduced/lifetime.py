@@ -281,6 +281,8 @@ class _Core:
             pb = pa - (kappa * F + F1) / (math.pi * r * r)
         else:                    # p_b from the ideal gas (8); molecule flow eqs (9), (19)
             pb = N * self.kT / V
+        if l <= 0.0:             # a line contact: eq (6)'s pressure is unbounded, u_c = 0 (sealed)
+            return 0.0, pb, math.inf, 0.0, 0.0, r, rp, l, V, Vp, F, Fh
         p = kappa * F / (2.0 * math.pi * r * l) + self.beta * (pa - pb)
         uc = self.uc(p / E)
         if self.liquid:
@@ -492,9 +494,10 @@ def _run_reference(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifeti
     # sealed anywhere on the branch? (u_c = 0 makes Ndot vanish; it is never crossed in finite time)
     sealed_at = _sealed_on_branch(core, h0, h_end, F1)
     if sealed_at is not None:
+        line = " (l = 0 there: a line contact, no strip resolved)" if core.geo.at(sealed_at)[4] <= 0 else ""
         return _result(core, F1, math.inf, "sealed",
-                       f"u_c = 0 at h = {1e3 * sealed_at:.4g} mm on the way: the interface seals, no "
-                       f"further leak", Fmax, N0, [0.0], [[N0, 0.0]], [h0], 0)
+                       f"u_c = 0 at h = {1e3 * sealed_at:.4g} mm on the way{line}: the interface "
+                       f"seals, no further leak", Fmax, N0, [0.0], [[N0, 0.0]], [h0], 0)
     N_h0, slope0 = core.n_eq(h0, 1.0, F1)
     last = [h0, N_h0, slope0]     # last root, its N and dN_eq/dh: a predictor
 
@@ -650,8 +653,8 @@ def _run_relaxed(core: _Core, F1, N0, h0, Fmax, t_max, rtol, refine) -> Lifetime
 
 def _sealed_on_branch(core: _Core, h0: float, h_end: float, F1: float) -> float | None:
     """First h on [h0, h_end] (checked on the fold-search grid) where u_c = 0, or None."""
-    if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf:
-        return None        # a table without sealed rows never seals
+    if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf and not core.geo.line_contact:
+        return None        # a table without sealed rows never seals, unless the strip is a line
     h, _ = core.grid
     for x in [h0] + [float(x) for x in h[(h > h0) & (h < h_end)]] + [h_end]:
         N = core.n_eq(x, 1.0, F1)[0]

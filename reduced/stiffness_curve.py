@@ -6,11 +6,15 @@ than the rigid-cone laws -- the inner contact radius r_c(h) (cf. eq. 3), the con
 width l(h) (cf. eq. 5) and the enclosed cavity volume V(h) (cf. eq. 4) -- and its provenance.
 
 It can come from an FEM run, a measured CSV or the Appendix A formula; the reduced model does
-not know which. Arrays are SI inside; the CSV names every unit in its column names::
+not know which. Arrays are SI inside; the CSV is a plain table that names every unit in its
+column names (readable by pandas.read_csv and numpy.genfromtxt as they are)::
 
-    # provenance: {"source": "fem", ...}
     u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3
     0.0,12.0,0.0,...
+
+Its provenance travels in a JSON sidecar of the same name (``curve.json``, key ``provenance``),
+among it the cup design the curve was computed for (``geometry``: r0_mm, r1_mm, alpha_deg,
+h1_mm, the thickness profile), which `design` returns; a lifetime takes the cup from there.
 
 Interpolation is monotone piecewise-cubic (PCHIP): it never overshoots between samples, so
 a monotone measured curve stays monotone. Evaluating outside the sampled range is an error,
@@ -43,7 +47,9 @@ CSV_COLUMNS: dict[str, tuple[str, float]] = {
     "V_mm3": ("V_m3", 1e-9),
 }
 _OPTIONAL = ("r_c_m", "l_m", "V_m3")
-_PROVENANCE_TAG = "# provenance:"
+_PROVENANCE_TAG = "# provenance:"       # the former in-CSV form, still read
+#: the keys a recorded design must have for the reduced model to use it
+DESIGN_KEYS = ("r0_mm", "r1_mm", "alpha_deg", "h1_mm")
 
 
 @dataclass(frozen=True)
@@ -101,6 +107,15 @@ class StiffnessCurve:
     def h_range_m(self) -> tuple[float, float]:
         """(smallest, largest) sampled cup height [m]."""
         return float(self.h1_m - self.u_m[-1]), float(self.h1_m - self.u_m[0])
+
+    @property
+    def design(self) -> dict[str, Any] | None:
+        """The cup design recorded in the provenance (``geometry`` with r0_mm, r1_mm, alpha_deg,
+        h1_mm, ...), or None when the curve names none (a measured curve, a user's mesh)."""
+        geometry = self.provenance.get("geometry")
+        if isinstance(geometry, Mapping) and all(k in geometry for k in DESIGN_KEYS):
+            return dict(geometry)
+        return None
 
     def has(self, name: str) -> bool:
         """True if the optional column `name` ('r_c_m', 'l_m' or 'V_m3') is present."""
@@ -160,10 +175,12 @@ class StiffnessCurve:
         return {n: PchipInterpolator(self.u_m, getattr(self, n), extrapolate=False) for n in names}
 
     # --------------------------------------------------------------------- IO
-    def to_csv(self, path: str | os.PathLike) -> Path:
-        """Write the curve (units in the column names, provenance as a JSON comment line).
+    def to_csv(self, path: str | os.PathLike, sidecar: bool = True) -> Path:
+        """Write the curve as a plain CSV (units in the column names) and, with `sidecar`, its
+        provenance to the JSON sidecar ``path.with_suffix('.json')`` (key ``provenance``).
 
-        The file appears atomically: it is written to a temporary file and renamed.
+        Each file appears atomically (written to a temporary file and renamed). A caller that
+        writes a richer sidecar itself (`validation.handoff`) passes ``sidecar=False``.
         """
         cols = {"u_mm": self.u_m * 1e3, "h_mm": self.h_m * 1e3, "F0_N": self.F0_N}
         for csv_name, (name, factor) in CSV_COLUMNS.items():
@@ -172,17 +189,16 @@ class StiffnessCurve:
         table = np.column_stack(list(cols.values()))
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        # a unique sibling name, created with the normal (umask) permissions, unlike mkstemp's 0600
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
-        try:
-            with open(tmp, "x") as f:
-                f.write(f"{_PROVENANCE_TAG} {json.dumps(self.provenance, sort_keys=True, default=str)}\n")
-                f.write(",".join(cols) + "\n")
-                np.savetxt(f, table, delimiter=",", fmt="%.10g")
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        if sidecar:
+            text = json.dumps({"provenance": self.provenance, "h1_mm": 1e3 * self.h1_m}, indent=1,
+                              sort_keys=True, default=str) + "\n"
+            _atomic_write(path.with_suffix(".json"), lambda f: f.write(text))
+
+        def write_table(f) -> None:
+            f.write(",".join(cols) + "\n")
+            np.savetxt(f, table, delimiter=",", fmt="%.10g")
+
+        _atomic_write(path, write_table)
         return path
 
     @classmethod
@@ -190,7 +206,9 @@ class StiffnessCurve:
         """Read a curve written by `to_csv`, or a measured one with at least `u_mm,F0_N`.
 
         h1 is taken from the `h_mm` column (h1 = u + h) when present; otherwise `h1_m` must
-        be given (the undeformed height of the cup the curve was measured on).
+        be given (the undeformed height of the cup the curve was measured on). The provenance
+        comes from the JSON sidecar ``path.with_suffix('.json')`` when there is one (or from a
+        ``# provenance:`` line, the former format).
         """
         path = Path(path)
         if not path.is_file():
@@ -232,8 +250,37 @@ class StiffnessCurve:
             h1_m = h1_csv
         if h1_m is None:
             raise ValueError(f"h1_mm: '{path}' has no h_mm column; give the cup's undeformed height")
+        provenance = _sidecar_provenance(path) or provenance
         provenance.setdefault("source", f"csv:{path.name}")
         return cls(h1_m=h1_m, provenance=provenance, **si)
+
+
+def _sidecar_provenance(csv_path: Path) -> dict[str, Any]:
+    """The ``provenance`` of the curve's JSON sidecar, {} without one."""
+    side = csv_path.with_suffix(".json")
+    if not side.is_file():
+        return {}
+    try:
+        data = json.loads(side.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"stiffness: cannot parse the sidecar '{side}': {exc}") from None
+    prov = data.get("provenance") if isinstance(data, Mapping) else None
+    if not isinstance(prov, Mapping):
+        raise ValueError(f"stiffness: the sidecar '{side}' has no 'provenance' table")
+    return dict(prov)
+
+
+def _atomic_write(path: Path, write) -> None:
+    """Write through `write(file)` to a unique sibling and rename it onto `path`."""
+    # created with the normal (umask) permissions, unlike mkstemp's 0600
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+    try:
+        with open(tmp, "x") as f:
+            write(f)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def _frozen_array(value: Any, name: str, size: int | None = None) -> np.ndarray:

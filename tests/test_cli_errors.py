@@ -2,6 +2,7 @@
 work, a failed solve exits 1; neither leaves a file behind (common brief, review items 19-21, 23)."""
 
 import functools
+import json
 from pathlib import Path
 
 import pytest
@@ -32,7 +33,7 @@ def no_solve(monkeypatch):
 
 @pytest.mark.parametrize("argv,message", [
     (["stiffness", "--cup", "C"],
-     "cupcheck stiffness: error: argument --cup: invalid choice: 'C' (choose from 'A', 'B')"),
+     "cupcheck stiffness: error: argument --cup: invalid cup 'C' (choose from A, B, any case)"),
     (["stiffness", "--E-MPa", "abc"],
      "cupcheck stiffness: error: argument --E-MPa: invalid float value: 'abc'"),
     (["stiffness", "--u-max-mm"],
@@ -110,9 +111,14 @@ def test_solver_failure_exits_1_and_leaves_no_files(tmp_path, monkeypatch, capsy
     assert main(["stiffness", "--fidelity", "coarse", "--u-max-mm", "2", "--out", str(out),
                  "--fields-out", str(tmp_path / "fields.xdmf")]) == 1
     err = capsys.readouterr().err.splitlines()
-    assert err[-1].startswith("cupcheck stiffness: failed: load step 1 ")
-    assert "did not converge" in err[-1] and "residual history" in err[-1]
-    assert _files(tmp_path) == []
+    assert err[-1].startswith("cupcheck stiffness: failed: load step 1 from u = 0 to ")
+    assert " mm did not converge (residual " in err[-1]
+    assert "likely cause" in err[-1] and len(err[-1]) < 400
+    # the residual history goes to a log the line names; no curve, sidecar or fields
+    log = out.with_suffix(".failure.json")
+    assert str(log) in err[-1] and _files(tmp_path) == ["curve.failure.json", "new"]
+    record = json.loads(log.read_text())
+    assert record["step"] == 1 and 0 < record["u_to_mm"] <= 2 and len(record["residual_history"]) == 2
 
 
 def test_failure_while_writing_leaves_none_of_the_files(tmp_path, monkeypatch, capsys):

@@ -12,7 +12,10 @@ from validation.cli import main
 
 
 def _run(capsys, *argv):
-    code = main(list(argv))
+    try:
+        code = main(list(argv))
+    except SystemExit as exc:               # argparse's own errors
+        code = exc.code
     out, err = capsys.readouterr()
     return code, out, err
 
@@ -48,19 +51,20 @@ def test_out_writes_trajectories_atomically(capsys, tmp_path):
     files = sorted(p.name for p in out.iterdir())
     assert files == ["summary.json", "trajectory_F1_10N.csv", "trajectory_F1_20N.csv"]
     lines = (out / "trajectory_F1_10N.csv").read_text().splitlines()
-    assert lines[1] == "t_s,r_mm,h_mm,p_b_Pa,p_Pa,u_c_nm,N,N_dot_per_s,phi_s,ballistic_share"
+    assert lines[0] == "cup,t_s,r_mm,h_mm,p_b_Pa,p_Pa,u_c_nm,N,N_dot_per_s,phi_s,ballistic_share"
+    assert lines[1].startswith("A,0,")
     assert len(lines) > 10
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]   # no temp dirs left
 
 
 @pytest.mark.parametrize("argv,message", [
     (["--force", "-3"], "--force: pull force must be > 0 N"),
-    (["--cup", "C"], "cup: unknown cup 'C'"),
+    (["--cup", "C"], "argument --cup: invalid cup 'C'"),
     (["--uc-table", "/nonexistent/uc.csv"], "uc-table: no such file"),
     (["--stiffness", "/nonexistent/F0.csv"], "--stiffness: no such file"),
     (["--relaxation", "/nonexistent/E.csv"], "relaxation: no such file"),
     (["--reference-mode", "--E-MPa", "3"], "--reference-mode: fixes --E-MPa"),
-    (["--E-MPa", "0"], "--E-MPa: modulus must be > 0 MPa"),
+    (["--E-MPa", "0"], "--E-MPa: Young's modulus must be > 0 MPa"),
     (["--fluid", "water", "--relaxation", "default"], "fluid: the water-filled cavity"),
     (["--reference-mode", "--fluid", "water"], "--reference-mode: fixes --fluid"),
     (["--cavitation-kPa", "2.34"], "--cavitation-kPa: only with --fluid water"),
@@ -86,9 +90,9 @@ def test_example_writes_table_and_figure(capsys, tmp_path):
     code, stdout, _ = _run(capsys, "example", "--out", str(tmp_path / "ex"))
     assert code == 0
     lines = (tmp_path / "ex" / "lifetime_vs_force.csv").read_text().splitlines()
-    assert lines[0].startswith("force_N,lifetime_s,reason")
+    assert lines[0].startswith("cup,force_N,lifetime_s,reason")
     assert len(lines) == 17                                   # 5, 10, ..., 80 N
-    lives = [float(l.split(",")[1]) for l in lines[1:]]
+    lives = [float(l.split(",")[2]) for l in lines[1:]]
     assert all(math.isfinite(t) and t > 0 for t in lives)
     png = (tmp_path / "ex" / "lifetime_vs_force.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
@@ -102,7 +106,7 @@ def test_stiffness_csv_is_the_same_mechanism_as_appendix_a(capsys, tmp_path):
     assert code == code_ref == 0
     # the CSV holds the same samples to 10 digits: the same lifetime to ~1e-9
     assert json.loads(out)[0]["lifetime_s"] == pytest.approx(json.loads(out_ref)[0]["lifetime_s"], rel=1e-7)
-    code, _, err = _run(capsys, "lifetime", "--stiffness", str(path), "--geometry", "curve", "--force", "20")
+    code, _, err = _run(capsys, "lifetime", "--stiffness", str(path), "--cup-laws", "curve", "--force", "20")
     assert code == 2 and "geometry: 'curve' needs" in err
 
 
@@ -116,7 +120,7 @@ def test_water_json(capsys):
 
 
 @pytest.mark.parametrize("argv,message", [
-    (["--cup", "Z"], "cup: unknown cup 'Z'"),
+    (["--cup", "Z"], "argument --cup: invalid cup 'Z'"),
     (["--uc-table", "/nonexistent/uc.csv"], "uc-table: no such file"),
 ])
 def test_example_bad_input_exits_2_without_output(capsys, tmp_path, argv, message):

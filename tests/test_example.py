@@ -52,12 +52,15 @@ def test_fem_stiffness_is_a_direct_compress_cup_run(example):
 
 
 @pytest.mark.parametrize("argv,message", [
-    (["--cup", "Z"], "cup: unknown cup 'Z'"),
+    (["--cup", "Z"], "argument --cup: invalid cup 'Z'"),
     (["--surface", "glass"], "surface: unknown preset 'glass'"),
     (["--uc-table", "/nonexistent/uc.csv"], "uc-table: no such file"),
 ])
 def test_bad_input_exits_2_without_output(capsys, tmp_path, argv, message):
-    code = main(["example", "--out", str(tmp_path / "ex"), *argv])
+    try:
+        code = main(["example", "--out", str(tmp_path / "ex"), *argv])
+    except SystemExit as exc:               # argparse's own errors
+        code = exc.code
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and message in err
     assert list(tmp_path.iterdir()) == []

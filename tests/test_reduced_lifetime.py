@@ -238,18 +238,25 @@ def test_water_filled_cavity_eq24_against_an_independent_ode():
         dataclasses.replace(REF_A, fluid="oil")
 
 
-def test_curve_geometry_with_a_vanishing_strip_width_is_an_input_error():
-    # an FEM curve whose strip width is 0 where only the rim corner touches: eq (6) would divide by
-    # zero there, so the model must refuse the curve up front, naming the column
+def test_curve_geometry_with_a_vanishing_strip_width_is_a_sealing_line_contact():
+    # an FEM curve whose strip width is 0 where only the rim corner touches (u < 0.1 h1): a line
+    # contact, eq (6)'s pressure is unbounded there, u_c = 0: the cup seals when it gets there
     u = np.linspace(0.0, 0.8 * CUP_A.h1_m, 40)
     h = CUP_A.h1_m - u
     x = 1.0 + h / CUP_A.h0_m
-    l = np.where(u < 0.1 * CUP_A.h1_m, 0.0, CUP_A.l0_m + CUP_A.l_a_m * (1.0 - x))
-    curve = StiffnessCurve(u_m=u, F0_N=2.5e3 * u, h1_m=CUP_A.h1_m, r_c_m=CUP_A.r0_m * x,
-                           l_m=l, V_m3=CUP_A.V0_m3 * (x ** 3 - 1.0))
-    model = dataclasses.replace(REF_A, stiffness=curve, geometry="curve")
-    with pytest.raises(ValueError, match="l_mm: .* strip width is 0"):
-        lifetime(model, 20.0)
+    strip = CUP_A.l0_m + CUP_A.l_a_m * (1.0 - x)
+    l = np.where(u < 0.1 * CUP_A.h1_m, 0.0, strip)
+    kw = dict(u_m=u, F0_N=2.5e3 * u, h1_m=CUP_A.h1_m, r_c_m=CUP_A.r0_m * x, V_m3=CUP_A.V0_m3 * (x ** 3 - 1.0))
+    line = lifetime(dataclasses.replace(REF_A, stiffness=StiffnessCurve(l_m=l, **kw), geometry="curve"), 20.0)
+    assert line.reason == "sealed" and math.isinf(line.lifetime_s) and "line contact" in line.message
+    sealed_h = float(line.message.split("h = ")[1].split(" mm")[0]) * 1e-3
+    # PCHIP keeps l = 0 from the last zero sample u_z on: the first point of the fold-search grid
+    # (h1 / 1200 apart) at or above h1 - u_z
+    u_z = u[u < 0.1 * CUP_A.h1_m][-1]
+    assert CUP_A.h1_m - u_z - 1e-6 <= sealed_h <= CUP_A.h1_m - u_z + CUP_A.h1_m / 1200 + 1e-6
+    # the same curve with the strip everywhere leaks to r1 in finite time
+    open_ = lifetime(dataclasses.replace(REF_A, stiffness=StiffnessCurve(l_m=strip, **kw), geometry="curve"), 20.0)
+    assert open_.reason in ("reached_r1", "fold") and 0 < open_.lifetime_s < math.inf
 
 
 def test_water_cavitation_against_a_hand_written_bubble_ode():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import os
 import secrets
 import shutil
@@ -52,6 +53,25 @@ def atomic_file(path: str | os.PathLike) -> Iterator[Path]:
         os.replace(tmp, path)
     finally:
         Path(tmp).unlink(missing_ok=True)
+
+
+def write_table(path: str | os.PathLike, columns: dict[str, object]) -> Path:
+    """A plain CSV: one header line (units in the names), then rows; numbers as %.10g, text quoted
+    only where it must be. No comment lines, so pandas.read_csv and numpy.genfromtxt read it as is.
+
+    `columns` maps each name to a sequence (all of one length) or to one value repeated (a label).
+    """
+    lengths = {len(v) for v in columns.values() if not isinstance(v, (str, int, float))}
+    if len(lengths) > 1:
+        raise ValueError(f"write_table: columns of different lengths {sorted(lengths)}")
+    n = lengths.pop() if lengths else 1
+    cells = [[v] * n if isinstance(v, (str, int, float)) else list(v) for v in columns.values()]
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(columns)
+        for row in zip(*cells):
+            w.writerow([x if isinstance(x, str) else f"{float(x):.10g}" for x in row])
+    return Path(path)
 
 
 def terminal_progress(label: str, stream=None, min_interval_s: float = 0.2) -> Progress:

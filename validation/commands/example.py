@@ -9,11 +9,12 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
    theory, EMT, nu = 0.5), the surface of the paper's Figs. for cup A.
 3. Reduced model (Sec. 3-4) in reference conventions (no relaxation, E = 4 MPa in p/E, air at
    293.15 K, p_a = 1e5 Pa) with F0(h) from step 1 and r, V, l from the cone laws (3)-(5) with
-   Table 1's l0, l1 (--geometry curve takes them from the FEM instead).
+   Table 1's l0, l1 (--cup-laws curve takes them from the FEM instead). Another design
+   (--geometry FILE) runs the same chain on its own geometry (`validation.design`).
 
 Writes to DIR, atomically:
 
-  lifetime_vs_force.csv   force_N, lifetime_s, reason, ballistic_share, r_final_mm, p_b_final_Pa
+  lifetime_vs_force.csv   cup, force_N, lifetime_s, reason, ballistic_share, r_final_mm, p_b_final_Pa
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
 """
@@ -25,6 +26,8 @@ import math
 import time
 from pathlib import Path
 
+from validation.commands._cup import add_cup_arguments, add_cup_law_arguments
+
 NAME = "example"
 HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"
 
@@ -33,14 +36,16 @@ FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (written atomically)")
-    p.add_argument("--cup", default="A", metavar="A|B", help="Table 1 cup preset (default: A)")
+    add_cup_arguments(p, "the FEM runs on it and the lifetimes use it")
+    add_cup_law_arguments(p)
     p.add_argument("--contact", default="sticking", choices=("sticking", "frictionless"),
-                   help="FEM contact with the substrate (default: sticking, Appendix A's no slip)")
+                   help="FEM contact with the substrate (default: sticking, the no-slip assumption of "
+                        "Appendix A, whose stiffness the paper's lifetimes match; `cupcheck stiffness` "
+                        "defaults to frictionless, the soap-lubricated glass of the paper's measured "
+                        "F0, Sec. 5.5)")
     p.add_argument("--fidelity", default=None, choices=("coarse", "medium", "fine"),
                    help="FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
                         "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)")
-    p.add_argument("--geometry", default="cone", choices=("cone", "curve"),
-                   help="r, V, l from the cone laws eqs 3-5 (default) or from the FEM curve")
     src = p.add_mutually_exclusive_group()
     src.add_argument("--surface", default=None, metavar="NAME",
                      help="calibrated surface preset for u_c(p/E) (default: pmma-1.89)")
@@ -49,32 +54,39 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _inputs(args: argparse.Namespace):
-    """Every check before the solve: (cup parameters, u_c table, its label)."""
+    """Every check before the solve: (the FEM geometry, u_c table, its label)."""
     import os
 
-    from reduced.cup import cup_by_name
+    from fem.geometry import cup_geometry, load_geometry
+    from validation.guards import check_design, check_uc_table
 
-    cup = cup_by_name(args.cup)
+    geometry = load_geometry(args.geometry, cup=args.cup or "A") if args.geometry is not None \
+        else cup_geometry(args.cup or "A")
+    check_design(geometry.describe(), args.allow_unusual_design, source=geometry.name)
     if args.uc_table is not None:
         if not os.path.isfile(args.uc_table):
             raise ValueError(f"uc-table: no such file {args.uc_table!r}")
         from reduced.critical_gap import UcTable
-        return cup, UcTable.from_csv(args.uc_table), Path(args.uc_table).name
+        table = UcTable.from_csv(args.uc_table)
+        check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
+        return geometry, table, Path(args.uc_table).name
     from reduced.roughness import uc_table
     from reduced.roughness.surfaces import preset
     name = args.surface or "pmma-1.89"
-    return cup, uc_table(preset(name).spectrum(), 0.5), name
+    return geometry, uc_table(preset(name).spectrum(), 0.5), name
 
 
-def fem_stiffness(cup_name: str, contact: str, fidelity: str, progress=None):
-    """(CupResponse, StiffnessCurve) of the preset cup: the FEM step of the main job."""
+def fem_stiffness(geometry, contact: str, fidelity: str, progress=None):
+    """(CupResponse, StiffnessCurve) of a cup geometry (`fem.geometry.CupGeometry` or a preset
+    name): the FEM step of the main job."""
     from fem.cup import compress_cup
     from fem.geometry import cup_geometry
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh, mesh_spec
     from validation import handoff
 
-    geometry = cup_geometry(cup_name)
+    if isinstance(geometry, str):
+        geometry = cup_geometry(geometry)
     mesh = cup_mesh(geometry, fidelity)
     response = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact=contact,
                             u_max_m=0.9 * geometry.h1_m, progress=progress)
@@ -83,18 +95,19 @@ def fem_stiffness(cup_name: str, contact: str, fidelity: str, progress=None):
     return response, handoff.stiffness_curve(response, prov)
 
 
-def write_table(results, path: Path) -> None:
-    cols = ("force_N", "lifetime_s", "reason", "ballistic_share", "r_final_mm", "p_b_final_Pa")
-    with open(path, "w") as f:
-        f.write(",".join(cols) + "\n")
-        for r in results:
-            s = r.summary()
-            life = "inf" if s["lifetime_s"] is None else f"{s['lifetime_s']:.8g}"
-            f.write(f"{r.force_N:g},{life},{r.reason},{s['ballistic_share']:.6f},"
-                    f"{s['r_final_mm']:.6f},{s['p_b_final_Pa']:.6g}\n")
+def write_table(results, path: Path, cup: str) -> None:
+    from validation.output import write_table as write_csv
+
+    s = [r.summary() for r in results]
+    write_csv(path, {"cup": cup, "force_N": [r.force_N for r in results],
+                     "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in s],
+                     "reason": [r.reason for r in results],
+                     "ballistic_share": [x["ballistic_share"] for x in s],
+                     "r_final_mm": [x["r_final_mm"] for x in s],
+                     "p_b_final_Pa": [x["p_b_final_Pa"] for x in s]})
 
 
-def plot(results, baseline, curve, path: Path, title: str) -> None:
+def plot(results, baseline, curve, cup, path: Path, title: str) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -110,8 +123,8 @@ def plot(results, baseline, curve, path: Path, title: str) -> None:
     ax[0].legend(fontsize=8)
     u = curve.u_m
     ax[1].plot(1e3 * u, curve.F0_N, label="FEM")
-    alpha = curve.provenance.get("geometry", {}).get("alpha_deg", 33.0)
-    ax[1].plot(1e3 * u, appendix_a_force(u, alpha, 4e6, 2e-3, 5e-3, 19e-3), "--", label="Appendix A")
+    ax[1].plot(1e3 * u, appendix_a_force(u, cup.alpha_deg, 4e6, 2e-3, cup.r0_m, cup.r1_m), "--",
+               label="Appendix A")
     ax[1].set(xlabel="plate displacement u (mm)", ylabel="stiffness force $F_0$ (N)")
     ax[1].legend(fontsize=8)
     fig.savefig(path, dpi=110)
@@ -123,29 +136,33 @@ def run(args: argparse.Namespace) -> int:
 
     from reduced.lifetime import lifetime_sweep, reference_model
     from validation import handoff
+    from validation.design import resolve_cup
     from validation.output import atomic_directory, terminal_progress
 
     from fem.mesh import DEFAULT_FIDELITY
 
     t0 = time.perf_counter()
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
-    cup, uc, uc_label = _inputs(args)
+    geometry, uc, uc_label = _inputs(args)
     with atomic_directory(args.out) as tmp:
-        response, curve = fem_stiffness(cup.name, args.contact, args.fidelity, terminal_progress("FEM"))
-        curve.to_csv(tmp / "stiffness_fem.csv")
+        response, curve = fem_stiffness(geometry, args.contact, args.fidelity, terminal_progress("FEM"))
+        choice = resolve_cup(curve, r_start_mm=args.r_start_mm, l0_mm=args.l0_mm, l1_mm=args.l1_mm,
+                             curve_label="the FEM curve")
+        curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
         handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
-        base = reference_model(cup, uc)
-        model = replace(base, stiffness=curve, geometry=args.geometry, label="FEM-fed")
+        base = reference_model(choice.cup, uc)
+        model = replace(base, stiffness=curve, geometry=args.cup_laws, label="FEM-fed")
         results = lifetime_sweep(model, FORCES_N, progress=terminal_progress("lifetime"), refine=4)
         baseline = lifetime_sweep(base, FORCES_N, refine=1)
-        write_table(results, tmp / "lifetime_vs_force.csv")
-        plot(results, baseline, curve, tmp / "lifetime_vs_force.png",
-             f"cup {cup.name}, FEM {args.contact} ({args.fidelity}), {uc_label}")
+        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name)
+        plot(results, baseline, curve, choice.cup, tmp / "lifetime_vs_force.png",
+             f"{choice.label}, FEM {args.contact} ({args.fidelity}), {uc_label}")
     wall = time.perf_counter() - t0
     slope = float(curve.force(curve.h1_m - 1e-3))
-    print(f"cup {cup.name}: FEM {args.contact} stiffness ({args.fidelity}, {response.stats.steps} steps), "
+    laws = "cone laws (3)-(5), l0, l1: " + choice.l_source if args.cup_laws == "cone" else "FEM curve"
+    print(f"{choice.label}: FEM {args.contact} stiffness ({args.fidelity}, {response.stats.steps} steps), "
           f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
-          f"r, V, l from the {'cone laws (3)-(5)' if args.geometry == 'cone' else 'FEM curve'}")
+          f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V, l from the {laws}")
     print(f"  {'F1 (N)':>7} {'lifetime (s)':>13} {'Appendix A-fed (s)':>19}  end")
     for r, b in zip(results, baseline):
         print(f"  {r.force_N:7g} {r.lifetime_s:13.4g} {b.lifetime_s:19.4g}  {r.reason}")

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from validation.commands._cup import add_cup_arguments, add_cup_law_arguments
 from validation.commands._surface import add_surface_arguments, has_surface, spectrum_from_args
 
 NAME = "lifetime"
@@ -31,12 +32,15 @@ HELP = "lifetime of a suction cup under pull forces (reduced leakage model, eqs 
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--cup", default="A", metavar="A|B", help="Table 1 cup preset (default: A)")
+    add_cup_arguments(p, "with --stiffness FILE, the curve's own design is used and an explicit "
+                         "cup must agree with it")
+    add_cup_law_arguments(p)
     p.add_argument("--force", dest="force_N", type=float, nargs="+", default=[10.0], metavar="F1_N",
                    help="pull force(s) F1 in N, > 0 (default: 10)")
     p.add_argument("--stiffness", default="appendix-a", metavar="appendix-a|FILE.csv",
                    help="stiffness force F0: the Appendix A formula, or a StiffnessCurve CSV "
-                        "(columns u_mm,F0_N[,h_mm,r_c_mm,l_mm,V_mm3]) (default: appendix-a)")
+                        "(columns u_mm,F0_N[,h_mm,r_c_mm,l_mm,V_mm3]; its JSON sidecar, if any, "
+                        "names the cup design) (default: appendix-a)")
     p.add_argument("--E-MPa", dest="E_MPa", type=float, default=4.0,
                    help="Young's modulus in MPa for Appendix A and for p/E without relaxation (default: 4)")
     p.add_argument("--d0-mm", dest="d0_mm", type=float, default=2.0,
@@ -60,9 +64,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--phi0-s", dest="phi0_s", type=float, default=None,
                    help="contact time of the stiffness measurement in s (default: l/rdot at r_start "
                         "and 0.12 mm/s plate speed, 13.0 s for cup A)")
-    p.add_argument("--geometry", default="cone", choices=("cone", "curve"),
-                   help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 (cone) or from the "
-                        "stiffness CSV's r_c_mm, V_mm3, l_mm columns (curve) (default: cone)")
     p.add_argument("--fluid", default="air", choices=("air", "water"),
                    help="what fills the cavity and leaks in: air (ideal gas, eqs 8, 19) or water "
                         "(incompressible, eq 24; p_b from the force balance, may be negative) (default: air)")
@@ -94,58 +95,65 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
     """The critical gap u_c(p/E) [m] the options ask for (the one place that builds it)."""
     from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
+    from validation.guards import check_spectrum, check_uc_table
     if has_surface(args):
         from reduced.roughness import uc_table
         from reduced.roughness.persson import check_gap_parameters, effective_modulus
         import numpy as np
         effective_modulus(1e6, args.nu)                                   # validates nu
         check_gap_parameters(np.array([1.0]), args.uc_method, args.gamma, args.a_c)
-        return uc_table(spectrum_from_args(args), args.nu, method=args.uc_method,
-                        gamma=args.gamma, a_c=args.a_c)
-    return UcTable.from_csv(args.uc_table if args.uc_table else ILLUSTRATIVE_UC_CSV)
+        spectrum = spectrum_from_args(args)
+        check_spectrum(spectrum.h_rms_m(), "surface")
+        return uc_table(spectrum, args.nu, method=args.uc_method, gamma=args.gamma, a_c=args.a_c)
+    table = UcTable.from_csv(args.uc_table if args.uc_table else ILLUSTRATIVE_UC_CSV)
+    check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
+    return table
 
 
 def build_model(args: argparse.Namespace):
-    """Validate the options and build the `LeakageModel` (cheap; raises ValueError on bad input)."""
+    """Validate the options and build the `LeakageModel` (cheap; raises ValueError on bad input).
+
+    The cup comes from the stiffness curve's recorded design, else from --geometry / --cup
+    (`validation.design`); the chosen `CupChoice` is kept on ``args.cup_choice`` for the outputs.
+    """
     from reduced.appendix_a import appendix_a_curve
-    from reduced.cup import cup_by_name
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel, largest_holdable_force, reference_model
-    from reduced.stiffness_curve import StiffnessCurve
     from reduced.viscoelastic import RelaxationModulus, default_relaxation
+    from validation.guards import check_design, check_modulus
 
-    cup = cup_by_name(args.cup)
     for F in args.force_N:
         if not (math.isfinite(F) and F > 0):
             raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
     if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
         raise ValueError(f"--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
+    check_modulus(args.E_MPa, "--E-MPa")
+    curve, choice = _curve_and_cup(args)
+    check_design(choice.design, args.allow_unusual_design, source=choice.label)
+    args.cup_choice = choice
+    cup = choice.cup
     uc = build_uc(args)
     if args.reference_mode:
         changed = [opt for opt, val, default in (
             ("--stiffness", args.stiffness, "appendix-a"), ("--E-MPa", args.E_MPa, 4.0),
             ("--d0-mm", args.d0_mm, 2.0), ("--relaxation", args.relaxation, "none"),
-            ("--geometry", args.geometry, "cone"), ("--T-K", args.T_K, 293.15),
+            ("--cup-laws", args.cup_laws, "cone"), ("--T-K", args.T_K, 293.15),
             ("--p-a-Pa", args.p_a_Pa, 1e5), ("--phi0-s", args.phi0_s, None),
             ("--fluid", args.fluid, "air"), ("--cavitation-kPa", args.cavitation_kPa, None))
             if val != default]
         if changed:
             raise ValueError(f"--reference-mode: fixes {', '.join(changed)}; drop them")
         return reference_model(cup, uc)
-    if not (math.isfinite(args.E_MPa) and args.E_MPa > 0):
-        raise ValueError(f"--E-MPa: modulus must be > 0 MPa, got {args.E_MPa:g}")
     p_cav = args.cavitation_kPa
     if p_cav is not None and args.fluid != "water":
         raise ValueError("--cavitation-kPa: only with --fluid water")
     if p_cav is not None and not (math.isfinite(p_cav) and 0 <= 1e3 * p_cav < args.p_a_Pa):
         raise ValueError(f"--cavitation-kPa: must be in [0, p_a) = [0, {args.p_a_Pa / 1e3:g}) kPa, "
                          f"got {p_cav:g}")
-    if args.stiffness == "appendix-a":
+    if curve is None:
         if not (math.isfinite(args.d0_mm) and args.d0_mm > 0):
             raise ValueError(f"--d0-mm: wall thickness must be > 0 mm, got {args.d0_mm:g}")
         curve = appendix_a_curve(cup, E_Pa=1e6 * args.E_MPa, d0_m=1e-3 * args.d0_mm)
-    else:
-        curve = StiffnessCurve.from_csv(args.stiffness, h1_m=None if _has_h(args.stiffness) else cup.h1_m)
     if args.relaxation == "none":
         relax = None
     elif args.relaxation == "default":
@@ -155,11 +163,28 @@ def build_model(args: argparse.Namespace):
     gas = Gas(T_K=args.T_K)
     model = LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
                          E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
-                         geometry=args.geometry, fluid=args.fluid,
+                         geometry=args.cup_laws, fluid=args.fluid,
                          liquid_viscosity_Pa_s=args.liquid_viscosity,
-                         cavitation_pressure_Pa=None if p_cav is None else 1e3 * p_cav)
+                         cavitation_pressure_Pa=None if p_cav is None else 1e3 * p_cav,
+                         label=choice.label)
     largest_holdable_force(model)   # builds the start state: checks geometry and curve range now
     return model
+
+
+def _curve_and_cup(args: argparse.Namespace):
+    """(the stiffness curve or None for Appendix A, the `CupChoice`)."""
+    from reduced.stiffness_curve import StiffnessCurve
+    from validation.design import explicit_design, resolve_cup
+
+    options = dict(cup=args.cup, geometry_file=args.geometry, r_start_mm=args.r_start_mm,
+                   l0_mm=args.l0_mm, l1_mm=args.l1_mm)
+    if args.stiffness == "appendix-a":
+        if args.cup_laws == "curve":
+            raise ValueError("--cup-laws: 'curve' needs --stiffness FILE.csv with r_c_mm, V_mm3, l_mm")
+        return None, resolve_cup(None, **options)
+    h1 = None if _has_h(args.stiffness) else 1e-3 * explicit_design(args.cup, args.geometry)["h1_mm"]
+    curve = StiffnessCurve.from_csv(args.stiffness, h1_m=h1)
+    return curve, resolve_cup(curve, curve_label=f"'{args.stiffness}'", **options)
 
 
 def _has_h(path: str) -> bool:
@@ -172,16 +197,18 @@ def _has_h(path: str) -> bool:
     return False
 
 
-def write_trajectories(results, out: Path) -> None:
-    """One CSV per force (units in the column names) and summary.json, into an existing dir."""
+def write_trajectories(results, out: Path, cup: dict) -> None:
+    """One CSV per force (the cup's name first, units in the column names) and summary.json."""
+    from validation.output import write_table
+
     for r in results:
-        cols = r.trajectory_columns()
-        path = out / f"trajectory_F1_{r.force_N:g}N.csv"
-        with open(path, "w") as f:
-            f.write(f"# cupcheck lifetime: F1 = {r.force_N:g} N, reason {r.reason}; {r.message}\n")
-            f.write(",".join(cols) + "\n")
-            np.savetxt(f, np.column_stack(list(cols.values())), delimiter=",", fmt="%.10g")
-    (out / "summary.json").write_text(json.dumps([r.summary() for r in results], indent=2) + "\n")
+        write_table(out / f"trajectory_F1_{r.force_N:g}N.csv", {"cup": cup["name"], **r.trajectory_columns()})
+    (out / "summary.json").write_text(json.dumps(summaries(results, cup), indent=2) + "\n")
+
+
+def summaries(results, cup: dict) -> list[dict]:
+    """Per force the result's summary and the cup it was computed for."""
+    return [{**r.summary(), "cup": cup} for r in results]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -189,6 +216,10 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import atomic_directory, terminal_progress
 
     model = build_model(args)
+    choice = args.cup_choice
+    cup = {**choice.describe(), "laws": args.cup_laws}
+    for note in choice.notes:
+        print(f"note: {note}", file=sys.stderr)
     if args.uc_table is None and not has_surface(args) and not args.json:
         print("note: using the ILLUSTRATIVE u_c table (reduced/data/uc_illustrative.csv)", file=sys.stderr)
     # a reference-mode lifetime takes milliseconds, a relaxed one ~0.1 s: report only long sweeps
@@ -201,12 +232,15 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         with atomic_directory(args.out) as tmp:
             results = compute()
-            write_trajectories(results, tmp)
+            write_trajectories(results, tmp, cup)
     else:
         results = compute()
     if args.json:
-        print(json.dumps([r.summary() for r in results], indent=2))
+        print(json.dumps(summaries(results, cup), indent=2))
     else:
+        laws = "cone laws (3)-(5)" if args.cup_laws == "cone" else "the stiffness curve"
+        print(f"cup: {choice.label} from the {choice.source}; r_start {cup['r_start_mm']:.4g} mm; "
+              f"r, V, l from {laws}" + (f"; l0, l1: {choice.l_source}" if args.cup_laws == "cone" else ""))
         print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'ballistic':>9} {'r_end_mm':>8}")
         for r in results:
             life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"

@@ -27,6 +27,8 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
+from validation.commands._cup import add_cup_arguments
+
 NAME = "stiffness"
 HELP = "FEM stiffness curve F0(h), r_c, l, V of cup A, B or your own design (CSV + JSON sidecar)"
 
@@ -38,13 +40,7 @@ FIELD_SUFFIXES = (".vtu", ".vtk", ".xdmf")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    g = parser.add_argument_group("cup")
-    g.add_argument("--cup", choices=("A", "B"), default="A",
-                   help="preset of Table 1 / Sec. 5.5 (A: alpha 33 deg, d 2.5 -> 0.3 mm; B: 21 deg, "
-                        "1.5 -> 0.3 mm; r0 5 mm, r1 19 mm); also the base of --geometry (default A)")
-    g.add_argument("--geometry", metavar="FILE", type=Path,
-                   help="geometry file (.toml or .json; keys r0_mm, r1_mm, alpha_deg, "
-                        "thickness_convention, thickness = {r_mm = [...], d_mm = [...]}) overriding --cup")
+    g = add_cup_arguments(parser, "also the base of --geometry")
     g.add_argument("--thickness-convention", choices=("normal", "vertical"),
                    help="wall thickness measured along the cavity surface's normal or vertically "
                         "(default: normal, or the geometry file's)")
@@ -62,7 +58,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "incompressible, nu up to 0.4999)")
     m.add_argument("--contact", choices=("frictionless", "sticking"), default="frictionless",
                    help="contact with the plane: frictionless, or sticking (a touching point stops "
-                        "sliding) (default frictionless)")
+                        "sliding) (default frictionless: the soap-lubricated glass on which the paper "
+                        "measured F0, Sec. 5.5; `cupcheck example` defaults to sticking, Appendix A's "
+                        "no-slip assumption)")
     r = parser.add_argument_group("run")
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default=None,
                    help="mesh level of a generated mesh (default medium: F0 within 1 %% of the "
@@ -85,13 +83,19 @@ def run(args: argparse.Namespace) -> int:
     from validation import handoff
     from validation.output import atomic_file, terminal_progress
 
-    response = compress_cup(job["mesh"], job["material"], contact=args.contact, u_max_m=job["u_max_m"],
-                            progress=terminal_progress("stiffness"))
+    from fem.solver import ConvergenceError
+    from validation.commands._failure import solver_failure
+
+    try:
+        response = compress_cup(job["mesh"], job["material"], contact=args.contact,
+                                u_max_m=job["u_max_m"], progress=terminal_progress("stiffness"))
+    except ConvergenceError as exc:
+        raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
     prov = handoff.provenance(response, geometry=job["geometry"], mesh=job["mesh_info"],
                               fidelity=job["fidelity"])
     curve = handoff.stiffness_curve(response, prov)
     with atomic_file(job["sidecar"]) as tmp_json, atomic_file(args.out) as tmp_csv:
-        curve.to_csv(tmp_csv)
+        curve.to_csv(tmp_csv, sidecar=False)
         handoff.write_sidecar(handoff.sidecar(response, prov), tmp_json)
         if args.fields_out is not None:
             with atomic_file(args.fields_out) as tmp_fields:
@@ -126,7 +130,9 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
             raise ValueError(f"fields_out: must end in .vtu or .vtk (the last step) or .xdmf (every "
                              f"step), in any case, got '{fields}'")
         _writable(fields, "fields_out")
-    material = NeoHookean(E_Pa=_positive(args.E_MPa, "E_MPa", "Young's modulus") * 1e6,
+    from validation.guards import check_design, check_modulus
+
+    material = NeoHookean(E_Pa=check_modulus(args.E_MPa) * 1e6,
                           nu=args.nu, formulation=args.formulation)
     if material.formulation == "displacement" and material.nu > LOCKING_NU:
         raise ValueError(f"nu: with the displacement formulation Poisson's ratio must be <= "
@@ -134,7 +140,7 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
                          f"--formulation mixed for nu up to 0.4999, got {args.nu:g}")
     fidelity = args.fidelity or DEFAULT_FIDELITY
     if args.mesh is not None:
-        given = [o for o, v in (("--geometry", args.geometry), ("--fidelity", args.fidelity),
+        given = [o for o, v in (("--geometry", args.geometry), ("--fidelity", args.fidelity), ("--cup", args.cup),
                                 ("--thickness-convention", args.thickness_convention)) if v is not None]
         if given:
             raise ValueError(f"mesh: a mesh file fixes the geometry and the mesh; drop {', '.join(given)}")
@@ -144,12 +150,13 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
                      "sha256": hashlib.sha256(Path(args.mesh).read_bytes()).hexdigest()}
         fidelity = None
     else:
-        geo = load_geometry(args.geometry, cup=args.cup) if args.geometry is not None \
-            else cup_geometry(args.cup)
+        geo = load_geometry(args.geometry, cup=args.cup or "A") if args.geometry is not None \
+            else cup_geometry(args.cup or "A")
         if args.thickness_convention is not None:
             geo = replace(geo, thickness_convention=args.thickness_convention)
-        mesh = cup_mesh(geo, fidelity)
         geometry = geo.describe()
+        check_design(geometry, args.allow_unusual_design, source=geo.name)
+        mesh = cup_mesh(geo, fidelity)
         mesh_info = {"generated": asdict(FIDELITIES[fidelity])}
     mesh_info.update(element=type(mesh).__name__, elements=int(mesh.t.shape[1]),
                      nodes=int(mesh.doflocs.shape[1]))

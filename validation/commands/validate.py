@@ -5,7 +5,8 @@ Writes to DIR, atomically: README.md (all sections, tables inline), one CSV per 
 column names), PNG figures, and summary.json with the headline numbers (appendix_a_slope_N_per_mm,
 fem_slope_frictionless_N_per_mm, fem_slope_sticking_N_per_mm, ...). Every FEM run a section needs is
 declared up front and run once; --cache-dir keeps them between calls (keyed by the run and the fem
-sources).
+sources). The report is written in full either way; the exit status is 1 when any of its checks
+FAILs (the rows marked FAIL), 0 when all pass.
 
 examples:
   cupcheck validate --quick --out out/validate-quick            # the CI subset, ~1 min
@@ -16,6 +17,7 @@ examples:
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 NAME = "validate"
@@ -62,4 +64,14 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {args.out}/README.md, {len(report.files)} tables and figures, summary.json "
           f"({s['fem_runs_computed']} FEM runs computed, {s['fem_runs_from_cache']} from cache, "
           f"{s['wall_s']:.0f} s)")
+    failed = failed_checks(s)
+    if failed:
+        print(f"validate: {failed} check(s) FAIL (the rows marked FAIL in {args.out}/README.md); exit "
+              f"status 1", file=sys.stderr)
+        return 1
     return 0
+
+
+def failed_checks(summary: dict) -> int:
+    """How many rows of the report failed a check (today: the extremes' FAIL rows)."""
+    return int(summary.get("extremes_outcomes", {}).get("FAIL", 0))

@@ -1,0 +1,63 @@
+"""The cup options, one meaning in every command: which cup (`--cup`, `--geometry FILE`) and, for
+the lifetime, where r(h), V(h), l(h) come from (`--cup-laws`) and the reduced model's start.
+
+`--cup` takes A or B in any case; `--geometry` is always a design file (.toml or .json, the keys of
+`fem.geometry.load_geometry`). Shared by `stiffness`, `lifetime` and `example`.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from reduced.cup import CUPS
+
+
+def cup_name(value: str) -> str:
+    """argparse type: a Table 1 preset name, case-insensitive."""
+    key = value.strip().upper()
+    if key not in CUPS:
+        raise argparse.ArgumentTypeError(f"invalid cup {value!r} (choose from {', '.join(CUPS)}, any case)")
+    return key
+
+
+def design_file(value: str) -> Path:
+    """argparse type: a geometry file (the former cone|curve meaning moved to --cup-laws)."""
+    if value in ("cone", "curve"):
+        raise argparse.ArgumentTypeError(f"'{value}' is not a geometry file: the cone/curve choice "
+                                         f"is --cup-laws {value}")
+    return Path(value)
+
+
+def add_cup_arguments(parser: argparse.ArgumentParser, role: str):
+    """--cup, --geometry FILE, --allow-unusual-design in a group "cup" (returned for more options);
+    `role` says what the cup is used for."""
+    g = parser.add_argument_group("cup")
+    g.add_argument("--cup", type=cup_name, default=None, metavar="A|B",
+                   help="Table 1 cup preset, any case (A: alpha 33 deg, d 2.5 -> 0.3 mm; B: 21 deg, "
+                        f"1.5 -> 0.3 mm; r0 5 mm, r1 19 mm); {role} (default: A)")
+    g.add_argument("--geometry", type=design_file, default=None, metavar="FILE",
+                   help="your design (.toml or .json; keys cup, r0_mm, r1_mm, alpha_deg, "
+                        "thickness_convention, thickness = {r_mm = [...], d_mm = [...]}), "
+                        "starting from --cup")
+    g.add_argument("--allow-unusual-design", action="store_true",
+                   help="accept a cone angle outside 5..80 deg or a wall more than 400x longer "
+                        "than thick (refused by default: the FEM meshes cannot resolve them)")
+    return g
+
+
+def add_cup_law_arguments(parser: argparse.ArgumentParser) -> None:
+    """--cup-laws, --r-start-mm, --l0-mm, --l1-mm: the reduced model's cup."""
+    g = parser.add_argument_group("reduced-model cup")
+    g.add_argument("--cup-laws", default="cone", choices=("cone", "curve"),
+                   help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 with the cup's r0, r1, "
+                        "alpha (cone), or from the stiffness curve's r_c_mm, V_mm3, l_mm columns "
+                        "(curve; l = 0 is a line contact, sealed) (default: cone)")
+    g.add_argument("--r-start-mm", dest="r_start_mm", type=float, default=None,
+                   help="inner contact radius after pressing on, in (r0, r1) mm (default: 12 mm "
+                        "for cups A and B (Table 1), (r0 + r1)/2 for other designs)")
+    g.add_argument("--l0-mm", dest="l0_mm", type=float, default=None,
+                   help="eq (5)'s strip width at r0 in mm (default: Table 1 for cups A and B; for "
+                        "other designs fitted to the FEM curve's l(r_c))")
+    g.add_argument("--l1-mm", dest="l1_mm", type=float, default=None,
+                   help="eq (5)'s strip width at r1 in mm (with --l0-mm)")

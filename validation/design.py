@@ -1,0 +1,177 @@
+"""Which cup a lifetime is computed for: the stiffness curve's recorded design, a geometry file or a
+Table 1 preset, turned into the reduced model's `CupParameters` (eqs 3-6).
+
+An FEM stiffness curve records the design it was computed for (`StiffnessCurve.design`: r0, r1,
+alpha, h1, the thickness profile). A lifetime takes the cup from there; an explicit ``--cup`` or
+``--geometry FILE`` must describe the same cup, or the run is refused with both named. A curve
+that names no design (a measured CSV, a user's mesh) takes the explicit cup, else cup A with a
+note saying so.
+
+For a Table 1 cup (A, B) the reduced model keeps the paper's r_start = 12 mm, l0, l1 and
+beta = 0.8. Any other design keeps beta = 0.8 (Table 1's value for both cups), starts at the middle
+of the wall, r_start = (r0 + r1) / 2 (where 12 mm lies for A and B), and takes eq (5)'s strip
+widths l0, l1 from a least-squares line through the curve's l(r_c) samples, unless given.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from reduced.cup import CUPS, CupParameters
+from reduced.stiffness_curve import StiffnessCurve
+
+__all__ = ["CupChoice", "resolve_cup", "explicit_design", "preset_design", "same_design"]
+
+_MM = 1e-3
+#: relative tolerance of two designs being the same cup
+_SAME = 1e-6
+
+
+@dataclass(frozen=True)
+class CupChoice:
+    """The cup a lifetime uses, where it came from, and what was assumed on the way."""
+
+    cup: CupParameters
+    design: dict[str, Any]     # the design record (`CupGeometry.describe`: mm, degrees)
+    label: str                 # e.g. "cup A (Table 1)", "my_cup.toml: r0 5, r1 25 mm, alpha 40 deg"
+    source: str                # "stiffness curve", "geometry file", "preset" or "default preset"
+    l_source: str              # where eq (5)'s l0, l1 come from
+    notes: tuple[str, ...] = ()
+
+    def describe(self) -> dict[str, Any]:
+        """JSON-ready description (mm, degrees) for every lifetime output."""
+        c = self.cup
+        return {"label": self.label, "name": c.name, "source": self.source,
+                "r0_mm": c.r0_m / _MM, "r1_mm": c.r1_m / _MM, "alpha_deg": c.alpha_deg,
+                "h1_mm": c.h1_m / _MM, "r_start_mm": c.r_start_m / _MM, "l0_mm": c.l0_m / _MM,
+                "l1_mm": c.l1_m / _MM, "beta": c.beta, "l_source": self.l_source}
+
+
+def preset_design(name: str) -> dict[str, Any]:
+    """The FEM design record (`fem.geometry.CupGeometry.describe`) of Table 1 cup `name`."""
+    from fem.geometry import cup_geometry          # numpy only: no FEM machinery is imported
+    return cup_geometry(name).describe()
+
+
+def same_design(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
+    """True if two design records describe the same cup (radii, angle, thickness at both ends)."""
+    keys = ("r0_mm", "r1_mm", "alpha_deg", "d_at_r0_mm", "d_at_r1_mm")
+    for k in keys:
+        if k in a and k in b and not math.isclose(float(a[k]), float(b[k]), rel_tol=_SAME, abs_tol=1e-9):
+            return False
+    return a.get("thickness_convention", "normal") == b.get("thickness_convention", "normal")
+
+
+def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
+                geometry_file: str | Path | None = None, r_start_mm: float | None = None,
+                l0_mm: float | None = None, l1_mm: float | None = None,
+                curve_label: str = "the stiffness curve") -> CupChoice:
+    """The cup for a lifetime: the curve's design, checked against an explicit cup or file."""
+    explicit = explicit_design(cup, geometry_file) if (cup or geometry_file) else None
+    explicit_label = f"--geometry {geometry_file}" if geometry_file is not None else f"--cup {cup}"
+    recorded = curve.design if curve is not None else None
+    notes: list[str] = []
+    if recorded is not None and explicit is not None and not same_design(recorded, explicit):
+        raise ValueError(f"cup: {curve_label} was computed for {_label(recorded)}, but "
+                         f"{explicit_label} is {_label(explicit)}; drop the option or use that "
+                         f"cup's curve")
+    if recorded is not None:
+        design, source = recorded, "stiffness curve"
+    elif explicit is not None:
+        design, source = explicit, ("geometry file" if geometry_file is not None else "preset")
+    else:
+        design, source = preset_design("A"), "default preset"
+        if curve is not None:
+            notes.append(f"{curve_label} names no cup design: cup A of Table 1 assumed "
+                         f"(give --cup or --geometry)")
+    if curve is not None:
+        _check_height(design, curve, curve_label)
+    params, l_source = _parameters(design, curve, r_start_mm, l0_mm, l1_mm)
+    return CupChoice(cup=params, design=dict(design), label=_label(design), source=source, l_source=l_source,
+                     notes=tuple(notes))
+
+
+def explicit_design(cup: str | None, geometry_file: str | Path | None) -> dict[str, Any]:
+    """The design record of a geometry file (starting from preset `cup`) or of preset `cup`
+    (cup A when neither is given)."""
+    if geometry_file is not None:
+        from fem.geometry import load_geometry
+        return load_geometry(geometry_file, cup=cup or "A").describe()
+    return preset_design(cup or "A")
+
+
+def _preset_of(design: Mapping[str, Any]) -> str | None:
+    return next((name for name in CUPS if same_design(design, preset_design(name))), None)
+
+
+def _label(design: Mapping[str, Any]) -> str:
+    preset = _preset_of(design)
+    if preset is not None:
+        return f"cup {preset} (Table 1)"
+    return (f"{design.get('name', 'a custom design')} (r0 {design['r0_mm']:.4g} mm, r1 "
+            f"{design['r1_mm']:.4g} mm, alpha {design['alpha_deg']:.4g} deg)")
+
+
+def _check_height(design: Mapping[str, Any], curve: StiffnessCurve, curve_label: str) -> None:
+    h1 = (design["r1_mm"] - design["r0_mm"]) * math.tan(math.radians(design["alpha_deg"]))
+    if not math.isclose(h1, 1e3 * curve.h1_m, rel_tol=1e-4):
+        raise ValueError(f"cup: {curve_label} has h1 = {1e3 * curve.h1_m:.6g} mm but {_label(design)} "
+                         f"has h1 = (r1 - r0) tan(alpha) = {h1:.6g} mm: not the same cup")
+
+
+def _parameters(design: Mapping[str, Any], curve: StiffnessCurve | None, r_start_mm: float | None,
+                l0_mm: float | None, l1_mm: float | None) -> tuple[CupParameters, str]:
+    """Table 1's parameters for a preset; the design's own otherwise (module docstring)."""
+    preset = _preset_of(design)
+    r0, r1 = design["r0_mm"] * _MM, design["r1_mm"] * _MM
+    if r_start_mm is not None and not (math.isfinite(r_start_mm) and r0 < r_start_mm * _MM < r1):
+        raise ValueError(f"r_start_mm: start radius must be in (r0, r1) = ({r0 / _MM:g}, "
+                         f"{r1 / _MM:g}) mm, got {r_start_mm:g}")
+    if (l0_mm is None) != (l1_mm is None):
+        raise ValueError("l0_mm, l1_mm: give both strip widths of eq (5) or neither")
+    for name, value in (("l0_mm", l0_mm), ("l1_mm", l1_mm)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{name}: contact-strip width must be > 0 mm, got {value:g}")
+    r_start = None if r_start_mm is None else r_start_mm * _MM
+    if preset is not None:
+        base = CUPS[preset]
+        if l0_mm is not None:
+            base = replace(base, l0_m=l0_mm * _MM, l1_m=l1_mm * _MM)
+        return (replace(base, r_start_m=r_start or base.r_start_m),
+                "given" if l0_mm is not None else "Table 1")
+    if l0_mm is not None:
+        l0, l1, l_source = l0_mm * _MM, l1_mm * _MM, "given"
+    else:
+        l0, l1, l_source = _fitted_strip_widths(curve, r0, r1, design)
+    cup = CupParameters(r0_m=r0, r1_m=r1, alpha_deg=float(design["alpha_deg"]),
+                        r_start_m=r_start or 0.5 * (r0 + r1), l0_m=l0, l1_m=l1, beta=0.8,
+                        name=str(design.get("name", "custom")))
+    return cup, l_source
+
+
+def _fitted_strip_widths(curve: StiffnessCurve | None, r0: float, r1: float,
+                         design: Mapping[str, Any]) -> tuple[float, float, str]:
+    """l0, l1 of eq (5) from a least-squares line through the curve's (r_c, l > 0) samples."""
+    refuse = (f"l0_mm, l1_mm: {_label(design)} is not a Table 1 cup, so eq (5)'s strip widths "
+              f"are unknown")
+    if curve is None or not (curve.has("r_c_m") and curve.has("l_m")):
+        raise ValueError(f"{refuse}: give --l0-mm and --l1-mm, or an FEM stiffness curve "
+                         f"(it carries l and r_c)")
+    ok = curve.l_m > 0
+    r, l = curve.r_c_m[ok], curve.l_m[ok]
+    if r.size < 2 or np.ptp(r) <= 1e-3 * (r1 - r0):
+        raise ValueError(f"{refuse} and the curve resolves a strip at {r.size} radii only: give "
+                         f"--l0-mm and --l1-mm")
+    slope, intercept = np.polyfit(r, l, 1)
+    l0, l1 = intercept + slope * r0, intercept + slope * r1
+    if not (l0 > 0 and l1 > 0):
+        raise ValueError(f"{refuse} and the line through the curve's l(r_c) gives l0 = "
+                         f"{l0 / _MM:.3g} mm, l1 = {l1 / _MM:.3g} mm: give --l0-mm and --l1-mm")
+    return float(l0), float(l1), (f"eq (5) fitted to the curve's l(r_c) at {r.size} samples: "
+                                  f"l0 = {l0 / _MM:.3g} mm, l1 = {l1 / _MM:.3g} mm")
