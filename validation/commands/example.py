@@ -119,7 +119,8 @@ def plot(results, baseline, curve, cup, path: Path, title: str) -> None:
         pts = [(r.force_N, r.lifetime_s) for r in res if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
         if pts:
             ax[0].semilogy(*zip(*pts), style, label=label)
-    ax[0].set(xlabel="pull force $F_1$ (N)", ylabel="lifetime (s)", title=title)
+    ax[0].set(xlabel="pull force $F_1$ (N)", ylabel="lifetime (s)")
+    fig.suptitle(title, fontsize=9)
     ax[0].legend(fontsize=8)
     u = curve.u_m
     ax[1].plot(1e3 * u, curve.F0_N, label="FEM")

@@ -57,7 +57,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--a-c", dest="a_c", type=float, default=0.42,
                    help="with a surface: percolation threshold A/A0 [-] (default: 0.42)")
     p.add_argument("--nu", type=float, default=0.5,
-                   help="with a surface: Poisson ratio of the cup for E* = E/(1-nu^2) [-] (default: 0.5)")
+                   help="with a surface: Poisson ratio of the cup for E* = E/(1-nu^2) [-] (default: 0.5, "
+                        "the paper's rubber; `stiffness` defaults to 0.49 because its displacement "
+                        "elements lock above 0.495)")
     p.add_argument("--relaxation", default="none", metavar="none|default|FILE.csv",
                    help="relaxation modulus E_eff(t): none, the default power law (4.4 MPa at 1 s, "
                         "1.8 MPa at 3e4 s), or a CSV with columns t_s,E_Pa (default: none)")
