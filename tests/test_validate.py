@@ -226,3 +226,49 @@ def test_deformed_outline_is_the_closed_cross_section():
     shoelace = 0.5 * np.sum(x[:-1] * z[1:] - x[1:] * z[:-1])
     area = Basis(mesh, ElementQuad2()).dx.sum()
     assert abs(shoelace) == pytest.approx(area, rel=1e-3)     # straight chords vs exact edges
+
+
+# ------------------------------------------------------------------- section 6: the paper's numbers
+def test_quick_report_paper_numbers(quick_report):
+    import pandas as pd
+
+    table = pd.read_csv(quick_report / "paper_numbers.csv", keep_default_na=False)
+    assert list(table.columns) == ["claim", "where", "paper", "route", "cupcheck", "unit", "ratio",
+                                   "agrees", "reason"]
+    assert set(table["agrees"]) <= {"yes", "no", "by construction"}
+    # every gap names its reason; every route of the quick report is there
+    assert all(table.loc[table["agrees"] == "no", "reason"].str.len() > 20)
+    assert {"appendix-a", "fem-frictionless"} <= set(table["route"])
+    # the calibrated inputs hit their targets (the calibration's own tolerance)
+    built = table[table["agrees"] == "by construction"]
+    assert len(built) == 7 and all(abs(float(r) - 1) < 1e-4 for r in built["ratio"])
+    s = json.loads((quick_report / "summary.json").read_text())
+    assert s["paper_numbers"]["yes"] + s["paper_numbers"]["no"] + s["paper_numbers"]["by construction"] == len(table)
+
+
+def test_sec2_estimate_against_its_ballistic_bound():
+    """u_c for 1 cm^3 of air in 1 hour by eq (19) lies below the ballistic-only estimate of the
+    paper's eq (1) (the diffusive channel adds flow) and above half of it (at ~200 nm the flow is
+    ~80 % ballistic): both with cupcheck's v = 463 m/s, L_y/L_x = 20, p_b = 0."""
+    from reduced.gas import AIR, interpolated_leak_rate
+    from validation.crosscheck.paper import Rows, _estimates
+
+    rows = Rows()
+    _estimates(rows)
+    uc = rows[0][4] * 1e-9
+    ballistic = math.sqrt(1e-6 / (10 * AIR.mean_speed_m_s * 3600.0))      # eq (1) with (1/2) L_y/L_x = 10
+    assert 0.5 * ballistic < uc < ballistic
+    leaked = interpolated_leak_rate(AIR, 1e5, 0.0, uc, 20.0) * 3600.0
+    assert leaked == pytest.approx(1e5 * 1e-6 / AIR.kT_J, rel=1e-9)
+
+
+def test_stall_criterion_tells_a_stall_from_a_ramp():
+    from types import SimpleNamespace
+
+    from validation.crosscheck.paper import _grows_continuously
+
+    t = np.linspace(0.0, 100.0, 201)
+    ramp = SimpleNamespace(reason="reached_r1", lifetime_s=100.0, t_s=t, r_m=12e-3 + 7e-3 * (t / 100) ** 2)
+    stall = SimpleNamespace(reason="reached_r1", lifetime_s=100.0, t_s=t,
+                            r_m=np.where(t < 95, 12.5e-3, 12.5e-3 + 6.5e-3 * (t - 95) / 5))
+    assert _grows_continuously(ramp) and not _grows_continuously(stall)

@@ -13,14 +13,14 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from validation.crosscheck import appendix, cone_laws, extremes, lifetimes, speed
+from validation.crosscheck import appendix, cone_laws, extremes, lifetimes, paper, speed
 from validation.crosscheck.context import Context
 from validation.crosscheck.report import Report
 from validation.crosscheck.runs import FemRun, RunMemo
 
 __all__ = ["SECTIONS", "section_names", "planned_requests", "run_validation", "FemRun", "RunMemo"]
 
-SECTIONS = (appendix, cone_laws, lifetimes, speed, extremes)
+SECTIONS = (appendix, cone_laws, lifetimes, speed, extremes, paper)
 
 
 def section_names() -> tuple[str, ...]:
