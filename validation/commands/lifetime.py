@@ -45,6 +45,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="Young's modulus in MPa for Appendix A and for p/E without relaxation (default: 4)")
     p.add_argument("--d0-mm", dest="d0_mm", type=float, default=2.0,
                    help="Appendix A wall thickness at r0 in mm (d1 = 0) (default: 2)")
+    p.add_argument("--kappa", type=float, default=1.0,
+                   help="stiffness factor: F0 replaced by kappa F0, > 0 (the paper's Fig. "
+                        "1stiffnessFactor) (default: 1)")
     src = p.add_mutually_exclusive_group()
     src.add_argument("--uc-table", default=None, metavar="FILE.csv",
                      help="critical gap table, columns p_over_E,u_c_m (u_c in m; 0 = sealed) "
@@ -141,7 +144,8 @@ def build_model(args: argparse.Namespace):
             ("--d0-mm", args.d0_mm, 2.0), ("--relaxation", args.relaxation, "none"),
             ("--cup-laws", args.cup_laws, "cone"), ("--T-K", args.T_K, 293.15),
             ("--p-a-Pa", args.p_a_Pa, 1e5), ("--phi0-s", args.phi0_s, None),
-            ("--fluid", args.fluid, "air"), ("--cavitation-kPa", args.cavitation_kPa, None))
+            ("--fluid", args.fluid, "air"), ("--cavitation-kPa", args.cavitation_kPa, None),
+            ("--kappa", args.kappa, 1.0))
             if val != default]
         if changed:
             raise ValueError(f"--reference-mode: fixes {', '.join(changed)}; drop them")
@@ -156,6 +160,10 @@ def build_model(args: argparse.Namespace):
         if not (math.isfinite(args.d0_mm) and args.d0_mm > 0):
             raise ValueError(f"--d0-mm: wall thickness must be > 0 mm, got {args.d0_mm:g}")
         curve = appendix_a_curve(cup, E_Pa=1e6 * args.E_MPa, d0_m=1e-3 * args.d0_mm)
+    if not (math.isfinite(args.kappa) and args.kappa > 0):
+        raise ValueError(f"--kappa: stiffness factor must be > 0, got {args.kappa:g}")
+    if args.kappa != 1.0:
+        curve = curve.scaled(args.kappa)
     if args.relaxation == "none":
         relax = None
     elif args.relaxation == "default":
