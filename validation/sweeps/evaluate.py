@@ -1,0 +1,144 @@
+"""One design of a sweep, end to end: geometry -> FEM stiffness curve -> the quantities that matter.
+
+`evaluate_design` is the unit of work a dask worker runs. It never raises for the design's own
+sake: an invalid geometry or a solver failure becomes rows whose `failure` names the stage and the
+cause, so one bad design never stops a sweep. Quantities (units in the names):
+
+* ``F0_at_<u>mm_N``: the FEM's F0 at the requested plate displacements;
+* ``small_u_stiffness_N_per_mm``: the secant F0(1 mm) / 1 mm; ``appendix_a_ratio``: that over
+  Appendix A's secant for the design's own alpha, r0, r1, E and root thickness d0 (d1 = 0);
+* ``r_c_start_mm``, ``l_start_mm``: the FEM's inner contact radius and strip width at the start
+  state (eq 3's height at r_start); ``largest_force_N``: the largest F1 the fresh cup holds;
+* ``lifetime_s``, ``reason`` per pull force (the paper's route, eqs 3-7 with the cone laws and eq
+  (5)'s strip widths l0, l1 as given, by default Table 1's for the base cup, the only measured
+  ones; no relaxation, u_c(p/E) of the surface);
+* ``volume_mm3``: the wall's material volume (a cost for the Pareto front);
+* cost: ``wall_time_s``, ``dofs``, ``newton_iterations``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from typing import Any
+
+from validation.sweeps.spec import design_hash
+
+__all__ = ["evaluate_design", "geometry_of", "material_volume_mm3"]
+
+_MM = 1e-3
+
+
+def geometry_of(design: dict[str, Any]):
+    """The `fem.geometry.CupGeometry` of a design (the preset with its overrides)."""
+    from fem.geometry import LinearThickness, cup_geometry
+
+    base = cup_geometry(design["cup"])
+    r0 = design["r0_mm"] * _MM if design.get("r0_mm") is not None else base.r0_m
+    r1 = design["r1_mm"] * _MM if design.get("r1_mm") is not None else base.r1_m
+    d0 = design["d0_mm"] * _MM if design.get("d0_mm") is not None else float(base.thickness(base.r0_m))
+    d1 = design["d1_mm"] * _MM if design.get("d1_mm") is not None else float(base.thickness(base.r1_m))
+    alpha = design["alpha_deg"] if design.get("alpha_deg") is not None else base.alpha_deg
+    return cup_geometry(design["cup"], r0_m=r0, r1_m=r1, alpha_deg=alpha,
+                        thickness=LinearThickness(r0, d0, r1, d1), name=f"design {design_hash(design)}")
+
+
+def material_volume_mm3(geometry) -> float:
+    """The wall's volume of revolution, pi oint r^2 dz around the cross-section [mm^3]."""
+    poly = geometry.boundary_polygon(401)
+    r, z = poly[:, 0], poly[:, 1]
+    r2, z2 = r[[*range(1, len(r)), 0]], z[[*range(1, len(z)), 0]]
+    # a counter-clockwise outline in (r, z): V = -pi/3 sum (z2 - z1)(r1^2 + r1 r2 + r2^2)
+    return float(abs(math.pi / 3.0 * sum((b - a) * (p * p + p * q + q * q)
+                                         for a, b, p, q in zip(z, z2, r, r2)))) / _MM ** 3
+
+
+def evaluate_design(design: dict[str, Any]) -> list[dict[str, Any]]:
+    """Rows (one per pull force) of one design: its parameters, hash, quantities or failure."""
+    start = time.perf_counter()
+    common = {**{k: v for k, v in design.items() if k not in ("F1_N", "F0_at_u_mm", "allow_unusual_design")},
+              "design_hash": design_hash(design)}
+    stage = "geometry"
+    try:
+        from validation.guards import check_design
+
+        geometry = geometry_of(design)
+        check_design(geometry.describe(), design["allow_unusual_design"], source="design")
+        common["volume_mm3"] = material_volume_mm3(geometry)
+        stage = "fem"
+        response, curve = _stiffness(geometry, design)
+        common.update(_fem_quantities(response, curve, geometry, design))
+        stage = "lifetime"
+        rows = _lifetimes(curve, design, common)
+    except (ValueError, RuntimeError, ArithmeticError) as exc:
+        reason = f"{stage}: {type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
+        rows = [{**common, "F1_N": F, "failure": reason} for F in design["F1_N"]]
+    wall = time.perf_counter() - start
+    for row in rows:
+        row["wall_time_s"] = wall
+    return rows
+
+
+def _stiffness(geometry, design: dict[str, Any]):
+    from fem.cup import compress_cup
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+    from validation import handoff
+
+    mesh = cup_mesh(geometry, design["fidelity"])
+    nu = design["nu"]
+    material = NeoHookean(E_Pa=design["E_MPa"] * 1e6, nu=nu,
+                          formulation="mixed" if nu > 0.495 else "displacement")
+    response = compress_cup(mesh, material, contact=design["contact"], u_max_m=0.9 * geometry.h1_m)
+    prov = handoff.provenance(response, geometry=geometry.describe(), mesh={"fidelity": design["fidelity"]},
+                              fidelity=design["fidelity"])
+    return response, handoff.stiffness_curve(response, prov)
+
+
+def _fem_quantities(response, curve, geometry, design) -> dict[str, Any]:
+    from reduced.appendix_a import appendix_a_force
+
+    out: dict[str, Any] = {"dofs": response.stats.dofs, "newton_iterations": response.stats.newton_iterations}
+    u_hi = float(curve.u_m[-1])
+    for u_mm in design["F0_at_u_mm"]:
+        out[f"F0_at_{u_mm:g}mm_N"] = float(curve.force(curve.h1_m - u_mm * _MM)) if u_mm * _MM <= u_hi else None
+    stiffness = float(curve.force(curve.h1_m - 1e-3)) / 1.0
+    d0 = float(geometry.thickness(geometry.r0_m))
+    app = float(appendix_a_force(1e-3, geometry.alpha_deg, design["E_MPa"] * 1e6, d0, geometry.r0_m,
+                                 geometry.r1_m)) / 1.0
+    out.update(small_u_stiffness_N_per_mm=stiffness, appendix_a_ratio=stiffness / app)
+    return out
+
+
+def _lifetimes(curve, design, common) -> list[dict[str, Any]]:
+    from reduced.lifetime import LeakageModel, largest_holdable_force, lifetime
+    from validation.design import resolve_cup
+
+    from reduced.cup import CUPS
+
+    table1 = CUPS[design["cup"]]
+    l0 = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
+    l1 = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
+    choice = resolve_cup(curve, r_start_mm=design.get("r_start_mm"), l0_mm=l0, l1_mm=l1)
+    model = LeakageModel(cup=choice.cup, stiffness=curve, u_c=_uc_table(design["surface"]),
+                         E_Pa=design["E_MPa"] * 1e6, geometry="cone")
+    h_start = choice.cup.h_start_m
+    common = {**common, "r_start_mm": choice.cup.r_start_m / _MM, "l0_mm": l0, "l1_mm": l1,
+              "r_c_start_mm": float(curve.contact_radius(h_start)) / _MM,
+              "l_start_mm": float(curve.contact_width(h_start)) / _MM,
+              "largest_force_N": largest_holdable_force(model)}
+    rows = []
+    for F in design["F1_N"]:
+        r = lifetime(model, F)
+        rows.append({**common, "F1_N": F, "lifetime_s": r.lifetime_s if math.isfinite(r.lifetime_s) else None,
+                     "reason": r.reason, "failure": None})
+    return rows
+
+
+@functools.lru_cache(maxsize=8)
+def _uc_table(surface: str):
+    """u_c(p/E) of a calibrated surface (Persson theory, EMT, nu = 0.5), once per worker."""
+    from reduced.roughness import uc_table
+    from reduced.roughness.surfaces import preset
+    return uc_table(preset(surface).spectrum(), 0.5)

@@ -1,0 +1,188 @@
+"""The sweep file: a base design and the axes to vary, validated before any work.
+
+    [base]                          # one cup design and its conditions (units in the key names)
+    cup = "A"                       # the preset the geometry keys modify
+    alpha_deg = 33
+    d0_mm = 2.5                     # wall thickness at r0 and at r1 (a line between them)
+    d1_mm = 0.447
+    E_MPa = 4.0
+    nu = 0.49
+    contact = "sticking"            # frictionless | sticking
+    surface = "pmma-1.89"           # a calibrated preset (`cupcheck uc --list-surfaces`)
+    fidelity = "coarse"             # FEM mesh level
+    F1_N = [10, 40]                 # lifetimes at these pull forces: one table row per force
+    F0_at_u_mm = [1, 3]             # F0 reported at these plate displacements
+    allow_unusual_design = false    # true: steep or slender walls are run, not refused (`validation.guards`)
+    # l0_mm, l1_mm: eq (5)'s strip widths (default: Table 1's for the base cup, as measured for it)
+
+    [sampling]                      # grid (every combination of the axes' values) | lhs | sobol
+    method = "grid"                 # lhs and sobol draw `n` designs in the axes' [low, high]
+    n = 16
+    seed = 1
+
+    [[axes]]                        # grid: values; lhs/sobol: low and high (numeric axes)
+    name = "alpha_deg"
+    values = [25, 33, 40]
+
+Axis names are the numeric base keys (alpha_deg, r0_mm, r1_mm, d0_mm, d1_mm, E_MPa, nu, r_start_mm)
+and, on a grid, the categorical ones (contact, surface). Errors name the key path
+(``axes[1].name: expected one of ...``) and are ValueErrors (exit status 2 on the command line).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["SweepSpec", "load_sweep", "sweep_from_mapping", "NUMERIC_AXES", "design_hash"]
+
+NUMERIC_AXES = ("alpha_deg", "r0_mm", "r1_mm", "d0_mm", "d1_mm", "E_MPa", "nu", "r_start_mm", "l0_mm", "l1_mm")
+CATEGORICAL_AXES = ("contact", "surface")
+_BASE_DEFAULTS: dict[str, Any] = {
+    "cup": "A", "alpha_deg": None, "r0_mm": None, "r1_mm": None, "d0_mm": None, "d1_mm": None,
+    "E_MPa": 4.0, "nu": 0.49, "contact": "sticking", "surface": "pmma-1.89", "fidelity": "coarse",
+    "r_start_mm": None, "l0_mm": None, "l1_mm": None, "F1_N": [10.0], "F0_at_u_mm": [1.0], "allow_unusual_design": False,
+}
+_CHOICES = {"contact": ("frictionless", "sticking"), "fidelity": ("coarse", "medium", "fine"),
+            "cup": ("A", "B")}
+_METHODS = ("grid", "lhs", "sobol")
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A validated sweep: the base design, the axes and how to sample them."""
+
+    base: dict[str, Any]
+    axes: tuple[dict[str, Any], ...]
+    method: str = "grid"
+    n: int = 0
+    seed: int = 0
+
+    def designs(self) -> list[dict[str, Any]]:
+        """Every design of the sweep: the base with the axes' values, in a reproducible order."""
+        names = [a["name"] for a in self.axes]
+        if self.method == "grid":
+            grids = np.meshgrid(*[np.arange(len(a["values"])) for a in self.axes], indexing="ij")
+            points = [[a["values"][int(g.flat[i])] for a, g in zip(self.axes, grids)]
+                      for i in range(grids[0].size)] if self.axes else [[]]
+        else:
+            from scipy.stats import qmc
+            engine = (qmc.LatinHypercube(d=len(self.axes), seed=self.seed) if self.method == "lhs"
+                      else qmc.Sobol(d=len(self.axes), scramble=True, seed=self.seed))
+            unit = engine.random(self.n)
+            lo = np.array([a["low"] for a in self.axes])
+            hi = np.array([a["high"] for a in self.axes])
+            points = qmc.scale(unit, lo, hi).tolist()
+        return [{**self.base, **dict(zip(names, p))} for p in points]
+
+
+def design_hash(design: Mapping[str, Any]) -> str:
+    """Content hash of a design's parameters (its identity in the result store)."""
+    text = json.dumps({k: design[k] for k in sorted(design)}, sort_keys=True, default=float)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def load_sweep(path: str | Path) -> SweepSpec:
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"sweep: no such file '{path}'")
+    try:
+        data = tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"sweep: cannot parse '{path}': {exc}".replace("\n", " ")) from None
+    return sweep_from_mapping(data)
+
+
+def sweep_from_mapping(data: Mapping[str, Any]) -> SweepSpec:
+    """A `SweepSpec` from parsed TOML (module docstring); ValueError naming the key path."""
+    _keys(data, ("base", "sampling", "axes"), "")
+    base = _base(data.get("base", {}))
+    sampling = data.get("sampling", {})
+    _keys(sampling, ("method", "n", "seed"), "sampling")
+    method = sampling.get("method", "grid")
+    if method not in _METHODS:
+        raise ValueError(f"sampling.method: expected one of {', '.join(_METHODS)}, got {method!r}")
+    n, seed = sampling.get("n", 0), sampling.get("seed", 0)
+    if method != "grid" and not (isinstance(n, int) and 1 <= n <= 100_000):
+        raise ValueError(f"sampling.n: {method} needs a number of designs in [1, 100000], got {n!r}")
+    if not isinstance(seed, int):
+        raise ValueError(f"sampling.seed: expected an integer, got {seed!r}")
+    axes = data.get("axes", [])
+    if not isinstance(axes, list):
+        raise ValueError("axes: expected a list of tables ([[axes]])")
+    parsed = tuple(_axis(a, i, method) for i, a in enumerate(axes))
+    names = [a["name"] for a in parsed]
+    if len(set(names)) != len(names):
+        raise ValueError(f"axes: an axis appears twice ({', '.join(names)})")
+    if method != "grid" and not parsed:
+        raise ValueError(f"axes: {method} sampling needs at least one axis")
+    return SweepSpec(base=base, axes=parsed, method=method, n=n if method != "grid" else 0, seed=seed)
+
+
+def _keys(table: Any, allowed: tuple[str, ...], where: str) -> None:
+    if not isinstance(table, Mapping):
+        raise ValueError(f"{where or 'sweep'}: expected a table")
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        prefix = f"{where}." if where else ""
+        raise ValueError(f"{prefix}{unknown[0]}: unknown key; allowed: {', '.join(allowed)}")
+
+
+def _base(table: Mapping[str, Any]) -> dict[str, Any]:
+    _keys(table, tuple(_BASE_DEFAULTS), "base")
+    base = {**_BASE_DEFAULTS, **table}
+    for key, choices in _CHOICES.items():
+        if base[key] not in choices:
+            raise ValueError(f"base.{key}: expected one of {', '.join(choices)}, got {base[key]!r}")
+    if not isinstance(base["allow_unusual_design"], bool):
+        raise ValueError(f"base.allow_unusual_design: expected true or false, got {base['allow_unusual_design']!r}")
+    for key in NUMERIC_AXES:
+        if base[key] is not None:
+            base[key] = _number(base[key], f"base.{key}")
+    for key in ("F1_N", "F0_at_u_mm"):
+        values = base[key] if isinstance(base[key], list) else [base[key]]
+        base[key] = [_number(v, f"base.{key}[{i}]", positive=True) for i, v in enumerate(values)]
+    return base
+
+
+def _axis(axis: Any, i: int, method: str) -> dict[str, Any]:
+    where = f"axes[{i}]"
+    _keys(axis, ("name", "values", "low", "high"), where)
+    name = axis.get("name")
+    allowed = NUMERIC_AXES + (CATEGORICAL_AXES if method == "grid" else ())
+    if name not in allowed:
+        raise ValueError(f"{where}.name: expected one of {', '.join(allowed)}, got {name!r}")
+    if method == "grid":
+        values = axis.get("values")
+        if not isinstance(values, list) or not values or "low" in axis or "high" in axis:
+            raise ValueError(f"{where}.values: a grid axis needs a non-empty list of values (no low/high)")
+        if name in CATEGORICAL_AXES:
+            choices = _CHOICES.get(name)
+            bad = [v for v in values if not isinstance(v, str) or (choices and v not in choices)]
+            if bad:
+                raise ValueError(f"{where}.values: expected {' or '.join(choices) if choices else 'names'}, "
+                                 f"got {bad[0]!r}")
+            return {"name": name, "values": values}
+        return {"name": name, "values": [_number(v, f"{where}.values[{j}]") for j, v in enumerate(values)]}
+    if "values" in axis:
+        raise ValueError(f"{where}.values: {method} sampling takes low and high, not values")
+    lo, hi = (_number(axis.get(k), f"{where}.{k}") for k in ("low", "high"))
+    if not lo < hi:
+        raise ValueError(f"{where}.high: must exceed low = {lo:g}, got {hi:g}")
+    return {"name": name, "low": lo, "high": hi}
+
+
+def _number(value: Any, where: str, positive: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{where}: expected a finite number, got {value!r}")
+    if positive and value <= 0:
+        raise ValueError(f"{where}: must be > 0, got {value:g}")
+    return float(value)
