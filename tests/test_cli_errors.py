@@ -132,3 +132,14 @@ def test_failure_while_writing_leaves_none_of_the_files(tmp_path, monkeypatch, c
                  "--out", str(tmp_path / "curve.csv"), "--fields-out", str(tmp_path / "f.vtu")]) == 1
     assert capsys.readouterr().err.splitlines()[-1] == "cupcheck stiffness: failed: fields: disk full"
     assert _files(tmp_path) == []
+
+
+def test_example_solver_failure_is_one_line_in_mm_with_a_log(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(fem.cup, "compress_cup", functools.partial(
+        fem.cup.compress_cup, max_iterations=2, initial_step=0.5, min_step=0.5))
+    out = tmp_path / "ex"
+    assert main(["example", "--fidelity", "coarse", "--out", str(out)]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err[-1].startswith("cupcheck example: failed: load step 1 from u = 0 to ") and " mm did " in err[-1]
+    assert _files(tmp_path) == ["ex.failure.json"]          # the log only: no half-written output
+    assert json.loads((tmp_path / "ex.failure.json").read_text())["step"] == 1

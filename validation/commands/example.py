@@ -145,8 +145,14 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     geometry, uc, uc_label = _inputs(args)
+    from fem.solver import ConvergenceError
+    from validation.commands._failure import solver_failure
+
     with atomic_directory(args.out) as tmp:
-        response, curve = fem_stiffness(geometry, args.contact, args.fidelity, terminal_progress("FEM"))
+        try:
+            response, curve = fem_stiffness(geometry, args.contact, args.fidelity, terminal_progress("FEM"))
+        except ConvergenceError as exc:
+            raise solver_failure(exc, Path(f"{Path(args.out)}.failure.json")) from None
         choice = resolve_cup(curve, r_start_mm=args.r_start_mm, l0_mm=args.l0_mm, l1_mm=args.l1_mm,
                              curve_label="the FEM curve")
         curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
