@@ -16,8 +16,9 @@ first local maximum: that maximum (or its value at r1) is the largest force the 
 at or above it the cup detaches at t = 0.
 
 `ForceBalance` evaluates everything a lifetime needs at one state (h, N, phi) as floats, for the
-ODE right-hand sides of `reduced.lifetime`: N_eq(h), the holding force, the leak state (eqs 6, 9,
-19, 23, 24), the fold, the start and, for a liquid, cavitation.
+ODE right-hand sides of `reduced.lifetime`: N_eq(h), the holding force, the leak state (through
+the model's seal, `reduced.seal`: eq 6's strip or the contact-pressure profile), the fold, the
+start and, for a liquid, cavitation.
 """
 
 from __future__ import annotations
@@ -30,8 +31,8 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from reduced.fast_curve import CurveRangeError, ScalarPchip
-from reduced.gas import ballistic_share, interpolated_leak_rate, liquid_volume_rate
 from reduced.geometry import geometry_source
+from reduced.seal import ProfileSeal, StripSeal
 from reduced.viscoelastic import measurement_contact_time
 
 if TYPE_CHECKING:
@@ -56,6 +57,9 @@ class ForceBalance:
         self.pa = m.p_a_Pa
         self.beta = m.cup.beta
         self.uc = getattr(m.u_c, "scalar", m.u_c)
+        seal = ProfileSeal if m.seal == "profile" else StripSeal
+        self.seal = seal(m.stiffness, m.u_c, m.gas, m.p_a_Pa, m.cup.beta,
+                         m.liquid_viscosity_Pa_s if self.liquid else None)
         self.relax = m.relaxation
         if self.relax is not None:
             self.phi0 = m.phi0_s if m.phi0_s is not None else measurement_contact_time(m.cup)
@@ -110,15 +114,7 @@ class ForceBalance:
             pb = pa - (kappa * F + F1) / (math.pi * r * r)
         else:                    # p_b from the ideal gas (8); molecule flow eqs (9), (19)
             pb = N * self.kT / V
-        if l <= 0.0:             # a line contact: eq (6)'s pressure is unbounded, u_c = 0 (sealed)
-            return 0.0, pb, math.inf, 0.0, 0.0, r, rp, l, V, Vp, F, Fh
-        p = kappa * F / (2.0 * math.pi * r * l) + self.beta * (pa - pb)
-        uc = self.uc(p / E)
-        if self.liquid:
-            return (liquid_volume_rate(self.m.liquid_viscosity_Pa_s, pa, pb, uc, 2.0 * math.pi * r / l),
-                    pb, p, uc, 0.0, r, rp, l, V, Vp, F, Fh)
-        Ndot = interpolated_leak_rate(self.gas, pa, pb, uc, 2.0 * math.pi * r / l)
-        share = ballistic_share(self.gas, pa, pb, uc)
+        Ndot, p, uc, share = self.seal.flow(F, r, l, pb, kappa, E, self.h1 - h)
         return Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh
 
     # ------------------------------------------------------------------ the h grid
@@ -203,7 +199,7 @@ class ForceBalance:
             return hs, N0, kappa0, self.largest_liquid_force(hs), hs
         if N0 <= 0:
             raise ValueError("r_start_m: the stiffness force at r_start exceeds the full vacuum force "
-                             f"(no gas can be trapped); check the stiffness curve or r_start")
+                             "(no gas can be trapped); check the stiffness curve or r_start")
         h, _ = self.grid
         hh = np.concatenate(([hs], h[h > hs]))
         r, rp, V, Vp, _ = self.geo.at_array(hh)

@@ -58,6 +58,7 @@ from reduced.cup import CupParameters
 from reduced.fast_curve import CurveRangeError
 from reduced.gas import AIR, WATER_VISCOSITY_PA_S, Gas
 from reduced.force_balance import ForceBalance
+from reduced.seal import SEALS
 from reduced.ode import dopri5
 from reduced.stiffness_curve import StiffnessCurve
 from reduced.viscoelastic import RelaxationModulus
@@ -79,7 +80,8 @@ class LeakageModel:
     ambient pressure. relaxation: E_eff(t), or None for no relaxation (then kappa = 1 and E_Pa is the
     modulus in p/E). phi0_s: contact time of the stiffness measurement (default: eq 10 steady state
     at the paper's 0.12 mm/s, see `measurement_contact_time`). geometry: 'cone' (eqs 3-5) or 'curve'
-    (r, V, l from the stiffness curve). fluid: 'air' (the gas leaks in, eqs 8, 19) or 'water' (the
+    (r, V, l from the stiffness curve). seal: 'strip' (eq 6, the paper's route) or 'profile' (the
+    curve's contact-pressure profiles, `reduced.seal`; needs geometry 'curve'). fluid: 'air' (the gas leaks in, eqs 8, 19) or 'water' (the
     cavity is full of an incompressible liquid that flows in by eq 24; its "content" is the liquid
     volume, p_b follows from the force balance and may become negative, i.e. tension, Sec. 6).
     cavitation_pressure_Pa: water only; None: the liquid sustains any tension (metastable); a value
@@ -95,6 +97,7 @@ class LeakageModel:
     relaxation: RelaxationModulus | None = None
     phi0_s: float | None = None
     geometry: str = "cone"
+    seal: str = "strip"
     fluid: str = "air"
     liquid_viscosity_Pa_s: float = WATER_VISCOSITY_PA_S
     cavitation_pressure_Pa: float | None = None
@@ -109,6 +112,11 @@ class LeakageModel:
             raise ValueError(f"phi0_s: measurement contact time must be > 0 s, got {self.phi0_s}")
         if self.geometry not in ("cone", "curve"):
             raise ValueError(f"geometry: unknown source '{self.geometry}', allowed: cone, curve")
+        if self.seal not in SEALS:
+            raise ValueError(f"seal: unknown seal '{self.seal}', allowed: {', '.join(SEALS)}")
+        if self.seal == "profile" and self.geometry != "curve":
+            raise ValueError("seal: the profile's radii are the FEM's: 'profile' needs geometry 'curve' "
+                             "(r and V from the same curve)")
         if self.fluid not in ("air", "water"):
             raise ValueError(f"fluid: unknown fluid '{self.fluid}', allowed: air, water")
         if self.fluid == "water" and self.relaxation is not None:
@@ -369,7 +377,7 @@ def _run_relaxed(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) -> L
         G_h = kappa * Fh - 2 * math.pi * r * rp * (pa - pb) - A * pb * Vp / V
         G_N = A * kT / V
         G_phi = dk * F
-        a = rp * phi / l
+        a = rp * phi / l if l > 0.0 else 0.0     # a line contact (l = 0) keeps its point: phi grows
         D = G_h - a * G_phi
         hdot = -(G_N * Ndot + G_phi) / D
         return Ndot, 1.0 - a * hdot, D
@@ -421,7 +429,8 @@ def _run_relaxed(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) -> L
 
 def _sealed_on_branch(core: ForceBalance, h0: float, h_end: float, F1: float) -> float | None:
     """First h on [h0, h_end] (checked on the fold-search grid) where u_c = 0, or None."""
-    if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf and not core.geo.line_contact:
+    line = core.geo.line_contact and core.m.seal == "strip"
+    if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf and not line:
         return None        # a table without sealed rows never seals, unless the strip is a line
     h, _ = core.grid
     for x in [h0] + [float(x) for x in h[(h > h0) & (h < h_end)]] + [h_end]:

@@ -15,6 +15,10 @@ column names (readable by pandas.read_csv and numpy.genfromtxt as they are)::
 Its provenance travels in a JSON sidecar of the same name (``curve.json``, key ``provenance``),
 among it the cup design the curve was computed for (``geometry``: r0_mm, r1_mm, alpha_deg,
 h1_mm, the thickness profile), which `design` returns; a lifetime takes the cup from there.
+Optionally the curve carries the contact-pressure profile p(r) of every sample (`profiles`, for
+the leak through the profile, `reduced.profile_leak`); the sidecar holds them as the FEM writes
+them, ``steps.pressure_r_mm[i]`` and ``steps.pressure_kPa[i]``, and `read_profiles_csv` reads a
+measured or user-made one (``u_mm,r_mm,p_kPa``, one row per point).
 
 Interpolation is monotone piecewise-cubic (PCHIP): it never overshoots between samples, so
 a monotone measured curve stays monotone. Evaluating outside the sampled range is an error,
@@ -35,7 +39,9 @@ from typing import Any
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-__all__ = ["StiffnessCurve", "CSV_COLUMNS"]
+from reduced.profile_leak import ContactProfile
+
+__all__ = ["StiffnessCurve", "CSV_COLUMNS", "read_profiles_csv", "profiles_from_lists"]
 
 #: CSV column name -> (dataclass field, factor from the CSV unit to SI)
 CSV_COLUMNS: dict[str, tuple[str, float]] = {
@@ -64,6 +70,7 @@ class StiffnessCurve:
     r_c_m, l_m, V_m3 : optional inner contact radius [m], contact-strip width [m] and
         enclosed cavity volume [m^3] at the same samples.
     provenance : free-form description of where the data come from (source, parameters).
+    profiles : optional contact-pressure profile per sample (None where nothing touches).
     """
 
     u_m: np.ndarray
@@ -73,6 +80,7 @@ class StiffnessCurve:
     l_m: np.ndarray | None = None
     V_m3: np.ndarray | None = None
     provenance: Mapping[str, Any] = field(default_factory=dict)
+    profiles: tuple[ContactProfile | None, ...] | None = None
 
     def __post_init__(self) -> None:
         u = _frozen_array(self.u_m, "u_m")
@@ -92,6 +100,11 @@ class StiffnessCurve:
                     raise ValueError(f"{name}: must be >= 0")
                 object.__setattr__(self, name, arr)
         object.__setattr__(self, "provenance", dict(self.provenance))
+        if self.profiles is not None:
+            if len(self.profiles) != u.size:
+                raise ValueError(f"profiles: expected one profile (or None) per sample, {u.size}, "
+                                 f"got {len(self.profiles)}")
+            object.__setattr__(self, "profiles", tuple(self.profiles))
 
     # ------------------------------------------------------------------ views
     @property
@@ -147,8 +160,10 @@ class StiffnessCurve:
         if not (np.isfinite(kappa) and kappa > 0):
             raise ValueError(f"kappa: stiffness scale factor must be > 0, got {kappa}")
         prov = dict(self.provenance, scaled_by=float(kappa))
+        profiles = None if self.profiles is None else tuple(
+            None if p is None else ContactProfile(p.r_m, kappa * p.p_Pa) for p in self.profiles)
         return StiffnessCurve(self.u_m, kappa * self.F0_N, self.h1_m, self.r_c_m, self.l_m,
-                              self.V_m3, prov)
+                              self.V_m3, prov, profiles)
 
     def _u_of(self, h_m: float | np.ndarray) -> np.ndarray:
         u = self.h1_m - np.asarray(h_m, dtype=float)
@@ -190,8 +205,10 @@ class StiffnessCurve:
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         if sidecar:
-            text = json.dumps({"provenance": self.provenance, "h1_mm": 1e3 * self.h1_m}, indent=1,
-                              sort_keys=True, default=str) + "\n"
+            data: dict[str, Any] = {"provenance": self.provenance, "h1_mm": 1e3 * self.h1_m}
+            if self.profiles is not None:
+                data["steps"] = profiles_to_lists(self.profiles)
+            text = json.dumps(data, indent=1, sort_keys=True, default=str) + "\n"
             _atomic_write(path.with_suffix(".json"), lambda f: f.write(text))
 
         def write_table(f) -> None:
@@ -250,13 +267,18 @@ class StiffnessCurve:
             h1_m = h1_csv
         if h1_m is None:
             raise ValueError(f"h1_mm: '{path}' has no h_mm column; give the cup's undeformed height")
-        provenance = _sidecar_provenance(path) or provenance
+        side = _sidecar(path)
+        provenance = side.get("provenance") or provenance
         provenance.setdefault("source", f"csv:{path.name}")
-        return cls(h1_m=h1_m, provenance=provenance, **si)
+        steps = side.get("steps", {})
+        profiles = None
+        if "pressure_r_mm" in steps and "pressure_kPa" in steps:
+            profiles = profiles_from_lists(steps["pressure_r_mm"], steps["pressure_kPa"])
+        return cls(h1_m=h1_m, provenance=provenance, profiles=profiles, **si)
 
 
-def _sidecar_provenance(csv_path: Path) -> dict[str, Any]:
-    """The ``provenance`` of the curve's JSON sidecar, {} without one."""
+def _sidecar(csv_path: Path) -> dict[str, Any]:
+    """The curve's JSON sidecar (``provenance``, optionally ``steps`` with the profiles), {} without one."""
     side = csv_path.with_suffix(".json")
     if not side.is_file():
         return {}
@@ -264,10 +286,47 @@ def _sidecar_provenance(csv_path: Path) -> dict[str, Any]:
         data = json.loads(side.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"stiffness: cannot parse the sidecar '{side}': {exc}") from None
-    prov = data.get("provenance") if isinstance(data, Mapping) else None
-    if not isinstance(prov, Mapping):
+    if not isinstance(data, Mapping) or not isinstance(data.get("provenance"), Mapping):
         raise ValueError(f"stiffness: the sidecar '{side}' has no 'provenance' table")
-    return dict(prov)
+    return {**data, "provenance": dict(data["provenance"])}
+
+
+def profiles_from_lists(r_mm: list, p_kPa: list) -> tuple[ContactProfile | None, ...]:
+    """Profiles from per-sample lists of radii [mm] and pressures [kPa] (the FEM sidecar's form);
+    points at the same radius are merged (the largest pressure), fewer than 2 points is None."""
+    out: list[ContactProfile | None] = []
+    for i, (r, p) in enumerate(zip(r_mm, p_kPa)):
+        r, p = np.asarray(r, dtype=float) * 1e-3, np.asarray(p, dtype=float) * 1e3
+        if r.shape != p.shape:
+            raise ValueError(f"pressure_kPa[{i}]: {p.size} pressures for {r.size} radii")
+        radii, inverse = np.unique(r, return_inverse=True)
+        merged = np.zeros(radii.size)
+        np.maximum.at(merged, inverse, p)
+        out.append(ContactProfile(radii, merged) if radii.size >= 2 and merged.max() > 0 else None)
+    return tuple(out)
+
+
+def profiles_to_lists(profiles) -> dict[str, list]:
+    """The sidecar form of `profiles`: ``pressure_r_mm`` and ``pressure_kPa``, one list per sample."""
+    return {"pressure_r_mm": [[] if p is None else (p.r_m * 1e3).tolist() for p in profiles],
+            "pressure_kPa": [[] if p is None else (p.p_Pa * 1e-3).tolist() for p in profiles]}
+
+
+def read_profiles_csv(path: str | os.PathLike, u_m: np.ndarray) -> tuple[ContactProfile | None, ...]:
+    """Contact-pressure profiles from a long CSV ``u_mm,r_mm,p_kPa`` (one row per point), one per
+    displacement of `u_m` (each u_mm must be one of the curve's samples, to 1e-6 mm)."""
+    table = np.genfromtxt(path, delimiter=",", names=True)
+    if table.dtype.names is None or set(table.dtype.names) != {"u_mm", "r_mm", "p_kPa"}:
+        raise ValueError(f"profiles: '{path}' must have exactly the columns u_mm, r_mm, p_kPa")
+    rows = np.atleast_1d(table)
+    u_mm = 1e3 * np.asarray(u_m)
+    which = np.array([int(np.argmin(np.abs(u_mm - u))) for u in rows["u_mm"]])
+    off = np.abs(u_mm[which] - rows["u_mm"]) > 1e-6
+    if off.any():
+        raise ValueError(f"profiles: u_mm = {rows['u_mm'][off][0]:g} in '{path}' is not a sample of the curve")
+    r_mm = [np.sort(rows["r_mm"][which == k]) for k in range(u_mm.size)]
+    p_kPa = [rows["p_kPa"][which == k][np.argsort(rows["r_mm"][which == k])] for k in range(u_mm.size)]
+    return profiles_from_lists(r_mm, p_kPa)
 
 
 def _atomic_write(path: Path, write) -> None:

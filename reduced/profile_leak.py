@@ -1,0 +1,152 @@
+"""Leakage through a contact-pressure profile p(r): the annulus as strips in series (Sec. 4, local).
+
+The paper lets the gas cross one strip of width l at the uniform pressure of eq (6). Here the
+contact zone r_0 < r < r_n is cut into rings [r_i, r_i+1], each with its own gap u_i = u_c(p_i / E)
+(p_i: the contact pressure at the ring's middle), and the gas pressure P(r) rises from p_b at the
+inner edge to p_a at the outer one. The molecule flow Q = 2 pi r j(r) is the same through every
+ring (steady state). Locally the flux per unit circumference is eq (13) with eq (19)'s ballistic
+correction, written with the local pressure:
+
+    j = -(u^3 / (12 eta kT)) (P + a / u) dP/dr,      a = xi (n lambda) kT / 2,   xi = 32 / pi
+
+(n lambda = 3 eta / (m v) does not depend on the density, eq 12). Integrated over a ring of
+constant gap u,
+
+    Phi_u(P_out) - Phi_u(P_in) = c Q,   Phi_u(P) = u^3 P^2 / 2 + a u^2 P,   c = 12 eta kT g / (2 pi)
+
+with the ring's geometric factor g = ln(r_out / r_in) (the exact annulus; ``radial="annulus"``) or
+g = (r_out - r_in) / r_0 (the paper's flat strip, L_y = 2 pi r_0; ``radial="strip"``). For one ring
+this is exactly eqs (19), (20), (23) with L_y / L_x = 2 pi / g: for a strip of width l at r,
+2 pi r / l, and for the annulus 2 pi / ln(1 + l / r) = (2 pi r / l)(1 + l / 2r + O(l^2/r^2)).
+Rings in series: P is marched from p_a at r_n inwards, P_i = -a/u + ((P_i+1 + a/u)^2 - 2 c_i Q / u^3)^(1/2),
+and Q is the root of P_0(Q) = p_b (monotone; Newton with bracketing). A ring with u = 0 (the
+contact area percolates: sealed) stops the flow; a ring with no contact (p = 0) costs nothing.
+
+Water (eq 24 locally): j_V = -(u^3 / (12 eta)) dP/dr, so p_a - p_b = Q_V sum_i 12 eta g_i / (2 pi u_i^3).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from reduced.gas import XI, Gas
+
+__all__ = ["ContactProfile", "ring_gaps", "profile_leak_rate", "profile_liquid_rate"]
+
+
+@dataclass(frozen=True)
+class ContactProfile:
+    """Contact pressure p(r) [Pa] at radii r [m] (strictly increasing) across the contact zone(s);
+    p = 0 marks no contact. Plain data: from the FEM (the lumped nodal pressures), a measurement
+    or a formula."""
+
+    r_m: np.ndarray
+    p_Pa: np.ndarray
+
+    def __post_init__(self) -> None:
+        r = np.array(self.r_m, dtype=float).reshape(-1)
+        p = np.array(self.p_Pa, dtype=float).reshape(-1)
+        if r.size != p.size or r.size < 2:
+            raise ValueError(f"p_Pa: a contact profile needs >= 2 matching (r, p) samples, got {r.size}, {p.size}")
+        if not (np.all(np.isfinite(r)) and np.all(np.isfinite(p))):
+            raise ValueError("r_m, p_Pa: a contact profile must be finite")
+        if np.any(r <= 0) or np.any(np.diff(r) <= 0):
+            raise ValueError("r_m: profile radii must be > 0 and strictly increasing")
+        if np.any(p < 0):
+            raise ValueError(f"p_Pa: contact pressure must be >= 0, got {p.min():.4g} Pa")
+        r.flags.writeable = p.flags.writeable = False
+        object.__setattr__(self, "r_m", r)
+        object.__setattr__(self, "p_Pa", p)
+
+    @property
+    def force_N(self) -> float:
+        """The contact force 2 pi int p r dr [N] (trapezoid over the samples)."""
+        f = self.p_Pa * self.r_m
+        return float(np.pi * np.sum((f[1:] + f[:-1]) * np.diff(self.r_m)))
+
+
+def ring_gaps(profile: ContactProfile, u_c: Callable[[float], float], E_Pa: float,
+              scale: float = 1.0, extra_Pa: float = 0.0) -> np.ndarray:
+    """Gap u_i [m] of each ring: u_c of the contact pressure at its middle, scale p + extra_Pa
+    (kappa F0's share and eq (6)'s beta (p_a - p_b)); inf where neither touches (no contact)."""
+    p = profile.p_Pa
+    mid = 0.5 * (p[1:] + p[:-1])
+    touching = (p[1:] > 0) | (p[:-1] > 0)
+    uc = getattr(u_c, "scalar", u_c)
+    return np.array([uc((scale * m + extra_Pa) / E_Pa) if t else math.inf for m, t in zip(mid, touching)])
+
+
+def _geometry(r: np.ndarray, radial: str) -> np.ndarray:
+    if radial == "annulus":
+        return np.log(r[1:] / r[:-1])
+    if radial == "strip":
+        return np.diff(r) / r[0]
+    raise ValueError(f"radial: expected 'annulus' or 'strip', got {radial!r}")
+
+
+def profile_leak_rate(gas: Gas, p_a: float, p_b: float, r_m: np.ndarray, gaps_m: np.ndarray,
+                      radial: str = "annulus") -> float:
+    """Molecule flow [1/s] into the cavity through rings [r_i, r_i+1] of gaps u_i (module docstring)."""
+    if not 0.0 <= p_b <= p_a:
+        raise ValueError(f"p_b: cavity pressure must be in [0, p_a] = [0, {p_a:g}] Pa, got {p_b:g}")
+    u = np.asarray(gaps_m, dtype=float)
+    g = _geometry(np.asarray(r_m, dtype=float), radial)
+    if np.any(u <= 0.0) or p_b == p_a:
+        return 0.0
+    resist = np.isfinite(u)
+    if not resist.any():
+        raise ValueError("gaps_m: no ring of the profile is in contact (the cavity is open)")
+    u, c = u[resist], 12.0 * gas.viscosity_Pa_s * gas.kT_J * g[resist] / (2.0 * math.pi)
+    b = XI * gas.n_lambda_per_m2 * gas.kT_J / 2.0 / u          # a / u for each ring
+    return _series_flow(p_a, p_b, u ** 3, b, c)
+
+
+def _series_flow(p_a: float, p_b: float, u3: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
+    """Q with P marched from p_a through the rings (Phi differences c_i Q) ending at p_b."""
+    # upper bound: no ring passes more than it would with the whole drop across it alone
+    q_hi = float(np.min(u3 * ((p_a + b) ** 2 - (p_b + b) ** 2) / (2.0 * c)))
+    lo, hi, q = 0.0, q_hi, 0.5 * q_hi
+    for _ in range(100):
+        p_in, dp_dq = _march(p_a, u3, b, c, q)
+        f = p_in - p_b
+        if f > 0.0:
+            lo = q
+        else:
+            hi = q
+        step = q - f / dp_dq if math.isfinite(dp_dq) and dp_dq < 0 else math.nan
+        q_new = step if lo < step < hi else 0.5 * (lo + hi)
+        if abs(q_new - q) <= 1e-13 * q_hi or hi - lo <= 1e-14 * q_hi:
+            return q_new
+        q = q_new
+    raise RuntimeError(f"profile leak: no convergence of the series flow (p_a {p_a:g}, p_b {p_b:g} Pa)")
+
+
+def _march(p_a: float, u3: np.ndarray, b: np.ndarray, c: np.ndarray, q: float) -> tuple[float, float]:
+    """(P at the inner edge, dP/dQ) for flow q; -inf if the pressure would fall below zero."""
+    P, dP = p_a, 0.0
+    for i in range(u3.size - 1, -1, -1):
+        w = (P + b[i]) ** 2 - 2.0 * c[i] * q / u3[i]
+        if w <= 0.0:
+            return -math.inf, -math.inf
+        root = math.sqrt(w)
+        dP = ((P + b[i]) * dP - c[i] / u3[i]) / root
+        P = root - b[i]
+    return P, dP
+
+
+def profile_liquid_rate(viscosity_Pa_s: float, p_a: float, p_b: float, r_m: np.ndarray,
+                        gaps_m: np.ndarray, radial: str = "annulus") -> float:
+    """Volume flow [m^3/s] of an incompressible liquid through the rings (eq 24 in series)."""
+    u = np.asarray(gaps_m, dtype=float)
+    g = _geometry(np.asarray(r_m, dtype=float), radial)
+    if np.any(u <= 0.0):
+        return 0.0
+    resist = np.isfinite(u)
+    if not resist.any():
+        raise ValueError("gaps_m: no ring of the profile is in contact (the cavity is open)")
+    R = float(np.sum(12.0 * viscosity_Pa_s * g[resist] / (2.0 * math.pi * u[resist] ** 3)))
+    return (p_a - p_b) / R
