@@ -1,4 +1,4 @@
-"""The main job, `cupcheck example`: FEM stiffness -> lifetime against F1 on pmma-1.89."""
+"""The main job, `cupcheck example`: FEM stiffness -> lifetime against F1 on pmma-1.89 (profile route)."""
 
 import math
 
@@ -43,12 +43,15 @@ def test_fem_stiffness_is_a_direct_compress_cup_run(example):
 
     curve = StiffnessCurve.from_csv(example / "stiffness_fem.csv")
     g = cup_geometry("A")
-    direct = compress_cup(cup_mesh(g, "medium"), NeoHookean(E_Pa=4e6, nu=0.49), contact="sticking",
+    direct = compress_cup(cup_mesh(g, "medium"), NeoHookean(E_Pa=4e6, nu=0.49), contact="frictionless",
                           u_max_m=0.9 * g.h1_m)
     # the CSV keeps 10 significant digits; the run is deterministic
     np.testing.assert_allclose(curve.u_m, direct.u_m, rtol=1e-9, atol=1e-15)
     np.testing.assert_allclose(curve.F0_N, direct.F0_N, rtol=1e-9, atol=1e-12)
-    assert curve.provenance["contact"] == "sticking" and curve.provenance["fidelity"] == "medium"
+    assert curve.provenance["contact"] == "frictionless" and curve.provenance["fidelity"] == "medium"
+    # the profile route's input travels with the curve: one contact-pressure profile per step
+    assert curve.profiles is not None and len(curve.profiles) == curve.u_m.size
+    assert all(p.force_N > 0 for p in curve.profiles[1:] if p is not None)
 
 
 @pytest.mark.parametrize("argv,message", [

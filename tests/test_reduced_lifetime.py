@@ -309,3 +309,32 @@ def test_water_cavitation_against_a_hand_written_bubble_ode():
 def test_bad_cavitation_pressure_is_rejected(kw, match):
     with pytest.raises(ValueError, match="cavitation_pressure_Pa: .*" + match):
         dataclasses.replace(REF_A, **kw)
+
+
+def test_profile_seal_of_a_uniform_strip_is_the_papers_strip_on_an_annulus():
+    """A curve whose profiles are eq (6)'s uniform strip (p = F0 / (2 pi r l) on [r, r + l]): the
+    profile seal's flow is the strip seal's times the annulus factor l / (r ln(1 + l/r)) at every
+    state (the paper's flat strip vs the exact ring), so the lifetime is a little shorter."""
+    from reduced.profile_leak import ContactProfile
+
+    u = np.linspace(0.0, 0.8 * CUP_A.h1_m, 60)
+    h = CUP_A.h1_m - u
+    x = 1.0 + h / CUP_A.h0_m
+    r, l = CUP_A.r0_m * x, CUP_A.l0_m + CUP_A.l_a_m * (1.0 - x)
+    F0 = appendix_a_force(u, CUP_A.alpha_deg, 4e6, 2e-3, CUP_A.r0_m, CUP_A.r1_m)
+    profiles = [None] + [ContactProfile([ri, ri + li], [F / (2 * math.pi * ri * li)] * 2)
+                         for ri, li, F in zip(r[1:], l[1:], F0[1:])]
+    curve = StiffnessCurve(u_m=u, F0_N=F0, h1_m=CUP_A.h1_m, r_c_m=r, l_m=l, V_m3=CUP_A.V0_m3 * (x ** 3 - 1),
+                           profiles=profiles)
+    strip = dataclasses.replace(REF_A, stiffness=curve, geometry="curve")
+    prof = dataclasses.replace(strip, seal="profile")
+    for hh in (0.3 * CUP_A.h1_m, 0.6 * CUP_A.h1_m):
+        i = int(np.argmin(np.abs(h - hh)))                   # at a sample: no interpolation between profiles
+        N = 0.5 * strip._core.n_eq(h[i], 1.0, 0.0)[0]
+        q_strip = strip._core.state(h[i], N, 1.0, 4e6, 10.0)[0]
+        q_prof = prof._core.state(h[i], N, 1.0, 4e6, 10.0)[0]
+        assert q_prof / q_strip == pytest.approx(l[i] / (r[i] * math.log(1 + l[i] / r[i])), rel=1e-9)
+    t_strip, t_prof = lifetime(strip, 20.0).lifetime_s, lifetime(prof, 20.0).lifetime_s
+    assert 0.85 * t_strip < t_prof < t_strip
+    with pytest.raises(ValueError, match="seal: the profile's radii are the FEM's"):
+        dataclasses.replace(prof, geometry="cone")

@@ -71,8 +71,11 @@ def same_design(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
 def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
                 geometry_file: str | Path | None = None, r_start_mm: float | None = None,
                 l0_mm: float | None = None, l1_mm: float | None = None,
-                curve_label: str = "the stiffness curve") -> CupChoice:
-    """The cup for a lifetime: the curve's design, checked against an explicit cup or file."""
+                curve_label: str = "the stiffness curve", laws: str = "cone") -> CupChoice:
+    """The cup for a lifetime: the curve's design, checked against an explicit cup or file.
+
+    laws: 'cone' (eq 5's l0, l1 are needed) or 'curve' (r, V, l come from the curve: a custom
+    design's l0, l1 are then not used and never refuse the run)."""
     explicit = explicit_design(cup, geometry_file) if (cup or geometry_file) else None
     explicit_label = f"--geometry {geometry_file}" if geometry_file is not None else f"--cup {cup}"
     recorded = curve.design if curve is not None else None
@@ -92,7 +95,7 @@ def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
                          f"(give --cup or --geometry)")
     if curve is not None:
         _check_height(design, curve, curve_label)
-    params, l_source = _parameters(design, curve, r_start_mm, l0_mm, l1_mm)
+    params, l_source = _parameters(design, curve, r_start_mm, l0_mm, l1_mm, laws)
     return CupChoice(cup=params, design=dict(design), label=_label(design), source=source, l_source=l_source,
                      notes=tuple(notes))
 
@@ -126,7 +129,7 @@ def _check_height(design: Mapping[str, Any], curve: StiffnessCurve, curve_label:
 
 
 def _parameters(design: Mapping[str, Any], curve: StiffnessCurve | None, r_start_mm: float | None,
-                l0_mm: float | None, l1_mm: float | None) -> tuple[CupParameters, str]:
+                l0_mm: float | None, l1_mm: float | None, laws: str = "cone") -> tuple[CupParameters, str]:
     """Table 1's parameters for a preset; the design's own otherwise (module docstring)."""
     preset = _preset_of(design)
     r0, r1 = design["r0_mm"] * _MM, design["r1_mm"] * _MM
@@ -148,7 +151,12 @@ def _parameters(design: Mapping[str, Any], curve: StiffnessCurve | None, r_start
     if l0_mm is not None:
         l0, l1, l_source = l0_mm * _MM, l1_mm * _MM, "given"
     else:
-        l0, l1, l_source = _fitted_strip_widths(curve, r0, r1, design)
+        try:
+            l0, l1, l_source = _fitted_strip_widths(curve, r0, r1, design)
+        except ValueError:
+            if laws == "cone":
+                raise
+            l0, l1, l_source = 0.1 * (r1 - r0), 0.1 * (r1 - r0), "not used: r, V, l from the curve"
     cup = CupParameters(r0_m=r0, r1_m=r1, alpha_deg=float(design["alpha_deg"]),
                         r_start_m=r_start or 0.5 * (r0 + r1), l0_m=l0, l1_m=l1, beta=0.8,
                         name=str(design.get("name", "custom")))

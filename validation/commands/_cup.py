@@ -46,13 +46,22 @@ def add_cup_arguments(parser: argparse.ArgumentParser, role: str):
     return g
 
 
-def add_cup_law_arguments(parser: argparse.ArgumentParser) -> None:
-    """--cup-laws, --r-start-mm, --l0-mm, --l1-mm: the reduced model's cup."""
+ROUTES = {"paper": "strip", "profile": "profile"}
+
+
+def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = "paper") -> None:
+    """--route, --cup-laws, --r-start-mm, --l0-mm, --l1-mm: the reduced model's cup and seal."""
     g = parser.add_argument_group("reduced-model cup")
-    g.add_argument("--cup-laws", default="cone", choices=("cone", "curve"),
+    g.add_argument("--route", default=default_route, choices=tuple(ROUTES),
+                   help="what the leak crosses: paper (eqs 3-7: one strip at the uniform pressure of "
+                        "eq 6, beta = 0.8), or profile (the FEM curve's own contact-pressure profile "
+                        "p(r) + beta (p_a - p_b), ring by ring, with its r_c and V; needs an FEM curve) "
+                        f"(default: {default_route})")
+    g.add_argument("--cup-laws", default=None, choices=("cone", "curve"),
                    help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 with the cup's r0, r1, "
                         "alpha (cone), or from the stiffness curve's r_c_mm, V_mm3, l_mm columns "
-                        "(curve; l = 0 is a line contact, sealed) (default: cone)")
+                        "(curve; l = 0 is a line contact, sealed) (default: cone for the paper route, "
+                        "curve for the profile route, which needs it)")
     g.add_argument("--r-start-mm", dest="r_start_mm", type=float, default=None,
                    help="inner contact radius after pressing on, in (r0, r1) mm (default: 12 mm "
                         "for cups A and B (Table 1), (r0 + r1)/2 for other designs)")
@@ -61,3 +70,15 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser) -> None:
                         "other designs fitted to the FEM curve's l(r_c))")
     g.add_argument("--l1-mm", dest="l1_mm", type=float, default=None,
                    help="eq (5)'s strip width at r1 in mm (with --l0-mm)")
+
+
+def route_model(args: argparse.Namespace) -> tuple[str, str]:
+    """(geometry, seal) of the `LeakageModel` the route and cup-law options ask for; fills
+    ``args.cup_laws`` with the route's default."""
+    seal = ROUTES[args.route]
+    if args.cup_laws is None:
+        args.cup_laws = "curve" if seal == "profile" else "cone"
+    if seal == "profile" and args.cup_laws != "curve":
+        raise ValueError("--cup-laws: the profile route takes r and V from the FEM curve whose "
+                         "profiles it crosses; drop --cup-laws cone")
+    return args.cup_laws, seal

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from validation.commands._cup import add_cup_arguments, add_cup_law_arguments
+from validation.commands._cup import add_cup_arguments, add_cup_law_arguments, route_model
 from validation.commands._surface import add_surface_arguments, has_surface, spectrum_from_args
 
 NAME = "lifetime"
@@ -133,6 +133,7 @@ def build_model(args: argparse.Namespace):
     if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
         raise ValueError(f"--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
     check_modulus(args.E_MPa, "--E-MPa")
+    geometry, seal = route_model(args)
     curve, choice = _curve_and_cup(args)
     check_design(choice.design, args.allow_unusual_design, source=choice.label)
     args.cup_choice = choice
@@ -142,7 +143,7 @@ def build_model(args: argparse.Namespace):
         changed = [opt for opt, val, default in (
             ("--stiffness", args.stiffness, "appendix-a"), ("--E-MPa", args.E_MPa, 4.0),
             ("--d0-mm", args.d0_mm, 2.0), ("--relaxation", args.relaxation, "none"),
-            ("--cup-laws", args.cup_laws, "cone"), ("--T-K", args.T_K, 293.15),
+            ("--cup-laws", args.cup_laws, "cone"), ("--route", args.route, "paper"), ("--T-K", args.T_K, 293.15),
             ("--p-a-Pa", args.p_a_Pa, 1e5), ("--phi0-s", args.phi0_s, None),
             ("--fluid", args.fluid, "air"), ("--cavitation-kPa", args.cavitation_kPa, None),
             ("--kappa", args.kappa, 1.0))
@@ -173,7 +174,7 @@ def build_model(args: argparse.Namespace):
     gas = Gas(T_K=args.T_K)
     model = LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
                          E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
-                         geometry=args.cup_laws, fluid=args.fluid,
+                         geometry=geometry, seal=seal, fluid=args.fluid,
                          liquid_viscosity_Pa_s=args.liquid_viscosity,
                          cavitation_pressure_Pa=None if p_cav is None else 1e3 * p_cav,
                          label=choice.label)
@@ -190,11 +191,13 @@ def _curve_and_cup(args: argparse.Namespace):
                    l0_mm=args.l0_mm, l1_mm=args.l1_mm)
     if args.stiffness == "appendix-a":
         if args.cup_laws == "curve":
-            raise ValueError("--cup-laws: 'curve' needs --stiffness FILE.csv with r_c_mm, V_mm3, l_mm")
+            raise ValueError(f"--{'route' if args.route == 'profile' else 'cup-laws'}: "
+                             f"'{args.route if args.route == 'profile' else 'curve'}' needs an FEM "
+                             f"stiffness curve (--stiffness FILE.csv with r_c_mm, V_mm3, l_mm)")
         return None, resolve_cup(None, **options)
     h1 = None if _has_h(args.stiffness) else 1e-3 * explicit_design(args.cup, args.geometry)["h1_mm"]
     curve = StiffnessCurve.from_csv(args.stiffness, h1_m=h1)
-    return curve, resolve_cup(curve, curve_label=f"'{args.stiffness}'", **options)
+    return curve, resolve_cup(curve, curve_label=f"'{args.stiffness}'", laws=args.cup_laws, **options)
 
 
 def _has_h(path: str) -> bool:
@@ -227,7 +230,7 @@ def run(args: argparse.Namespace) -> int:
 
     model = build_model(args)
     choice = args.cup_choice
-    cup = {**choice.describe(), "laws": args.cup_laws}
+    cup = {**choice.describe(), "laws": args.cup_laws, "route": args.route}
     for note in choice.notes:
         print(f"note: {note}", file=sys.stderr)
     if args.uc_table is None and not has_surface(args) and not args.json:
@@ -249,8 +252,10 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(summaries(results, cup), indent=2))
     else:
         laws = "cone laws (3)-(5)" if args.cup_laws == "cone" else "the stiffness curve"
+        seal = ("the curve's contact-pressure profiles" if args.route == "profile" else
+                "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})" if args.cup_laws == "cone" else ""))
         print(f"cup: {choice.label} from the {choice.source}; r_start {cup['r_start_mm']:.4g} mm; "
-              f"r, V, l from {laws}" + (f"; l0, l1: {choice.l_source}" if args.cup_laws == "cone" else ""))
+              f"r, V from {laws}; route {args.route}: the leak crosses {seal}")
         print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'ballistic':>9} {'r_end_mm':>8}")
         for r in results:
             life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"
