@@ -82,7 +82,7 @@ def stiffness_curve(response: CurveArrays, provenance: Mapping[str, Any]) -> Sti
     """The hand-off curve: u, F0 (the plate reaction), r_c, l (force-quartile width) and V per step,
     and, where the response has them, the contact-pressure profiles (lumped nodal pressures)."""
     pressure = getattr(response, "pressure", None)
-    profiles = None if pressure is None else profiles_from_lists(
+    profiles = None if not pressure else profiles_from_lists(
         [p.r_m * 1e3 for p in pressure], [p.p_Pa * 1e-3 for p in pressure])
     return StiffnessCurve(u_m=response.u_m, F0_N=response.F0_N + 0.0, h1_m=response.h1_m,
                           r_c_m=response.r_c_m, l_m=response.l_m, V_m3=response.V_m3,

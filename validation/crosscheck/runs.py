@@ -125,6 +125,7 @@ class FemResult:
     outline_z_m: np.ndarray = field(repr=False)
     outline_p_Pa: np.ndarray = field(repr=False)  # contact pressure on it (0 off contact)
     unstable: np.ndarray | None = field(default=None, repr=False)   # per step: tangent indefinite
+    pressure: tuple = field(default=(), repr=False)   # per step: fem.contact.PressureProfile
 
     def F0_at(self, u_m) -> np.ndarray:
         """F0 at plate displacements u [N], monotone cubic (PCHIP) between the steps."""
@@ -167,7 +168,7 @@ def compute(request: FemRun, progress: Callable[[float, str], None] | None = Non
                      energy_J=resp.energy_J, penetration_m=resp.penetration_m, wall_s=wall,
                      steps=int(resp.stats.steps), newton_iterations=int(resp.stats.newton_iterations),
                      dofs=int(resp.stats.dofs), outline_r_m=r, outline_z_m=z, outline_p_Pa=p,
-                     unstable=resp.unstable)
+                     unstable=resp.unstable, pressure=tuple(resp.pressure))
 
 
 def _deformed_outline(resp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
