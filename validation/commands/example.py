@@ -37,7 +37,7 @@ FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (written atomically)")
     add_cup_arguments(p, "the FEM runs on it and the lifetimes use it")
-    add_cup_law_arguments(p, default_route="profile")
+    add_cup_law_arguments(p, default_route="paper")
     p.add_argument("--contact", default="frictionless", choices=("frictionless", "sticking"),
                    help="FEM contact with the substrate (default: frictionless, as in the paper: its "
                         "F0 was measured on soap-lubricated glass and its lifetimes on soap-cleaned "
