@@ -299,7 +299,10 @@ def load_geometry(path: str | Path, cup: str = "A") -> CupGeometry:
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"geometry: no such file '{path}'")
-    text = path.read_text()
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise ValueError(f"geometry: '{path}' is not a UTF-8 text file") from None
     try:
         if path.suffix.lower() == ".toml":
             data = tomllib.loads(text)

@@ -56,7 +56,10 @@ def read_two_columns(path: str | os.PathLike, header: str, what: str) -> tuple[n
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"{what}: no such file '{path}'")
-    lines = [ln.strip() for ln in path.read_text().splitlines()]
+    try:
+        lines = [ln.strip() for ln in path.read_text(encoding="utf-8").splitlines()]
+    except UnicodeDecodeError:
+        raise ValueError(f"{what}: '{path}' is not a UTF-8 text file") from None
     body = [ln for ln in lines if ln and not ln.startswith("#")]
     if not body or [c.strip() for c in body[0].split(",")] != header.split(","):
         raise ValueError(f"{what}: '{path}' must start with the header '{header}'")

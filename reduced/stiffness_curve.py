@@ -231,8 +231,10 @@ class StiffnessCurve:
         if not path.is_file():
             raise ValueError(f"stiffness: no such file '{path}'")
         provenance: dict[str, Any] = {}
-        with open(path) as f:
-            lines = f.read().splitlines()
+        try:
+            lines = path.read_text(encoding="utf-8").splitlines()
+        except UnicodeDecodeError:
+            raise ValueError(f"stiffness: '{path}' is not a UTF-8 text file") from None
         body = []
         for line in lines:
             if line.startswith(_PROVENANCE_TAG):

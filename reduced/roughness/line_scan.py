@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import csv
 import os
+from pathlib import Path
 
 import numpy as np
 from scipy.signal import savgol_filter
@@ -29,10 +30,17 @@ from .spectrum import PowerSpectrum, line_to_isotropic
 _UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9}
 
 
+def _text(path, what: str) -> str:
+    """The file's text; a file that is not UTF-8 text is an input error naming `what`."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise ValueError(f"{what} {path}: not a UTF-8 text file") from None
+
+
 def read_line_scan(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     """(x [m], z [m]) from a CSV whose header is ``x_<unit>,z_<unit>``, unit in m, mm, um, nm."""
-    with open(path, newline="") as f:
-        rows = [r for r in csv.reader(f) if r]
+    rows = [r for r in csv.reader(_text(path, "line scan").splitlines()) if r]
     if not rows:
         raise ValueError(f"line scan {path}: file is empty")
     head = [c.strip() for c in rows[0][:2]]
@@ -47,6 +55,9 @@ def read_line_scan(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         data = np.array([[float(r[0]), float(r[1])] for r in rows[1:]], float)
     except (ValueError, IndexError) as exc:
         raise ValueError(f"line scan {path}: every row needs two numbers ({exc})") from None
+    bad = np.flatnonzero(~np.all(np.isfinite(data), axis=1)) if data.size else []
+    if len(bad):
+        raise ValueError(f"line scan {path}: row {int(bad[0]) + 2}: x and z must be finite")
     if data.shape[0] < 64:
         raise ValueError(f"line scan {path}: need at least 64 points, got {data.shape[0]}")
     return data[:, 0] * sx, data[:, 1] * sz

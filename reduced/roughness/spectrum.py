@@ -125,8 +125,11 @@ def read_psd_csv(path: str | os.PathLike, convention: str = "persson-2d") -> Pow
     """
     if CONVENTIONS.get(convention, (0,))[0] != 2:
         raise ValueError(f"convention: a C(q) table needs a 2D convention, got {convention!r}")
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))
+    except UnicodeDecodeError:
+        raise ValueError(f"psd file {path}: not a UTF-8 text file") from None
     if not rows or [c.strip() for c in rows[0][:2]] != ["q_per_m", "C_m4"]:
         raise ValueError(f"psd file {path}: first line must be the header 'q_per_m,C_m4'")
     try:

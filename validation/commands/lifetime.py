@@ -204,7 +204,11 @@ def _has_h(path: str) -> bool:
     p = Path(path)
     if not p.is_file():
         raise ValueError(f"--stiffness: no such file '{path}'")
-    for line in p.read_text().splitlines():
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise ValueError(f"--stiffness: '{path}' is not a UTF-8 text file") from None
+    for line in text.splitlines():
         if line.strip() and not line.startswith("#"):
             return "h_mm" in [c.strip() for c in line.split(",")]
     return False
