@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 #: subcommand modules, in the order `cupcheck --help` lists them
-COMMANDS = ("example", "lifetime", "stiffness", "sweep", "uc", "validate")
+COMMANDS = ("example", "lifetime", "run", "stiffness", "sweep", "uc", "validate")
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -21,10 +21,8 @@ reads it as it reads a measured curve. Everything else a run knows goes to the s
 from __future__ import annotations
 
 import json
-import platform
 from collections.abc import Mapping
 from dataclasses import asdict
-from importlib import metadata
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -32,21 +30,10 @@ import numpy as np
 
 from fem.cup import CupResponse
 from reduced.stiffness_curve import StiffnessCurve, profiles_from_lists
+from validation.output import software_versions
 
 __all__ = ["stiffness_curve", "provenance", "sidecar", "write_sidecar", "software_versions"]
 
-_PACKAGES = ("cupcheck", "numpy", "scipy", "scikit-fem", "meshio")
-
-
-def software_versions() -> dict[str, str]:
-    """Versions of Python and of the packages the FEM result depends on."""
-    versions = {"python": platform.python_version()}
-    for name in _PACKAGES:
-        try:
-            versions[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            versions[name] = "not installed"
-    return versions
 
 
 def provenance(response: CupResponse, *, geometry: Mapping[str, Any], mesh: Mapping[str, Any],

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import os
+import platform
 import secrets
 import shutil
 import sys
@@ -11,7 +12,23 @@ import tempfile
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from importlib import metadata
 from pathlib import Path
+
+#: the packages whose versions every output's provenance records
+_PACKAGES = ("cupcheck", "numpy", "scipy", "scikit-fem", "meshio")
+
+
+def software_versions() -> dict[str, str]:
+    """Versions of Python and of the packages the FEM result depends on."""
+    versions = {"python": platform.python_version()}
+    for name in _PACKAGES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = "not installed"
+    return versions
+
 
 #: progress callback used by long computations: progress(fraction_done in [0, 1], message)
 Progress = Callable[[float, str], None]

@@ -1,0 +1,90 @@
+"""Scenes (issue 13, first step): the scene file, the lazy cached pipeline, the shipped scenes."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from validation.cli import main
+from validation.scenes import pipeline
+from validation.scenes.outputs import run_scene
+from validation.scenes.schema import scene_from_mapping
+
+ROOT = Path(__file__).resolve().parents[1]
+SHIPPED = sorted(p for p in (ROOT / "scenes").glob("*.toml") if not p.name.startswith("sweep_"))
+
+
+@pytest.mark.parametrize("data,message", [
+    ({"outputs": [{"kind": "movie"}]}, "outputs[0].kind: expected one of curve, lifetimes, trajectories, figure"),
+    ({"outputs": [{"kind": "figure", "figure": "pie"}]}, "outputs[0].figure: expected one of lifetime_vs_force"),
+    ({"material": {"E_MPa": -4}, "outputs": [{"kind": "curve"}]}, "material.E_MPa: must be > 0"),
+    ({"loads": {"F1_N": [10, "x"]}, "outputs": [{"kind": "lifetimes"}]}, "loads.F1_N[1]: expected a finite number"),
+    ({"stiffness": {"route": "profile", "source": "appendix-a"}, "outputs": [{"kind": "lifetimes"}]},
+     "stiffness.route: 'profile' needs source = \"fem\""),
+    ({"cup": {"presett": "A"}, "outputs": [{"kind": "curve"}]}, "cup.presett: unknown key; allowed: preset, geometry"),
+    ({"camera": {}, "outputs": [{"kind": "curve"}]}, "camera: unknown table"),
+    ({}, "outputs: a scene needs a non-empty list of [[outputs]]"),
+    ({"outputs": [{"kind": "curve"}, {"kind": "curve"}]}, "outputs: two outputs would write the same file 'curve'"),
+])
+def test_bad_scenes_are_refused_with_the_key_path(data, message):
+    with pytest.raises(ValueError) as exc:
+        scene_from_mapping(data)
+    assert message in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_bad_scene_exits_2_and_writes_nothing(tmp_path, capsys):
+    path = tmp_path / "s.toml"
+    path.write_text('[[outputs]]\nkind = "figure"\nfigure = "pie"\n')
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--cache-dir", str(tmp_path / "c")]) == 2
+    assert "outputs[0].figure: expected one of" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+@pytest.mark.parametrize("scene", SHIPPED, ids=[p.stem for p in SHIPPED])
+def test_every_shipped_scene_runs_and_its_manifest_lists_every_file(scene, tmp_path, capsys):
+    assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--no-cache", "--quiet"]) == 0
+    manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
+    written = sorted(p.name for p in (tmp_path / "out").iterdir() if p.name != "manifest.json")
+    assert sorted(f["path"] for f in manifest["files"]) == written and written
+    assert manifest["scene"]["outputs"] and "numpy" in manifest["versions"]
+    for f in manifest["files"]:
+        if f["path"].endswith(".png"):
+            assert (tmp_path / "out" / f["path"]).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_second_run_computes_nothing_and_a_corrupt_entry_is_recomputed(tmp_path):
+    scene = ROOT / "scenes" / "lifetime_vs_force_cupA.toml"
+    cache = tmp_path / "cache"
+    pipeline.COMPUTED.clear()
+    first = run_scene(scene, tmp_path / "a", cache_dir=cache)
+    assert dict(pipeline.COMPUTED) == {"fem_curve": 1, "uc_table": 1, "lifetimes": 1}
+    run_scene(scene, tmp_path / "b", cache_dir=cache)
+    assert dict(pipeline.COMPUTED) == {"fem_curve": 1, "uc_table": 1, "lifetimes": 1}      # nothing new
+    assert (tmp_path / "a" / "lifetime_vs_force.csv").read_text() == (tmp_path / "b" / "lifetime_vs_force.csv").read_text()
+    for entry in cache.rglob("output.pkl"):            # damage every stored product
+        entry.write_bytes(b"not a pickle")
+    third = run_scene(scene, tmp_path / "c", cache_dir=cache)
+    assert dict(pipeline.COMPUTED) == {"fem_curve": 2, "uc_table": 2, "lifetimes": 2}
+    assert [r.lifetime_s for r in third.products["lifetimes"]] == [r.lifetime_s for r in first.products["lifetimes"]]
+
+
+_LAZY = """
+import sys
+from validation.scenes.outputs import run_scene
+from validation.scenes import pipeline
+run_scene({scene!r}, None)
+print(",".join(sorted(m for m in ("fem", "skfem") if m in sys.modules)), dict(pipeline.COMPUTED))
+"""
+
+
+@pytest.mark.parametrize("scene,computed", [
+    ("appendix_a_lifetimes.toml", "{'uc_table': 1, 'lifetimes': 1}"),
+    ("uc_pmma_1_89.toml", "{'uc_table': 1}"),
+])
+def test_a_scene_computes_only_what_it_needs(scene, computed):
+    """Appendix A lifetimes and a u_c figure never import fem; the u_c figure computes no lifetime."""
+    out = subprocess.run([sys.executable, "-c", _LAZY.format(scene=str(ROOT / "scenes" / scene))],
+                         cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
+    assert out == computed          # no "fem" or "skfem" before the dict: neither was imported

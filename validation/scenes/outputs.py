@@ -1,0 +1,156 @@
+"""Writing a scene's outputs: curves, lifetimes, trajectories, 2D figures, and the manifest.
+
+Each output pulls only the products it needs (`validation.scenes.pipeline.Products`). Figures are
+matplotlib (Agg) at the paper's column width (3.4 in), PNG and SVG, axes labelled with units.
+`run_scene` is the Python entry point (a scene file, a dict or a `Scene`; the results in memory,
+and on disk when given a directory, written atomically with ``manifest.json``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from validation.scenes.pipeline import Products
+from validation.scenes.schema import Scene, load_scene, scene_from_mapping
+
+__all__ = ["run_scene", "SceneResult"]
+
+COLUMN_IN = (3.4, 2.6)
+
+
+@dataclass
+class SceneResult:
+    """What a scene produced: the products in memory, the files written (name, kind, path)."""
+
+    scene: Scene
+    products: dict[str, Any]
+    files: list[dict[str, str]] = field(default_factory=list)
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
+              cache_dir: str | Path | None = None, progress=None) -> SceneResult:
+    """Compute a scene's outputs; with `out`, write them (atomically) and ``out/manifest.json``."""
+    from validation.output import atomic_directory, software_versions
+
+    if not isinstance(scene, Scene):
+        scene = scene_from_mapping(scene) if isinstance(scene, dict) else load_scene(scene)
+    products = Products(scene, cache_dir=cache_dir, progress=progress)
+    t0 = time.perf_counter()
+    if out is None:
+        files = [f for o in scene.outputs for f in _write(o, products, None)]
+        return SceneResult(scene, products.computed(), files, dict(products.timings))
+    with atomic_directory(out) as tmp:
+        files = [f for o in scene.outputs for f in _write(o, products, Path(tmp))]
+        manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
+                    "scene": scene.resolved(), "source": scene.source,
+                    "versions": software_versions(), "timings_s": {**products.timings,
+                                                                   "total": time.perf_counter() - t0}}
+        (Path(tmp) / "manifest.json").write_text(json.dumps(manifest, indent=1, default=str) + "\n")
+    files = [{**f, "path": str(Path(out) / Path(f["path"]).name)} for f in files]
+    return SceneResult(scene, products.computed(), files, dict(products.timings))
+
+
+def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str, str]]:
+    kind, name = output["kind"], output["name"]
+    if kind == "curve":
+        curve = products.curve()
+        if tmp is None:
+            return []
+        csv = curve.to_csv(tmp / f"{name}.csv")
+        return [_file(name, kind, csv), _file(name, kind, csv.with_suffix(".json"))]
+    if kind in ("lifetimes", "trajectories"):
+        results = products.lifetimes()
+        if tmp is None:
+            return []
+        if kind == "lifetimes":
+            return [_file(name, kind, _lifetime_table(results, products, tmp / f"{name}.csv"))]
+        return [_file(name, kind, _trajectory(r, tmp / f"{name}_F1_{r.force_N:g}N.csv")) for r in results]
+    figure = {"lifetime_vs_force": _lifetime_figure, "uc_vs_pressure": _uc_figure, "F0_vs_u": _F0_figure}
+    fig = figure[output["figure"]](products)
+    if tmp is None:
+        import matplotlib.pyplot as plt
+        plt.close(fig)
+        return []
+    paths = []
+    for suffix in ("png", "svg"):
+        path = tmp / f"{name}.{suffix}"
+        fig.savefig(path, dpi=200)
+        paths.append(_file(name, "figure", path))
+    import matplotlib.pyplot as plt
+    plt.close(fig)
+    return paths
+
+
+def _file(name: str, kind: str, path: Path) -> dict[str, str]:
+    return {"name": name, "kind": kind, "path": str(path)}
+
+
+def _lifetime_table(results, products: Products, path: Path) -> Path:
+    from validation.output import write_table
+
+    s = products.scene
+    return write_table(path, {
+        "route": s["stiffness"]["route"], "stiffness": s["stiffness"]["source"],
+        "force_N": [r.force_N for r in results],
+        "lifetime_s": [r.lifetime_s for r in results], "reason": [r.reason for r in results],
+        "ballistic_share": [r.ballistic_share for r in results],
+        "r_final_mm": [1e3 * float(r.r_m[-1]) for r in results],
+        "p_b_final_Pa": [float(r.p_b_Pa[-1]) for r in results]})
+
+
+def _trajectory(result, path: Path) -> Path:
+    from validation.output import write_table
+    return write_table(path, dict(result.trajectory_columns()))
+
+
+def _axes(xlabel: str, ylabel: str):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=COLUMN_IN, constrained_layout=True)
+    ax.set(xlabel=xlabel, ylabel=ylabel)
+    return fig, ax
+
+
+def _lifetime_figure(products: Products):
+    results = products.lifetimes()
+    s = products.scene
+    fig, ax = _axes("pull force $F_1$ (N)", "lifetime (s)")
+    pts = [(r.force_N, r.lifetime_s) for r in results if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
+    if pts:
+        ax.semilogy(*zip(*pts), "o-", ms=3, label=f"{s['stiffness']['source']}, {s['stiffness']['route']} route")
+        ax.legend(fontsize=6)
+    ax.set_title(f"cup {s['cup']['preset'] if not s['cup']['geometry'] else Path(s['cup']['geometry']).name}, "
+                 f"{s['surface']['preset'] if not s['surface']['uc_table'] else 'u_c table'}", fontsize=7)
+    return fig
+
+
+def _uc_figure(products: Products):
+    import numpy as np
+    table = products.uc_table()
+    fig, ax = _axes("$p/E$", "$u_c$ (nm)")
+    x = np.geomspace(1e-4, 0.1, 200)
+    u = np.array([table(v) for v in x])
+    ax.loglog(x[u > 0], 1e9 * u[u > 0])
+    ax.set_title(products.scene["surface"]["preset"] or "u_c table", fontsize=7)
+    return fig
+
+
+def _F0_figure(products: Products):
+    from reduced.appendix_a import appendix_a_curve
+    from reduced.cup import CUPS
+    curve = products.curve()
+    fig, ax = _axes("plate displacement $u$ (mm)", "stiffness force $F_0$ (N)")
+    ax.plot(1e3 * curve.u_m, curve.F0_N, label=products.scene["stiffness"]["source"])
+    if curve.design is None or not products.scene["cup"]["geometry"]:
+        ref = appendix_a_curve(CUPS[products.scene["cup"]["preset"]])
+        keep = ref.u_m <= curve.u_m[-1]
+        ax.plot(1e3 * ref.u_m[keep], ref.F0_N[keep], "--", label="Appendix A")
+    ax.legend(fontsize=6)
+    return fig

@@ -1,0 +1,158 @@
+"""The products a scene can ask for, computed lazily and cached on disk.
+
+    surface ----------------------------> u_c table ----+
+    cup, material, contact, fidelity ---> FEM curve ----+--> lifetimes (and trajectories)
+    cup (Appendix A) -------------------> curve --------+
+
+`Products` computes each product the first time an output asks for it and keeps it: a scene whose
+outputs need only the u_c table never builds a curve, and a lifetime fed by Appendix A never
+imports `fem`. The expensive products (u_c table, FEM curve, lifetimes) go through `joblib.Memory`
+(a kept library: content-addressed by the function's code and arguments, written atomically,
+recomputed when an entry cannot be read); the key includes a hash of the sources of the package
+that computes the product, so a code change invalidates exactly its products. `COMPUTED` counts
+the products actually computed in this process (a second run of the same scene computes none).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from collections import Counter
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+from validation.scenes.schema import Scene
+
+__all__ = ["Products", "COMPUTED", "package_version"]
+
+#: products computed (not taken from the cache) in this process, by name
+COMPUTED: Counter = Counter()
+_ROOT = Path(__file__).resolve().parents[2]
+
+
+@lru_cache(maxsize=None)
+def package_version(package: str) -> str:
+    """A hash of a package's sources (part of every cache key of its products)."""
+    h = hashlib.sha256()
+    for path in sorted((_ROOT / package).rglob("*.py")):
+        h.update(path.relative_to(_ROOT).as_posix().encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+# ------------------------------------------------------------------ the cached computations
+def _uc_table(surface: dict, code: str):
+    COMPUTED["uc_table"] += 1
+    from reduced.critical_gap import UcTable
+    if surface["uc_table"] is not None:
+        return UcTable.from_csv(surface["uc_table"])
+    from reduced.roughness import uc_table
+    from reduced.roughness.surfaces import preset
+    return uc_table(preset(surface["preset"]).spectrum(), 0.5)
+
+
+def _fem_curve(cup: dict, material: dict, contact: str, fidelity: str, code: str):
+    COMPUTED["fem_curve"] += 1
+    from fem.cup import compress_cup
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+    from validation import handoff
+
+    geometry = _geometry(cup)
+    response = compress_cup(cup_mesh(geometry, fidelity), NeoHookean(E_Pa=material["E_MPa"] * 1e6,
+                            nu=material["nu"], formulation="mixed" if material["nu"] > 0.495 else "displacement"),
+                            contact=contact, u_max_m=0.9 * geometry.h1_m)
+    prov = handoff.provenance(response, geometry=geometry.describe(), mesh={"fidelity": fidelity},
+                              fidelity=fidelity)
+    return handoff.stiffness_curve(response, prov)
+
+
+def _lifetimes(tables: dict, curve, uc, code: str):
+    COMPUTED["lifetimes"] += 1
+    from reduced.lifetime import lifetime_sweep
+    model = _model(tables, curve, uc)
+    return lifetime_sweep(model, tables["loads"]["F1_N"], refine=2)
+
+
+def _geometry(cup: dict):
+    from fem.geometry import cup_geometry, load_geometry
+    return load_geometry(cup["geometry"], cup=cup["preset"]) if cup["geometry"] else cup_geometry(cup["preset"])
+
+
+def _model(tables: dict, curve, uc):
+    """The `LeakageModel` of the scene (the cup from the curve's design, or Table 1's preset)."""
+    from dataclasses import replace
+
+    from reduced.cup import CUPS
+    from reduced.gas import Gas
+    from reduced.lifetime import LeakageModel
+    from reduced.viscoelastic import default_relaxation
+
+    loads, route = tables["loads"], tables["stiffness"]["route"]
+    if curve.design is None:               # Appendix A of a Table 1 preset: no fem imported
+        cup = CUPS[tables["cup"]["preset"]]
+        if loads["r_start_mm"] is not None:
+            cup = replace(cup, r_start_m=1e-3 * loads["r_start_mm"])
+    else:
+        from validation.design import resolve_cup
+        cup = resolve_cup(curve, r_start_mm=loads["r_start_mm"],
+                          laws="curve" if route == "profile" else "cone").cup
+    stiffness = curve.scaled(loads["kappa"]) if loads["kappa"] != 1.0 else curve
+    return LeakageModel(cup=cup, stiffness=stiffness, u_c=uc, gas=Gas(T_K=293.15), p_a_Pa=1e5,
+                        E_Pa=tables["material"]["E_MPa"] * 1e6,
+                        relaxation=default_relaxation() if tables["material"]["relaxation"] == "default" else None,
+                        geometry="curve" if route == "profile" else "cone",
+                        seal="profile" if route == "profile" else "strip", fluid=tables["fluid"]["kind"])
+
+
+# ------------------------------------------------------------------ the lazy products
+class Products:
+    """The products of one scene, each computed on first use (through the disk cache, if any)."""
+
+    def __init__(self, scene: Scene, cache_dir: str | Path | None = None, progress=None):
+        self.scene, self.timings, self._done = scene, {}, {}
+        self._progress = progress or (lambda message: None)
+        self._memory = None
+        if cache_dir is not None:
+            from joblib import Memory
+            self._memory = Memory(str(cache_dir), verbose=0)
+
+    def _cached(self, func):
+        return self._memory.cache(func) if self._memory is not None else func
+
+    def _get(self, name: str, compute):
+        if name not in self._done:
+            self._progress(f"{name} ...")
+            t0 = time.perf_counter()
+            self._done[name] = compute()
+            self.timings[name] = time.perf_counter() - t0
+        return self._done[name]
+
+    def uc_table(self):
+        return self._get("uc_table", lambda: self._cached(_uc_table)(self.scene["surface"],
+                                                                      package_version("reduced")))
+
+    def curve(self):
+        s = self.scene
+        if s["stiffness"]["source"] == "appendix-a":
+            return self._get("curve", self._appendix_a)
+        return self._get("curve", lambda: self._cached(_fem_curve)(
+            s["cup"], s["material"], s["contact"]["law"], s["stiffness"]["fidelity"], package_version("fem")))
+
+    def _appendix_a(self):
+        from reduced.appendix_a import appendix_a_curve
+        from reduced.cup import CUPS
+        return appendix_a_curve(CUPS[self.scene["cup"]["preset"]], E_Pa=self.scene["material"]["E_MPa"] * 1e6,
+                                d0_m=2e-3)
+
+    def lifetimes(self):
+        return self._get("lifetimes", lambda: self._cached(_lifetimes)(
+            self.scene.tables, self.curve(), self.uc_table(),
+            package_version("reduced") + package_version("validation")))
+
+    def model(self):
+        return self._get("model", lambda: _model(self.scene.tables, self.curve(), self.uc_table()))
+
+    def computed(self) -> dict[str, Any]:
+        return dict(self._done)

@@ -1,0 +1,173 @@
+"""The scene file: what to model and what to show, validated before any work.
+
+    [cup]            preset = "A" | geometry = "my_cup.toml"        (one of them)
+    [material]       E_MPa = 4.0, nu = 0.49, relaxation = "none" | "default"
+    [contact]        law = "frictionless" | "sticking"
+    [surface]        preset = "pmma-1.89" | uc_table = "uc.csv"     (one of them)
+    [fluid]          kind = "air" | "water"
+    [loads]          F1_N = [5, 10, 20], r_start_mm = 12 (optional), kappa = 1.0
+    [stiffness]      source = "fem" | "appendix-a", route = "paper" | "profile",
+                     fidelity = "coarse" | "medium" | "fine"
+    [[outputs]]      kind = "curve" | "lifetimes" | "trajectories" | "figure"
+                     name = "..." (file stem), figure = "lifetime_vs_force" | "uc_vs_pressure" | "F0_vs_u"
+
+Every table and key is optional but `outputs`; defaults are the main job's (cup A, frictionless
+FEM at the coarse level, the paper's route, pmma-1.89, air, F1 = 5 ... 80 N). Unknown keys, wrong
+types and contradictions are ValueErrors naming the key path (``outputs[2].kind: expected one of
+...``): one line and exit status 2 on the command line, before anything is computed or written.
+Paths in the scene are relative to the scene file.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+__all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES"]
+
+OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure")
+FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u")
+_TABLES: dict[str, dict[str, Any]] = {
+    "cup": {"preset": "A", "geometry": None},
+    "material": {"E_MPa": 4.0, "nu": 0.49, "relaxation": "none"},
+    "contact": {"law": "frictionless"},
+    "surface": {"preset": "pmma-1.89", "uc_table": None},
+    "fluid": {"kind": "air"},
+    "loads": {"F1_N": [5.0, 10.0, 20.0, 40.0, 80.0], "r_start_mm": None, "kappa": 1.0},
+    "stiffness": {"source": "fem", "route": "paper", "fidelity": "coarse"},
+}
+_CHOICES = {("cup", "preset"): ("A", "B"), ("material", "relaxation"): ("none", "default"),
+            ("contact", "law"): ("frictionless", "sticking"), ("fluid", "kind"): ("air", "water"),
+            ("stiffness", "source"): ("fem", "appendix-a"), ("stiffness", "route"): ("paper", "profile"),
+            ("stiffness", "fidelity"): ("coarse", "medium", "fine")}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene: every table resolved with its defaults, paths made absolute."""
+
+    tables: dict[str, dict[str, Any]]
+    outputs: tuple[dict[str, Any], ...]
+    source: str = "scene"
+
+    def __getitem__(self, table: str) -> dict[str, Any]:
+        return self.tables[table]
+
+    def resolved(self) -> dict[str, Any]:
+        """Plain data for the manifest: every table with its defaults, and the outputs."""
+        return {**{k: dict(v) for k, v in self.tables.items()}, "outputs": [dict(o) for o in self.outputs]}
+
+    def needs_fem(self) -> bool:
+        """Whether any requested output needs the FEM (a stiffness curve from it)."""
+        if self["stiffness"]["source"] != "fem":
+            return False
+        return any(o["kind"] != "figure" or o["figure"] != "uc_vs_pressure" for o in self.outputs)
+
+
+def load_scene(path: str | Path) -> Scene:
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"scene: no such file '{path}'")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"scene: cannot parse '{path}': {exc}".replace("\n", " ")) from None
+    return scene_from_mapping(data, base=path.parent, source=path.name)
+
+
+def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: str = "scene") -> Scene:
+    """A `Scene` from plain data (parsed TOML); ValueError naming the key path."""
+    unknown = sorted(set(data) - set(_TABLES) - {"outputs"})
+    if unknown:
+        raise ValueError(f"{unknown[0]}: unknown table; allowed: {', '.join([*_TABLES, 'outputs'])}")
+    tables = {name: _table(name, data.get(name, {}), defaults) for name, defaults in _TABLES.items()}
+    _paths(tables, Path(base))
+    _cross_checks(tables)
+    outputs = data.get("outputs")
+    if not isinstance(outputs, list) or not outputs:
+        raise ValueError("outputs: a scene needs a non-empty list of [[outputs]]")
+    parsed = tuple(_output(o, i) for i, o in enumerate(outputs))
+    files = [(o["name"], o["kind"] == "figure") for o in parsed]      # tables are .csv, figures .png/.svg
+    if len(set(files)) != len(files):
+        twice = next(n for n, f in files if files.count((n, f)) > 1)
+        raise ValueError(f"outputs: two outputs would write the same file '{twice}'; give one a name")
+    return Scene(tables=tables, outputs=parsed, source=source)
+
+
+def _table(name: str, given: Any, defaults: dict[str, Any]) -> dict[str, Any]:
+    if not isinstance(given, Mapping):
+        raise ValueError(f"{name}: expected a table")
+    unknown = sorted(set(given) - set(defaults))
+    if unknown:
+        raise ValueError(f"{name}.{unknown[0]}: unknown key; allowed: {', '.join(defaults)}")
+    table = {**defaults, **given}
+    for key, value in table.items():
+        where = f"{name}.{key}"
+        if (name, key) in _CHOICES and value not in _CHOICES[(name, key)]:
+            raise ValueError(f"{where}: expected one of {', '.join(_CHOICES[(name, key)])}, got {value!r}")
+        if key in ("E_MPa", "nu", "kappa", "r_start_mm") and value is not None:
+            table[key] = _number(value, where, positive=key != "nu")
+        if key == "F1_N":
+            values = value if isinstance(value, list) else [value]
+            if not values:
+                raise ValueError(f"{where}: expected at least one pull force")
+            table[key] = [_number(v, f"{where}[{i}]", positive=True) for i, v in enumerate(values)]
+    return table
+
+
+def _paths(tables: dict[str, dict[str, Any]], base: Path) -> None:
+    for name, key in (("cup", "geometry"), ("surface", "uc_table")):
+        value = tables[name][key]
+        if value is None:
+            continue
+        if not isinstance(value, str):
+            raise ValueError(f"{name}.{key}: expected a file name, got {value!r}")
+        path = (base / value).resolve()
+        if not path.is_file():
+            raise ValueError(f"{name}.{key}: no such file '{path}'")
+        tables[name][key] = str(path)
+
+
+def _cross_checks(tables: dict[str, dict[str, Any]]) -> None:
+    if tables["cup"]["geometry"] is not None and tables["stiffness"]["source"] != "fem":
+        raise ValueError("stiffness.source: a design file (cup.geometry) needs source = \"fem\"; Appendix A "
+                         "is for the Table 1 presets")
+    if tables["stiffness"]["route"] == "profile" and tables["stiffness"]["source"] != "fem":
+        raise ValueError("stiffness.route: 'profile' needs source = \"fem\" (the FEM's contact-pressure profiles)")
+    if tables["fluid"]["kind"] == "water" and tables["material"]["relaxation"] != "none":
+        raise ValueError("material.relaxation: the water-filled cavity is implemented without relaxation only")
+    if not 0.0 <= tables["material"]["nu"] < 0.5:
+        raise ValueError(f"material.nu: Poisson's ratio must be in [0, 0.5), got {tables['material']['nu']:g}")
+
+
+def _output(output: Any, i: int) -> dict[str, Any]:
+    where = f"outputs[{i}]"
+    if not isinstance(output, Mapping):
+        raise ValueError(f"{where}: expected a table")
+    unknown = sorted(set(output) - {"kind", "name", "figure"})
+    if unknown:
+        raise ValueError(f"{where}.{unknown[0]}: unknown key; allowed: kind, name, figure")
+    kind = output.get("kind")
+    if kind not in OUTPUT_KINDS:
+        raise ValueError(f"{where}.kind: expected one of {', '.join(OUTPUT_KINDS)}, got {kind!r}")
+    figure = output.get("figure")
+    if kind == "figure" and figure not in FIGURES:
+        raise ValueError(f"{where}.figure: expected one of {', '.join(FIGURES)}, got {figure!r}")
+    if kind != "figure" and figure is not None:
+        raise ValueError(f"{where}.figure: only for kind = \"figure\"")
+    name = output.get("name", figure if kind == "figure" else kind)
+    if not isinstance(name, str) or not name or "/" in name or name.startswith("."):
+        raise ValueError(f"{where}.name: expected a plain file stem, got {name!r}")
+    return {"kind": kind, "name": name, "figure": figure}
+
+
+def _number(value: Any, where: str, positive: bool) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{where}: expected a finite number, got {value!r}")
+    if positive and value <= 0:
+        raise ValueError(f"{where}: must be > 0, got {value:g}")
+    return float(value)
