@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 # ------------------------------------------------------------------------------ the sweep file
 @pytest.mark.parametrize("data,message", [
-    ({"bsae": {}}, "bsae: unknown key; allowed: base, sampling, axes"),
+    ({"bsae": {}}, "bsae: unknown key; allowed: scene, base, sampling, axes"),
     ({"base": {"E_Mpa": 4}}, "base.E_Mpa: unknown key"),
     ({"base": {"contact": "glued"}}, "base.contact: expected one of frictionless, sticking, got 'glued'"),
     ({"axes": [{"name": "alpha_deg", "values": [30]}, {"name": "angle", "values": [1]}]},
@@ -168,3 +168,16 @@ def test_pareto_front_is_the_non_dominated_set():
     vol = np.array([1.0, 2.0, 3.0, 4.0, 0.5])
     # (15, 3) is dominated by (20, 2); the rest trade lifetime for volume
     assert pareto_front(life, vol).tolist() == [4, 0, 1, 3]
+
+
+def test_a_sweep_takes_its_base_from_a_scene_file(tmp_path):
+    """One mechanism: a scene file (as `cupcheck run` reads it) is the sweep's base; [base] overrides."""
+    (tmp_path / "base.toml").write_text('[cup]\npreset = "B"\n[contact]\nlaw = "sticking"\n'
+                                        '[loads]\nF1_N = [20]\n[[outputs]]\nkind = "lifetimes"\n')
+    spec = sweep_from_mapping({"scene": "base.toml", "base": {"fidelity": "medium"},
+                               "axes": [{"name": "alpha_deg", "values": [20, 25]}]}, root=tmp_path)
+    d = spec.designs()
+    assert [x["alpha_deg"] for x in d] == [20, 25]
+    assert {(x["cup"], x["contact"], x["fidelity"], tuple(x["F1_N"])) for x in d} == {("B", "sticking", "medium", (20.0,))}
+    with pytest.raises(ValueError, match="scene: no such file"):
+        sweep_from_mapping({"scene": "missing.toml"}, root=tmp_path)

@@ -24,7 +24,9 @@
     name = "alpha_deg"
     values = [25, 33, 40]
 
-Axis names are the numeric base keys (alpha_deg, r0_mm, r1_mm, d0_mm, d1_mm, E_MPa, nu, r_start_mm)
+Instead of (or under) ``[base]``, ``scene = "my_scene.toml"`` takes the base design from a scene
+file (`validation.scenes.schema`: its cup, material, contact, surface, loads and FEM fidelity);
+keys in ``[base]`` then override the scene's. Axis names are the numeric base keys (alpha_deg, r0_mm, r1_mm, d0_mm, d1_mm, E_MPa, nu, r_start_mm)
 and, on a grid, the categorical ones (contact, surface). Errors name the key path
 (``axes[1].name: expected one of ...``) and are ValueErrors (exit status 2 on the command line).
 """
@@ -98,13 +100,14 @@ def load_sweep(path: str | Path) -> SweepSpec:
         data = tomllib.loads(path.read_text())
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"sweep: cannot parse '{path}': {exc}".replace("\n", " ")) from None
-    return sweep_from_mapping(data)
+    return sweep_from_mapping(data, root=path.parent)
 
 
-def sweep_from_mapping(data: Mapping[str, Any]) -> SweepSpec:
+def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".") -> SweepSpec:
     """A `SweepSpec` from parsed TOML (module docstring); ValueError naming the key path."""
-    _keys(data, ("base", "sampling", "axes"), "")
-    base = _base(data.get("base", {}))
+    _keys(data, ("scene", "base", "sampling", "axes"), "")
+    base = _base({**_scene_base(data["scene"], root), **data.get("base", {})} if "scene" in data
+                 else data.get("base", {}))
     sampling = data.get("sampling", {})
     _keys(sampling, ("method", "n", "seed"), "sampling")
     method = sampling.get("method", "grid")
@@ -125,6 +128,30 @@ def sweep_from_mapping(data: Mapping[str, Any]) -> SweepSpec:
     if method != "grid" and not parsed:
         raise ValueError(f"axes: {method} sampling needs at least one axis")
     return SweepSpec(base=base, axes=parsed, method=method, n=n if method != "grid" else 0, seed=seed)
+
+
+def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
+    """The sweep's base design from a scene file (the same format as `cupcheck run`)."""
+    from validation.scenes.schema import load_scene
+
+    if not isinstance(scene, str):
+        raise ValueError(f"scene: expected a scene file name, got {scene!r}")
+    sc = load_scene(Path(root) / scene)
+    base = {"cup": sc["cup"]["preset"], "E_MPa": sc["material"]["E_MPa"], "nu": sc["material"]["nu"],
+            "contact": sc["contact"]["law"], "fidelity": sc["stiffness"]["fidelity"], "F1_N": sc["loads"]["F1_N"]}
+    if sc["surface"]["preset"] and not sc["surface"]["uc_table"]:
+        base["surface"] = sc["surface"]["preset"]
+    if sc["loads"]["r_start_mm"] is not None:
+        base["r_start_mm"] = sc["loads"]["r_start_mm"]
+    if sc["cup"]["geometry"]:
+        from fem.geometry import load_geometry
+        d = load_geometry(sc["cup"]["geometry"], cup=sc["cup"]["preset"]).describe()
+        base.update(r0_mm=d["r0_mm"], r1_mm=d["r1_mm"], alpha_deg=d["alpha_deg"], d0_mm=d["d_at_r0_mm"],
+                    d1_mm=d["d_at_r1_mm"])
+    if sc["surface"]["uc_table"] or sc["stiffness"]["source"] != "fem" or sc["fluid"]["kind"] != "air":
+        raise ValueError(f"scene: a sweep evaluates FEM designs in air on a preset surface; '{scene}' asks for "
+                         f"another stiffness source, fluid or a u_c table")
+    return base
 
 
 def _keys(table: Any, allowed: tuple[str, ...], where: str) -> None:
