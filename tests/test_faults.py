@@ -43,3 +43,44 @@ def test_a_killed_stiffness_run_leaves_no_partial_file(tmp_path, sig):
     # an earlier complete output survives a later killed run: once complete, it stays complete
     if "complete" in seen:
         assert _complete_or_absent(out) == "complete"
+
+
+def test_two_runs_into_the_same_output_do_not_interleave(tmp_path, capsys):
+    """While one run holds an output, a second run into it is refused at once, and writes nothing."""
+    from filelock import FileLock
+
+    from validation.cli import main
+
+    out = tmp_path / "run"
+    with FileLock(str(tmp_path / ".run.lock")):          # the first run, still writing
+        assert main(["lifetime", "--force", "10", "--out", str(out)]) == 2
+    assert "out: '" in capsys.readouterr().err and not out.exists()
+    assert main(["lifetime", "--force", "10", "--out", str(out)]) == 0       # free again
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]             # no lock file left
+
+
+def test_a_full_disk_is_a_clear_error_and_leaves_nothing(tmp_path):
+    """A file-size limit (RLIMIT_FSIZE, as a full disk would) while writing the trajectories: one
+    line, exit 1, and the output directory is not there."""
+    import resource
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (2000, 2000))
+
+    out = tmp_path / "run"
+    done = subprocess.run([sys.executable, "-m", "validation.cli", "lifetime", "--force", "10", "--relaxation",
+                           "default", "--out", str(out)], cwd=ROOT, capture_output=True, text=True,
+                          preexec_fn=limit, timeout=120)
+    assert done.returncode == 1, done.stderr
+    assert done.stderr.strip().splitlines()[-1].startswith("cupcheck lifetime: failed: cannot write the output: "
+                                                            "File too large")
+    assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name != ".run.lock"]
+
+
+def test_the_finite_guard_names_the_column_and_the_stage(tmp_path):
+    from validation.output import write_table
+
+    with pytest.raises(RuntimeError, match="lifetime: column r_mm has 1 non-finite value"):
+        write_table(tmp_path / "t.csv", {"t_s": [0.0, 1.0], "r_mm": [12.0, float("nan")]}, stage="lifetime")
+    write_table(tmp_path / "t.csv", {"lifetime_s": [float("inf"), 3.0]})      # an infinite lifetime means sealed
+    assert (tmp_path / "t.csv").read_text().splitlines()[1] == "inf"

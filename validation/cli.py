@@ -11,11 +11,15 @@ allowed range); a solver that fails (``RuntimeError``) prints where and why and 
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
+import signal
 import sys
 from collections.abc import Sequence
 from typing import NoReturn
 
+#: errno values that mean an output could not be written
+_WRITE_ERRORS = {errno.ENOSPC, errno.EROFS, errno.EACCES, errno.EFBIG, errno.EDQUOT, errno.EPERM}
 #: subcommand modules, in the order `cupcheck --help` lists them
 COMMANDS = ("example", "lifetime", "run", "stiffness", "sweep", "uc", "validate")
 
@@ -58,8 +62,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     args, unknown = parser.parse_known_args(argv)
     if unknown:                              # said by the subcommand, not by `cupcheck`
         args._parser.error(f"unrecognized arguments: {' '.join(unknown)}")
+    if hasattr(signal, "SIGXFSZ"):           # a file-size limit: an OSError to report, not a kill
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     try:
         return int(args._run(args) or 0)
+    except OSError as exc:                   # a full disk, a read-only directory, a size limit
+        where = f" ('{exc.filename}')" if exc.filename else ""
+        what = "cannot write the output: " if exc.errno in _WRITE_ERRORS else ""
+        print(f"cupcheck {args.command}: failed: {what}{exc.strerror or exc}{where}", file=sys.stderr)
+        return 1
     except ValueError as exc:
         print(f"cupcheck {args.command}: error: {_one_line(str(exc))}", file=sys.stderr)
         return 2

@@ -35,26 +35,48 @@ Progress = Callable[[float, str], None]
 
 
 @contextmanager
+def exclusive(out: Path) -> Iterator[None]:
+    """Hold the output `out` for this run: a second run writing the same output is refused at
+    once (an OS file lock, `filelock`, released even when the process is killed), so two runs
+    never interleave their files. The lock file ``.<name>.lock`` is removed on release."""
+    from filelock import FileLock, Timeout
+
+    lock_path = out.parent / f".{out.name}.lock"
+    lock = FileLock(str(lock_path), timeout=0)
+    try:
+        lock.acquire()
+    except Timeout:
+        raise ValueError(f"out: '{out}' is being written by another cupcheck run; wait for it or "
+                         f"choose another output") from None
+    try:
+        yield
+    finally:
+        lock.release()
+        lock_path.unlink(missing_ok=True)
+
+
+@contextmanager
 def atomic_directory(out: str | os.PathLike) -> Iterator[Path]:
     """Yield a fresh temporary directory next to `out`; on success its files move into `out`.
 
     On any exception nothing is written to `out` and the temporary directory is removed, so a
-    failed or interrupted run leaves no half-written output.
+    failed or interrupted run leaves no half-written output; each file arrives whole (a rename).
     """
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp"))
-    try:
-        yield tmp
-        out.mkdir(parents=True, exist_ok=True)
-        for item in sorted(tmp.rglob("*")):
-            target = out / item.relative_to(tmp)
-            if item.is_dir():
-                target.mkdir(parents=True, exist_ok=True)
-            else:
-                os.replace(item, target)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+    with exclusive(out):
+        tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp"))
+        try:
+            yield tmp
+            out.mkdir(parents=True, exist_ok=True)
+            for item in sorted(tmp.rglob("*")):
+                target = out / item.relative_to(tmp)
+                if item.is_dir():
+                    target.mkdir(parents=True, exist_ok=True)
+                else:
+                    os.replace(item, target)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
 
 
 @contextmanager
@@ -62,22 +84,46 @@ def atomic_file(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path next to `path`; on success it is renamed to `path`."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    # a unique sibling name, created with the normal (umask) permissions, unlike mkstemp's 0600
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp{path.suffix}")
-    tmp.touch(exist_ok=False)
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    finally:
-        Path(tmp).unlink(missing_ok=True)
+    with exclusive(path):
+        # a unique sibling name, created with the normal (umask) permissions, unlike mkstemp's 0600
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp{path.suffix}")
+        tmp.touch(exist_ok=False)
+        try:
+            yield tmp
+            os.replace(tmp, path)
+        finally:
+            Path(tmp).unlink(missing_ok=True)
 
 
-def write_table(path: str | os.PathLike, columns: dict[str, object]) -> Path:
+#: columns whose infinite values mean something (an infinite lifetime: sealed or beyond the
+#: horizon; an unbounded strip pressure: a line contact); NaN is refused everywhere
+INFINITE_OK = ("lifetime_s", "p_Pa")
+
+
+def check_finite(name: str, values, stage: str, infinite_ok: bool = False) -> None:
+    """The one guard every public output passes: no NaN (and no inf unless it means something);
+    a RuntimeError naming the column and the stage that produced it."""
+    import numpy as np
+
+    arr = np.asarray(values, dtype=object)
+    numbers = np.array([float(v) for v in arr.ravel() if isinstance(v, (int, float)) and not isinstance(v, bool)])
+    bad = np.isnan(numbers) | (np.isinf(numbers) & (not infinite_ok))
+    if bad.any():
+        raise RuntimeError(f"{stage}: column {name} has {int(bad.sum())} non-finite value(s) "
+                           f"({numbers[bad][0]}): refusing to write it")
+
+
+def write_table(path: str | os.PathLike, columns: dict[str, object], stage: str = "output") -> Path:
     """A plain CSV: one header line (units in the names), then rows; numbers as %.10g, text quoted
     only where it must be. No comment lines, so pandas.read_csv and numpy.genfromtxt read it as is.
 
     `columns` maps each name to a sequence (all of one length) or to one value repeated (a label).
+    Every column passes `check_finite` (`stage` names what produced it).
     """
+    for name, values in columns.items():
+        if not isinstance(values, str):
+            check_finite(name, [values] if isinstance(values, (int, float)) else values, stage,
+                         infinite_ok=name in INFINITE_OK)
     lengths = {len(v) for v in columns.values() if not isinstance(v, (str, int, float))}
     if len(lengths) > 1:
         raise ValueError(f"write_table: columns of different lengths {sorted(lengths)}")

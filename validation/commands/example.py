@@ -104,7 +104,7 @@ def write_table(results, path: Path, cup: str, route: str) -> None:
                      "reason": [r.reason for r in results],
                      "ballistic_share": [x["ballistic_share"] for x in s],
                      "r_final_mm": [x["r_final_mm"] for x in s],
-                     "p_b_final_Pa": [x["p_b_final_Pa"] for x in s]})
+                     "p_b_final_Pa": [x["p_b_final_Pa"] for x in s]}, stage="example lifetimes")
 
 
 def plot(series: dict, curve, cup, path: Path, title: str) -> None:

@@ -219,8 +219,9 @@ def write_trajectories(results, out: Path, cup: dict) -> None:
     from validation.output import write_table
 
     for r in results:
-        write_table(out / f"trajectory_F1_{r.force_N:g}N.csv", {"cup": cup["name"], **r.trajectory_columns()})
-    (out / "summary.json").write_text(json.dumps(summaries(results, cup), indent=2) + "\n")
+        write_table(out / f"trajectory_F1_{r.force_N:g}N.csv", {"cup": cup["name"], **r.trajectory_columns()},
+                    stage=f"lifetime at F1 = {r.force_N:g} N")
+    (out / "summary.json").write_text(json.dumps(summaries(results, cup), indent=2, allow_nan=False) + "\n")
 
 
 def summaries(results, cup: dict) -> list[dict]:
