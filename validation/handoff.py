@@ -107,7 +107,7 @@ def sidecar(response: CupResponse, provenance: Mapping[str, Any]) -> dict[str, A
 def write_sidecar(data: Mapping[str, Any], path: str | Path) -> Path:
     """Write the sidecar as indented JSON (to a path the caller makes atomic)."""
     path = Path(path)
-    path.write_text(json.dumps(data, indent=1, sort_keys=True, default=_plain) + "\n")
+    path.write_text(json.dumps(data, indent=1, sort_keys=True, default=_plain, allow_nan=False) + "\n")
     return path
 
 

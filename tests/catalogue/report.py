@@ -17,6 +17,31 @@ from tests.catalogue.bad_inputs import CASES
 from validation.cli import main as cupcheck
 
 
+FAULTS = """
+## Faults (tests/test_faults.py)
+
+- A `stiffness` run killed (SIGKILL and SIGTERM, a real subprocess, at 0.5, 1.2, 2 and 3.5 s) leaves
+  the curve and its sidecar complete or absent, never half-written (each file is written to a
+  hidden temporary and renamed; a kill inside a write can leave only that hidden temporary).
+- A file-size limit while writing (RLIMIT_FSIZE, as a full disk) is one line, `failed: cannot write
+  the output: File too large`, exit status 1, and the output directory is not there.
+- Two runs into the same output: the second is refused at once (an OS file lock on the output,
+  `filelock`), so their files never interleave; the lock file is removed on release.
+- Every table cupcheck writes passes one guard (`validation.output.check_finite`): NaN is refused
+  with the column and the stage that produced it; inf is written only where it means something
+  (an infinite lifetime, an unbounded line-contact pressure).
+
+## Properties (tests/test_properties.py, hypothesis, derandomized)
+
+- Random bytes and valid-ish CSVs into the stiffness, u_c, relaxation, PSD and line-scan readers,
+  and random sweep tables: each parses or raises a one-line ValueError, never another exception.
+- Random cups, u_c tables and forces (beta >= 0.05): a finite positive lifetime (reached_r1, fold),
+  0 (over_force) or inf (sealed, horizon) with a message, never NaN, the force balance to 1e-9 at
+  every output. Found: with beta -> 0 the strip pressure vanishes at detachment and the u_c
+  extrapolation overflows (left open).
+"""
+
+
 def outcome(argv, files, expected) -> str:
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
@@ -59,7 +84,7 @@ def main() -> None:
         total.update(counts)
     lines.append(f"| **all** | {sum(total.values())} | " + " | ".join(str(total[o]) for o in outcomes) + " |")
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text("\n".join(lines) + "\n")
+    args.out.write_text("\n".join(lines) + "\n" + FAULTS)
     print(f"wrote {args.out}: {sum(total.values())} inputs, " + ", ".join(f"{total[o]} {o}" for o in outcomes))
 
 
