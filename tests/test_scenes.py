@@ -88,3 +88,30 @@ def test_a_scene_computes_only_what_it_needs(scene, computed):
     out = subprocess.run([sys.executable, "-c", _LAZY.format(scene=str(ROOT / "scenes" / scene))],
                          cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
     assert out == computed          # no "fem" or "skfem" before the dict: neither was imported
+
+
+@pytest.mark.parametrize("data,message", [
+    ({"sweep": {"key": "material.E_MPa", "values": [1]}, "outputs": [{"kind": "lifetimes"}]},
+     "sweep.key: expected one of loads.kappa"),
+    ({"sweep": {"key": "loads.kappa", "values": [1, -2]}, "outputs": [{"kind": "lifetimes"}]},
+     "sweep.values[1]: must be > 0"),
+    ({"outputs": [{"kind": "figure", "figure": "lifetime_vs_parameter"}]},
+     "outputs: the figure lifetime_vs_parameter needs a [sweep] table"),
+    ({"sweep": {"key": "cup.preset", "values": ["A", "C"]}, "outputs": [{"kind": "lifetimes"}]},
+     "sweep.values: expected A, B, got 'C'"),
+])
+def test_bad_sweeps_in_scenes_are_refused(data, message):
+    with pytest.raises(ValueError) as exc:
+        scene_from_mapping(data)
+    assert message in str(exc.value)
+
+
+def test_a_swept_scene_is_the_same_model_as_the_command_line(tmp_path, capsys):
+    """The kappa sweep's lifetime at kappa = 2, 10 N equals `cupcheck lifetime --kappa 2` with the
+    same surface (Appendix A, the paper's route, no relaxation): two paths to one model."""
+    result = run_scene(ROOT / "scenes" / "kappa_sweep.toml", tmp_path / "out")
+    value, products = next((v, p) for v, p in result.products["variants"] if v == 2.0)
+    scene_life = products.lifetimes()[1].lifetime_s                      # F1 = 10 N
+    assert main(["lifetime", "--kappa", "2", "--force", "10", "--surface", "pmma-1.89", "--json"]) == 0
+    cli_life = json.loads(capsys.readouterr().out)[0]["lifetime_s"]
+    assert scene_life == pytest.approx(cli_life, rel=1e-9)

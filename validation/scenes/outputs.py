@@ -64,6 +64,10 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
             return []
         csv = curve.to_csv(tmp / f"{name}.csv")
         return [_file(name, kind, csv), _file(name, kind, csv.with_suffix(".json"))]
+    if kind == "lifetimes" and products.scene.sweep is not None:
+        for _, variant in products.variants():
+            variant.lifetimes()
+        return [_file(name, kind, _sweep_table(products, tmp / f"{name}.csv"))] if tmp else []
     if kind in ("lifetimes", "trajectories"):
         results = products.lifetimes()
         if tmp is None:
@@ -71,7 +75,8 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
         if kind == "lifetimes":
             return [_file(name, kind, _lifetime_table(results, products, tmp / f"{name}.csv"))]
         return [_file(name, kind, _trajectory(r, tmp / f"{name}_F1_{r.force_N:g}N.csv")) for r in results]
-    figure = {"lifetime_vs_force": _lifetime_figure, "uc_vs_pressure": _uc_figure, "F0_vs_u": _F0_figure}
+    figure = {"lifetime_vs_force": _lifetime_figure, "uc_vs_pressure": _uc_figure, "F0_vs_u": _F0_figure,
+              "lifetime_vs_parameter": _parameter_figure}
     fig = figure[output["figure"]](products)
     if tmp is None:
         import matplotlib.pyplot as plt
@@ -102,6 +107,32 @@ def _lifetime_table(results, products: Products, path: Path) -> Path:
         "ballistic_share": [r.ballistic_share for r in results],
         "r_final_mm": [1e3 * float(r.r_m[-1]) for r in results],
         "p_b_final_Pa": [float(r.p_b_Pa[-1]) for r in results]})
+
+
+def _sweep_table(products: Products, path: Path) -> Path:
+    from validation.output import write_table
+
+    key = products.scene.sweep["key"].split(".")[1]
+    rows = [(value, r) for value, p in products.variants() for r in p.lifetimes()]
+    return write_table(path, {key: [v for v, _ in rows], "force_N": [r.force_N for _, r in rows],
+                              "lifetime_s": [r.lifetime_s for _, r in rows], "reason": [r.reason for _, r in rows],
+                              "ballistic_share": [r.ballistic_share for _, r in rows]}, stage="scene sweep")
+
+
+def _parameter_figure(products: Products):
+    key = products.scene.sweep["key"].split(".")[1]
+    variants = products.variants()
+    numeric = all(isinstance(v, (int, float)) for v, _ in variants)
+    fig, ax = _axes(key, "lifetime (s)")
+    for i, F in enumerate(products.scene["loads"]["F1_N"]):
+        pts = [(j if not numeric else v, p.lifetimes()[i].lifetime_s) for j, (v, p) in enumerate(variants)]
+        pts = [(x, t) for x, t in pts if math.isfinite(t) and t > 0]
+        if pts:
+            ax.semilogy(*zip(*pts), "o-", ms=3, label=f"$F_1$ = {F:g} N")
+    if not numeric:
+        ax.set_xticks(range(len(variants)), [str(v) for v, _ in variants], rotation=30, fontsize=6)
+    ax.legend(fontsize=6)
+    return fig
 
 
 def _trajectory(result, path: Path) -> Path:

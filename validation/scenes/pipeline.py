@@ -151,6 +151,17 @@ class Products:
             self.scene.tables, self.curve(), self.uc_table(),
             package_version("reduced") + package_version("validation")))
 
+    def variants(self) -> list[tuple[Any, "Products"]]:
+        """For a swept scene: (value, the products of the scene with that value), sharing the cache."""
+        def compute():
+            return [(v, Products(self.scene.variant(v), cache_dir=None, progress=self._progress)._share(self))
+                    for v in self.scene.sweep["values"]]
+        return self._get("variants", compute)
+
+    def _share(self, parent: "Products") -> "Products":
+        self._memory = parent._memory
+        return self
+
     def model(self):
         return self._get("model", lambda: _model(self.scene.tables, self.curve(), self.uc_table()))
 

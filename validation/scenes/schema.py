@@ -8,8 +8,11 @@
     [loads]          F1_N = [5, 10, 20], r_start_mm = 12 (optional), kappa = 1.0
     [stiffness]      source = "fem" | "appendix-a", route = "paper" | "profile",
                      fidelity = "coarse" | "medium" | "fine"
+    [sweep]          key = "loads.kappa" | "loads.r_start_mm" | "surface.preset" | "cup.preset",
+                     values = [...]                  (optional: one parameter varied for a figure)
     [[outputs]]      kind = "curve" | "lifetimes" | "trajectories" | "figure"
                      name = "..." (file stem), figure = "lifetime_vs_force" | "uc_vs_pressure" | "F0_vs_u"
+                     | "lifetime_vs_parameter" (needs [sweep]: one line per F1)
 
 Every table and key is optional but `outputs`; defaults are the main job's (cup A, frictionless
 FEM at the coarse level, the paper's route, pmma-1.89, air, F1 = 5 ... 80 N). Unknown keys, wrong
@@ -30,7 +33,8 @@ from typing import Any
 __all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES"]
 
 OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure")
-FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u")
+FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parameter")
+SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset")
 _TABLES: dict[str, dict[str, Any]] = {
     "cup": {"preset": "A", "geometry": None},
     "material": {"E_MPa": 4.0, "nu": 0.49, "relaxation": "none"},
@@ -53,13 +57,22 @@ class Scene:
     tables: dict[str, dict[str, Any]]
     outputs: tuple[dict[str, Any], ...]
     source: str = "scene"
+    sweep: dict[str, Any] | None = None
+
+    def variant(self, value: Any) -> "Scene":
+        """The scene with the swept parameter set to `value` (and no sweep)."""
+        table, key = self.sweep["key"].split(".")
+        tables = {k: dict(v) for k, v in self.tables.items()}
+        tables[table][key] = value
+        return Scene(tables=tables, outputs=self.outputs, source=self.source)
 
     def __getitem__(self, table: str) -> dict[str, Any]:
         return self.tables[table]
 
     def resolved(self) -> dict[str, Any]:
         """Plain data for the manifest: every table with its defaults, and the outputs."""
-        return {**{k: dict(v) for k, v in self.tables.items()}, "outputs": [dict(o) for o in self.outputs]}
+        return {**{k: dict(v) for k, v in self.tables.items()}, "sweep": self.sweep,
+                "outputs": [dict(o) for o in self.outputs]}
 
     def needs_fem(self) -> bool:
         """Whether any requested output needs the FEM (a stiffness curve from it)."""
@@ -81,9 +94,9 @@ def load_scene(path: str | Path) -> Scene:
 
 def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: str = "scene") -> Scene:
     """A `Scene` from plain data (parsed TOML); ValueError naming the key path."""
-    unknown = sorted(set(data) - set(_TABLES) - {"outputs"})
+    unknown = sorted(set(data) - set(_TABLES) - {"outputs", "sweep"})
     if unknown:
-        raise ValueError(f"{unknown[0]}: unknown table; allowed: {', '.join([*_TABLES, 'outputs'])}")
+        raise ValueError(f"{unknown[0]}: unknown table; allowed: {', '.join([*_TABLES, 'sweep', 'outputs'])}")
     tables = {name: _table(name, data.get(name, {}), defaults) for name, defaults in _TABLES.items()}
     _paths(tables, Path(base))
     _cross_checks(tables)
@@ -95,7 +108,38 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
     if len(set(files)) != len(files):
         twice = next(n for n, f in files if files.count((n, f)) > 1)
         raise ValueError(f"outputs: two outputs would write the same file '{twice}'; give one a name")
-    return Scene(tables=tables, outputs=parsed, source=source)
+    sweep = _sweep(data["sweep"], tables) if "sweep" in data else None
+    if sweep is None and any(o["figure"] == "lifetime_vs_parameter" for o in parsed):
+        raise ValueError("outputs: the figure lifetime_vs_parameter needs a [sweep] table")
+    if sweep is not None and any(o["kind"] in ("curve", "trajectories") for o in parsed):
+        raise ValueError("sweep: a swept scene writes lifetimes and figures; drop the curve and trajectories outputs")
+    return Scene(tables=tables, outputs=parsed, source=source, sweep=sweep)
+
+
+def _sweep(table: Any, tables: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    if not isinstance(table, Mapping):
+        raise ValueError("sweep: expected a table")
+    unknown = sorted(set(table) - {"key", "values"})
+    if unknown:
+        raise ValueError(f"sweep.{unknown[0]}: unknown key; allowed: key, values")
+    key, values = table.get("key"), table.get("values")
+    if key not in SWEEP_KEYS:
+        raise ValueError(f"sweep.key: expected one of {', '.join(SWEEP_KEYS)}, got {key!r}")
+    if not isinstance(values, list) or not values:
+        raise ValueError("sweep.values: expected a non-empty list")
+    name, field = key.split(".")
+    if (name, field) in _CHOICES:
+        bad = [v for v in values if v not in _CHOICES[(name, field)]]
+        if bad:
+            raise ValueError(f"sweep.values: expected {', '.join(_CHOICES[(name, field)])}, got {bad[0]!r}")
+    elif field == "preset":
+        if not all(isinstance(v, str) for v in values):
+            raise ValueError("sweep.values: expected surface preset names")
+    else:
+        values = [_number(v, f"sweep.values[{i}]", positive=True) for i, v in enumerate(values)]
+    if key == "cup.preset" and tables["cup"]["geometry"]:
+        raise ValueError("sweep.key: cup.preset cannot be swept with a design file (cup.geometry)")
+    return {"key": key, "values": values}
 
 
 def _table(name: str, given: Any, defaults: dict[str, Any]) -> dict[str, Any]:
