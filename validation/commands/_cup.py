@@ -56,7 +56,7 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = 
                    help="what the leak crosses: paper (eqs 3-7: one strip at the uniform pressure of "
                         "eq 6, beta = 0.8), or profile (the FEM curve's own contact-pressure profile "
                         "p(r) + beta (p_a - p_b), ring by ring, with its r_c and V; needs an FEM curve; "
-                        "not mesh-converged where only the sharp rim corner touches, see README) "
+                        "not mesh-converged where only the sharp rim corner touches, see docs/lifetime.md) "
                         f"(default: {default_route})")
     g.add_argument("--cup-laws", default=None, choices=("cone", "curve"),
                    help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 with the cup's r0, r1, "

@@ -64,7 +64,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     r = parser.add_argument_group("run")
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default=None,
                    help="mesh level of a generated mesh (default medium: F0 within 1 %% of the "
-                        "converged curve; coarse ~2 %%, 4x faster; see README)")
+                        "converged curve; coarse ~2 %%, 4x faster; see docs/stiffness.md)")
     r.add_argument("--u-max-mm", type=float, default=None, dest="u_max_mm",
                    help="largest plate displacement u [mm], in (0, h1] (default 0.9 h1; at h1 the plate edge reaches the plane)")
     r.add_argument("--fields-out", type=Path, metavar="FILE",
