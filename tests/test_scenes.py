@@ -115,3 +115,27 @@ def test_a_swept_scene_is_the_same_model_as_the_command_line(tmp_path, capsys):
     assert main(["lifetime", "--kappa", "2", "--force", "10", "--surface", "pmma-1.89", "--json"]) == 0
     cli_life = json.loads(capsys.readouterr().out)[0]["lifetime_s"]
     assert scene_life == pytest.approx(cli_life, rel=1e-9)
+
+
+def test_a_render_runs_the_fem_only_to_its_displacement_and_shows_the_contact(tmp_path):
+    """The render at u = 3 mm: the FEM stops at 3 mm (no stiffness curve is computed), and the
+    image shows the cup (not blank) with the contact strip in the colour map's top (yellow)."""
+    import numpy as np
+    from matplotlib.image import imread
+
+    from validation.render import probe_offscreen_rendering
+
+    probe = probe_offscreen_rendering()
+    if not probe.ok:
+        pytest.skip(probe.message)
+    pipeline.COMPUTED.clear()
+    result = run_scene(ROOT / "scenes" / "render_cupA_3mm.toml", tmp_path / "out")
+    state = result.products["fem_state_3mm"]
+    assert state["u_m"] == pytest.approx(3e-3, rel=1e-12) and dict(pipeline.COMPUTED) == {"fem_state": 1}
+    img = imread(tmp_path / "out" / "cupA_3mm.png")[..., :3]
+    assert img.shape[:2] == (700, 900) and img.std() > 0.05
+    # viridis' top, shaded by the lights: red and green well above blue (the plane is grey-blue,
+    # the unloaded cup dark purple)
+    yellow = (img[..., 0] > 0.6) & (img[..., 1] > 0.55) & (img[..., 2] < 0.3)
+    above_bar = yellow[:600]                   # the colour bar sits at the bottom of the window
+    assert above_bar.sum() > 3                 # the contact strip, coloured by its peak pressure

@@ -207,7 +207,7 @@ def dataclasses_replace(obj, **kw):
     return dataclasses.replace(obj, **kw)
 
 
-def test_deformed_outline_is_the_closed_cross_section():
+def testdeformed_outline_is_the_closed_cross_section():
     """The scene's outline (cavity -> rim -> outer -> plate) of the undeformed cup closes on itself
     without doubling back: its shoelace area equals the mesh's cross-section area (each side is
     oriented from the corner the previous side ended at)."""
@@ -216,11 +216,11 @@ def test_deformed_outline_is_the_closed_cross_section():
     from fem.geometry import cup_geometry
     from fem.mesh import cup_mesh
     from skfem import Basis, ElementQuad2
-    from validation.crosscheck.runs import _deformed_outline
+    from validation.crosscheck.runs import deformed_outline
 
     mesh = cup_mesh(cup_geometry("A"), "coarse")
     n = mesh.doflocs.shape[1]
-    x, z, _ = _deformed_outline(SimpleNamespace(mesh=mesh, displacements=[np.zeros(2 * n)],
+    x, z, _ = deformed_outline(SimpleNamespace(mesh=mesh, displacements=[np.zeros(2 * n)],
                                                 nodal_pressure_Pa=[np.zeros(n)]))
     assert (x[0], z[0]) == (x[-1], z[-1])
     shoelace = 0.5 * np.sum(x[:-1] * z[1:] - x[1:] * z[:-1])

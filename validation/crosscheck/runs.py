@@ -162,7 +162,7 @@ def compute(request: FemRun, progress: Callable[[float, str], None] | None = Non
                         u_max_m=request.u_max_over_h1 * geometry.h1_m, progress=progress,
                         max_step=request.max_step)
     wall = time.perf_counter() - t0
-    r, z, p = _deformed_outline(resp)
+    r, z, p = deformed_outline(resp)
     return FemResult(request=request, h1_m=resp.h1_m, u_m=resp.u_m, F0_N=resp.F0_N,
                      F0_contact_N=resp.F0_contact_N, r_c_m=resp.r_c_m, l_m=resp.l_m, V_m3=resp.V_m3,
                      energy_J=resp.energy_J, penetration_m=resp.penetration_m, wall_s=wall,
@@ -171,7 +171,7 @@ def compute(request: FemRun, progress: Callable[[float, str], None] | None = Non
                      unstable=resp.unstable, pressure=tuple(resp.pressure))
 
 
-def _deformed_outline(resp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def deformed_outline(resp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The closed outline cavity -> rim -> outer -> plate of the last step, deformed."""
     from fem.mesh import boundary_path
 

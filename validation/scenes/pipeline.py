@@ -68,6 +68,24 @@ def _fem_curve(cup: dict, material: dict, contact: str, fidelity: str, code: str
     return handoff.stiffness_curve(response, prov)
 
 
+def _fem_state(cup: dict, material: dict, contact: str, fidelity: str, u_mm: float, code: str) -> dict:
+    """The deformed cross-section at the plate displacement u (the FEM run only that far)."""
+    COMPUTED["fem_state"] += 1
+    from fem.cup import compress_cup
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+    from validation.crosscheck.runs import deformed_outline
+
+    geometry = _geometry(cup)
+    if not 0 < u_mm * 1e-3 <= geometry.h1_m:
+        raise ValueError(f"outputs: render u_mm must be in (0, h1] = (0, {1e3 * geometry.h1_m:.4g}] mm, got {u_mm:g}")
+    response = compress_cup(cup_mesh(geometry, fidelity), NeoHookean(E_Pa=material["E_MPa"] * 1e6,
+                            nu=material["nu"], formulation="mixed" if material["nu"] > 0.495 else "displacement"),
+                            contact=contact, u_max_m=u_mm * 1e-3)
+    r, z, p = deformed_outline(response)
+    return {"u_m": float(response.u_m[-1]), "r_m": r, "z_m": z, "p_Pa": p}
+
+
 def _lifetimes(tables: dict, curve, uc, code: str):
     COMPUTED["lifetimes"] += 1
     from reduced.lifetime import lifetime_sweep
@@ -145,6 +163,11 @@ class Products:
         from reduced.cup import CUPS
         return appendix_a_curve(CUPS[self.scene["cup"]["preset"]], E_Pa=self.scene["material"]["E_MPa"] * 1e6,
                                 d0_m=2e-3)
+
+    def fem_state(self, u_mm: float) -> dict:
+        s = self.scene
+        return self._get(f"fem_state_{u_mm:g}mm", lambda: self._cached(_fem_state)(
+            s["cup"], s["material"], s["contact"]["law"], s["stiffness"]["fidelity"], u_mm, package_version("fem")))
 
     def lifetimes(self):
         return self._get("lifetimes", lambda: self._cached(_lifetimes)(

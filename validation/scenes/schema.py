@@ -13,6 +13,8 @@
     [[outputs]]      kind = "curve" | "lifetimes" | "trajectories" | "figure"
                      name = "..." (file stem), figure = "lifetime_vs_force" | "uc_vs_pressure" | "F0_vs_u"
                      | "lifetime_vs_parameter" (needs [sweep]: one line per F1)
+                     kind = "render" with u_mm = 3: the revolved deformed FEM cup at u, coloured by
+                     the contact pressure (pyvista off-screen; the FEM runs only to u)
 
 Every table and key is optional but `outputs`; defaults are the main job's (cup A, frictionless
 FEM at the coarse level, the paper's route, pmma-1.89, air, F1 = 5 ... 80 N). Unknown keys, wrong
@@ -32,7 +34,7 @@ from typing import Any
 
 __all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES"]
 
-OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure")
+OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure", "render")
 FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parameter")
 SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset")
 _TABLES: dict[str, dict[str, Any]] = {
@@ -104,7 +106,7 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
     if not isinstance(outputs, list) or not outputs:
         raise ValueError("outputs: a scene needs a non-empty list of [[outputs]]")
     parsed = tuple(_output(o, i) for i, o in enumerate(outputs))
-    files = [(o["name"], o["kind"] == "figure") for o in parsed]      # tables are .csv, figures .png/.svg
+    files = [(o["name"], o["kind"] in ("figure", "render")) for o in parsed]   # tables .csv, images .png
     if len(set(files)) != len(files):
         twice = next(n for n, f in files if files.count((n, f)) > 1)
         raise ValueError(f"outputs: two outputs would write the same file '{twice}'; give one a name")
@@ -192,9 +194,9 @@ def _output(output: Any, i: int) -> dict[str, Any]:
     where = f"outputs[{i}]"
     if not isinstance(output, Mapping):
         raise ValueError(f"{where}: expected a table")
-    unknown = sorted(set(output) - {"kind", "name", "figure"})
+    unknown = sorted(set(output) - {"kind", "name", "figure", "u_mm"})
     if unknown:
-        raise ValueError(f"{where}.{unknown[0]}: unknown key; allowed: kind, name, figure")
+        raise ValueError(f"{where}.{unknown[0]}: unknown key; allowed: kind, name, figure, u_mm")
     kind = output.get("kind")
     if kind not in OUTPUT_KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(OUTPUT_KINDS)}, got {kind!r}")
@@ -203,10 +205,15 @@ def _output(output: Any, i: int) -> dict[str, Any]:
         raise ValueError(f"{where}.figure: expected one of {', '.join(FIGURES)}, got {figure!r}")
     if kind != "figure" and figure is not None:
         raise ValueError(f"{where}.figure: only for kind = \"figure\"")
+    u_mm = output.get("u_mm")
+    if (kind == "render") != (u_mm is not None):
+        raise ValueError(f"{where}.u_mm: a render needs u_mm (the plate displacement shown), and only a render")
+    if u_mm is not None:
+        u_mm = _number(u_mm, f"{where}.u_mm", positive=True)
     name = output.get("name", figure if kind == "figure" else kind)
     if not isinstance(name, str) or not name or "/" in name or name.startswith("."):
         raise ValueError(f"{where}.name: expected a plain file stem, got {name!r}")
-    return {"kind": kind, "name": name, "figure": figure}
+    return {"kind": kind, "name": name, "figure": figure, "u_mm": u_mm}
 
 
 def _number(value: Any, where: str, positive: bool) -> float:

@@ -78,7 +78,8 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
             cluster = None if scheduler else LocalCluster(
                 n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                 dashboard_address=":0", silence_logs=40)
-            with Client(scheduler or cluster) as client:
+            client = Client(scheduler or cluster)
+            try:
                 dashboard, startup = client.dashboard_link, time.perf_counter() - t0
                 futures = {client.submit(evaluate, d, key=f"design-{design_hash(d)}", pure=False): d
                            for d in todo}
@@ -90,12 +91,25 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
                     failed += any(r.get("failure") for r in rows)
                     if progress:
                         progress(computed, failed, len(todo), design_hash(design))
-            if cluster is not None:
-                cluster.close()
+            finally:
+                _shut_down(client, cluster)
     table = collect_table(spec, out)
     return SweepRun(designs=len(all_designs), computed=computed, reused=len(all_designs) - len(todo),
                     failed=failed, wall_s=time.perf_counter() - t0, startup_s=startup, table=table,
                     dashboard=dashboard)
+
+
+def _shut_down(client, cluster) -> None:
+    """Close the client and the local cluster. Every finished design is committed by then, so a
+    cluster that does not stop cleanly (a nanny still restarting a killed worker) is reported on
+    stderr, not raised: it must not turn a finished sweep into a failed one."""
+    import sys
+    for close in (client.close, *((cluster.close,) if cluster is not None else ())):
+        try:
+            close()
+        except Exception as exc:      # noqa: BLE001 - shutdown only, results already on disk
+            print(f"sweep: warning: the dask cluster did not shut down cleanly ({type(exc).__name__}: "
+                  f"{exc})", file=sys.stderr)
 
 
 def collect_table(spec: SweepSpec, out: Path) -> Path:
