@@ -22,8 +22,6 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
-
 from validation.commands._cup import add_cup_arguments, add_cup_law_arguments, route_model
 from validation.commands._surface import add_surface_arguments, has_surface, spectrum_from_args
 
@@ -131,7 +129,7 @@ def build_model(args: argparse.Namespace):
         if not (math.isfinite(F) and F > 0):
             raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
     if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
-        raise ValueError(f"--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
+        raise ValueError("--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
     check_modulus(args.E_MPa, "--E-MPa")
     geometry, seal = route_model(args)
     curve, choice = _curve_and_cup(args)

@@ -185,8 +185,5 @@ class Products:
         self._memory = parent._memory
         return self
 
-    def model(self):
-        return self._get("model", lambda: _model(self.scene.tables, self.curve(), self.uc_table()))
-
     def computed(self) -> dict[str, Any]:
         return dict(self._done)
