@@ -18,6 +18,19 @@ step between the step's start and its free flight (`hold`); a held node whose re
 tensile is released (it carries no normal force, so no friction holds it) and lands again where
 the iteration puts it: it has slipped.
 
+Coulomb friction (``"coulomb"``, coefficient mu): a held node sticks at its anchor (where it was
+at the start of the load step, or where it touched down in it) while its tangential reaction
+|t| <= mu lambda, and slides otherwise with t = -mu lambda sign(Delta), Delta = u_r - anchor: the
+plane's friction opposes the slip. The step is the backward-Euler increment of the law (the
+history is the anchor, moved to the converged position by `commit`). Which nodes slide is an
+active set like the normal one, updated at every Newton iterate by the primal-dual rule of the
+Tresca problem with the bound g = mu lambda of that iterate (`slide`): z = t - c Delta, stick
+where |z| < g, slide in the direction -sign(z) otherwise (c > 0, the node's diagonal stiffness,
+moves the iterates only, not the solution). A sliding node's radial dof is free and loaded by
+the constant force -g s, so each iterate minimizes a smooth energy; at convergence the residual
+holds t = -mu lambda s with lambda of the converged state itself. No regularisation: mu = 0 is
+frictionless, and a large mu sticks wherever lambda > 0.
+
 The contact pressure p is the L2 projection, on the deformed contact boundary (weight 2 pi r ds),
 of the nodal reactions: M p = lambda over the facets touching an active node. With the consistent
 boundary mass matrix, int p 2 pi r ds = sum lambda exactly, i.e. the integrated contact force, and
@@ -37,9 +50,10 @@ import scipy.sparse.linalg as spla
 
 from .kinematics import Kinematics
 
-__all__ = ["RigidPlane", "ContactState", "PressureProfile"]
+__all__ = ["RigidPlane", "ContactState", "PressureProfile", "CONTACT_LAWS"]
 
-ContactLaw = Literal["frictionless", "sticking"]
+ContactLaw = Literal["frictionless", "sticking", "coulomb"]
+CONTACT_LAWS = ("frictionless", "sticking", "coulomb")
 
 # 1D quadratic shape functions on s in [0, 1] for facet nodes (vertex 0, vertex 1, midpoint)
 _GAUSS_S, _GAUSS_W = np.polynomial.legendre.leggauss(4)
@@ -54,10 +68,12 @@ def _shape(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class ContactState:
-    """Which candidate nodes are held on the plane, and (sticking) their frozen radial displacement."""
+    """Which candidate nodes are held on the plane, where they stick, and (Coulomb) which slide."""
 
     active: np.ndarray         # bool [ncand]
-    u_r_stick_m: np.ndarray      # float [ncand], meaningful where active
+    u_r_stick_m: np.ndarray    # float [ncand], where active: the radial displacement of the anchor
+    #                            (sticking: the touchdown point; coulomb: the step's start or touchdown)
+    slip: np.ndarray           # int8 [ncand]: coulomb: 0 sticks, +1 / -1 slides outward / inward
 
 
 @dataclass(frozen=True)
@@ -88,12 +104,15 @@ class RigidPlane:
     facets: np.ndarray            # candidate boundary facets (global facet indices)
     law: ContactLaw = "frictionless"
     exclude: np.ndarray | None = None   # nodes that are never candidates (e.g. clamped ones)
+    friction: float = 0.0               # Coulomb's coefficient mu (law "coulomb")
     nodes: np.ndarray = field(init=False, repr=False)           # the candidate nodes
     _facet_nodes: np.ndarray = field(init=False, repr=False)    # [3, nfacets]: vertices, midpoint
 
     def __post_init__(self) -> None:
-        if self.law not in ("frictionless", "sticking"):
-            raise ValueError(f"contact: must be 'frictionless' or 'sticking', got {self.law!r}")
+        if self.law not in CONTACT_LAWS:
+            raise ValueError(f"contact: must be one of {', '.join(CONTACT_LAWS)}, got {self.law!r}")
+        if not (np.isfinite(self.friction) and self.friction >= 0.0):
+            raise ValueError(f"friction: Coulomb's coefficient must be finite and >= 0, got {self.friction}")
         mesh = self.kin.mesh
         nv = int(mesh.t.max()) + 1      # number of vertices; Q2 edge nodes follow them
         # facet nodes: two vertices and the midpoint node (numbered after the vertices)
@@ -106,7 +125,7 @@ class RigidPlane:
 
     @classmethod
     def on(cls, kin: Kinematics, boundaries: list[str], exclude: list[str] = (),
-           law: ContactLaw = "frictionless") -> "RigidPlane":
+           law: ContactLaw = "frictionless", friction: float = 0.0) -> "RigidPlane":
         """Candidates: the facets of the named boundaries, minus nodes on the `exclude` boundaries."""
         mesh = kin.mesh
         facets = np.unique(np.concatenate([mesh.boundaries[b] for b in boundaries]))
@@ -114,25 +133,27 @@ class RigidPlane:
         if exclude:
             excl = np.unique(np.concatenate(
                 [kin.basis.get_dofs(mesh.boundaries[b]).all() // 2 for b in exclude]))
-        return cls(kin, facets, law, excl)
+        return cls(kin, facets, law, excl, friction)
 
     # --- the state -----------------------------------------------------------------------
     def initial_state(self) -> ContactState:
         n = len(self.nodes)
-        return ContactState(np.zeros(n, bool), np.zeros(n))
+        return ContactState(np.zeros(n, bool), np.zeros(n), np.zeros(n, np.int8))
 
     def gap(self, u: np.ndarray) -> np.ndarray:
         """Signed nodal gap g = Z + u_z [m] (negative: penetration)."""
         return self.kin.node_coordinates()[1, self.nodes] + u[2 * self.nodes + 1]
 
     def constraints(self, state: ContactState) -> tuple[np.ndarray, np.ndarray]:
-        """Dofs held by the active set and their values (z-dofs on the plane; sticking: frozen u_r)."""
+        """Dofs held by the active set and their values (z-dofs on the plane; the sticking nodes'
+        u_r at their anchors)."""
         a = np.flatnonzero(state.active)
         dofs = [2 * self.nodes[a] + 1]
         vals = [-self.kin.node_coordinates()[1, self.nodes[a]]]
-        if self.law == "sticking":
-            dofs.append(2 * self.nodes[a])
-            vals.append(state.u_r_stick_m[a])
+        if self.law != "frictionless":
+            stuck = a[state.slip[a] == 0]
+            dofs.append(2 * self.nodes[stuck])
+            vals.append(state.u_r_stick_m[stuck])
         return np.concatenate(dofs), np.concatenate(vals)
 
     def reactions(self, r_int: np.ndarray) -> np.ndarray:
@@ -145,14 +166,15 @@ class RigidPlane:
         held by `state` where it holds them), and every other penetrating node (g < 0) put back on
         the plane. For the sticking law such a landing node is put where it touched down,
         interpolated linearly in the load step between u_start (gap g0 > 0) and u (gap < 0); a node
-        that was on the plane at the step start (g0 = 0) lands where u puts it."""
+        that was on the plane at the step start (g0 = 0) lands where u puts it. Coulomb: as
+        sticking, but a sliding node goes where u puts it."""
         out = u.copy()
         nodes, Z = self.nodes, self.kin.node_coordinates()[1, self.nodes]
         g = self.gap(u)
         land = ~on_plane & (g < 0.0)
         out[2 * nodes[on_plane | land] + 1] = -Z[on_plane | land]
-        if self.law == "sticking":
-            held = on_plane & state.active
+        if self.law != "frictionless":
+            held = on_plane & state.active & (state.slip == 0)
             out[2 * nodes[held]] = state.u_r_stick_m[held]
             if np.any(land):
                 g0 = self.gap(u_start)[land]
@@ -169,17 +191,72 @@ class RigidPlane:
         so a node resting on the plane at the step start (g0 = 0, e.g. the rim corner at u = 0)
         does not slide. A node `released` in this step (its reaction turned tensile: no
         friction can hold it) lands again where u puts it: it has slipped. If its free flight
-        does not reach the plane, a node lands where u puts it."""
+        does not reach the plane, a node lands where u puts it. Coulomb: the same anchors; a node
+        held anew sticks first (`slide` decides)."""
         new = active & ~state.active
         stick = state.u_r_stick_m.copy()
-        if self.law == "sticking" and np.any(new):
+        if self.law != "frictionless" and np.any(new):
             nodes = self.nodes[new]
             g0, g1 = self.gap(u_start)[new], self.gap(u_free)[new]
             fly = (g1 < 0.0) & ~released[new]
             t = np.where(fly, np.clip(g0, 0.0, None) / np.maximum(g0 - g1, 1e-300), 1.0)
             r1 = np.where(fly, u_free[2 * nodes], u[2 * nodes])
             stick[new] = u_start[2 * nodes] + np.clip(t, 0.0, 1.0) * (r1 - u_start[2 * nodes])
-        return ContactState(active, stick)
+        return ContactState(active, stick, np.where(active & ~new, state.slip, 0).astype(np.int8))
+
+    # --- Coulomb friction (module docstring) -----------------------------------------------
+    def friction_bound(self, res: np.ndarray) -> np.ndarray:
+        """g = mu max(lambda, 0) [N] per candidate, lambda the normal reaction in `res`."""
+        return self.friction * np.maximum(self.reactions(res), 0.0)
+
+    def slide(self, state: ContactState, u: np.ndarray, res: np.ndarray, c: np.ndarray,
+              tol: float) -> ContactState:
+        """The stick/slide set at the iterate u (Coulomb; other laws: unchanged). res = r_int -
+        f_ext without friction (the sticking nodes' tangential reactions t), c [N/m] > 0 per
+        candidate: z = t - c Delta (t = -g s where sliding, Delta = 0 where sticking); stick where |z| < g, slide along
+        -sign(z) otherwise, with a hysteresis of `tol` [N] so that a converged set stays put."""
+        if self.law != "coulomb":
+            return state
+        rdof = 2 * self.nodes
+        g = self.friction_bound(res)
+        sticking = state.slip == 0
+        # a sticking node is at its anchor by its constraint (a node held anew may still have
+        # to jump there: not a slip), so its z is its reaction t alone
+        z = np.where(sticking, res[rdof], -g * state.slip - c * (u[rdof] - state.u_r_stick_m))
+        # a sliding node that would reverse sticks first (going straight to the reverse slide
+        # let nodes next to the cone's edge flip +1 <-> -1 for ever on cup A, mu = 0.3)
+        stick = np.where(sticking, np.abs(z) <= g + tol,
+                         (np.abs(z) < g - tol) | (-np.sign(z) != state.slip))
+        slip = np.where(state.active & ~stick, -np.sign(z), 0).astype(np.int8)
+        return ContactState(state.active, state.u_r_stick_m, slip)
+
+    def friction_force(self, state: ContactState, res: np.ndarray) -> np.ndarray:
+        """The plane's friction on the sliding nodes, -mu lambda s at their radial dofs [N]
+        (lambda from `res`, the residual without friction); zero for the other laws."""
+        f = np.zeros_like(res)
+        if self.law == "coulomb":
+            s = state.active & (state.slip != 0)
+            f[2 * self.nodes[s]] = -self.friction_bound(res)[s] * state.slip[s]
+        return f
+
+    def cone_excess(self, state: ContactState, r_int: np.ndarray) -> float:
+        """Coulomb: the largest excess of a sticking node's tangential reaction over the cone,
+        max(|t| - mu lambda, 0), relative to the largest nodal normal reaction; 0 for the other
+        laws. Round-off at a converged state, unless a node had to be held stuck (`fem.friction`)."""
+        a = state.active & (state.slip == 0)
+        if self.law != "coulomb" or not a.any():
+            return 0.0
+        lam = self.reactions(r_int)
+        excess = np.abs(r_int[2 * self.nodes[a]]) - self.friction * np.maximum(lam[a], 0.0)
+        return float(max(np.max(excess), 0.0) / max(np.max(lam[state.active]), 1e-300))
+
+    def commit(self, state: ContactState, u: np.ndarray) -> ContactState:
+        """The state carried into the next load step: Coulomb anchors move to the converged
+        positions (the law is incremental); sticking anchors stay where the nodes touched down."""
+        if self.law != "coulomb":
+            return state
+        anchor = np.where(state.active, u[2 * self.nodes], state.u_r_stick_m)
+        return ContactState(state.active, anchor, state.slip)
 
     # --- post-processing -----------------------------------------------------------------
     def _positions(self, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:

@@ -63,7 +63,7 @@ from typing import Any, Literal
 import numpy as np
 from skfem import Mesh
 
-from .contact import PressureProfile, RigidPlane
+from .contact import CONTACT_LAWS, PressureProfile, RigidPlane
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
 from .postprocess import (BIOT_STRETCH, enclosed_volume, half_maximum_width, inner_contact_radius,
                           median_force_width, quartile_width, smallest_stretch, weighted_width)
@@ -102,6 +102,8 @@ class CupResponse:
     mesh: Mesh = field(repr=False)
     displacements: tuple[np.ndarray, ...] = field(repr=False)
     nodal_pressure_Pa: tuple[np.ndarray, ...] = field(repr=False)
+    friction: float = 0.0       # Coulomb's mu (contact "coulomb")
+    cone_excess: np.ndarray | None = None   # Coulomb: largest excess over the cone / max lambda
 
     @property
     def h_m(self) -> np.ndarray:
@@ -131,21 +133,26 @@ def cup_height(mesh: Mesh) -> float:
 
 
 def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
-                 contact: Literal["frictionless", "sticking"] = "frictionless",
-                 u_max_m: float | None = None,
+                 contact: Literal["frictionless", "sticking", "coulomb"] = "frictionless",
+                 u_max_m: float | None = None, friction: float = 0.0,
                  progress: Callable[[float, str], None] | None = None,
                  **solver_opts: Any) -> CupResponse:
     """Press the cup from u = 0 to u_max_m (default 0.9 h1, at most h1: there the plate's edge
     reaches the plane; the steep rise of F0 where the wall is squeezed flat lies just below it)
     and return its `CupResponse`.
 
+    contact: the law at the plane (`fem.contact`): frictionless, sticking, or coulomb with
+    Coulomb's coefficient `friction` (mu >= 0).
     solver_opts: fields of `fem.solver.SolverOptions` (rtol, etol, max_iterations, initial_step,
     max_step, min_step, growth). Raises ValueError for bad input, `fem.solver.ConvergenceError`
     (a RuntimeError) if a step cannot be converged.
     """
     h1 = cup_height(mesh)
-    if contact not in ("frictionless", "sticking"):
-        raise ValueError(f"contact: must be 'frictionless' or 'sticking', got {contact!r}")
+    if contact not in CONTACT_LAWS:
+        raise ValueError(f"contact: must be one of {', '.join(CONTACT_LAWS)}, got {contact!r}")
+    if contact != "coulomb" and friction != 0.0:
+        raise ValueError(f"friction: Coulomb's coefficient applies to contact='coulomb' only, "
+                         f"got friction={friction} with contact={contact!r}")
     if not isinstance(material, NeoHookean):
         raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
     u_max = 0.9 * h1 if u_max_m is None else float(u_max_m)
@@ -160,7 +167,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     kin = Kinematics.of(mesh)
     mech = Mechanics(kin, material)
     top = _boundary_nodes(mesh, "top_plate")
-    plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top)
+    plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top, friction=friction)
     top_dofs = np.concatenate([2 * top, 2 * top + 1])
     path = boundary_path(mesh, "cavity")
 
@@ -179,7 +186,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
                         name="u [m]")
     per_step = {f.name: np.array([getattr(st, f.name) for st in steps])
                 for f in fields(_StepOutputs) if f.name not in _PER_STEP_OBJECTS}
-    return CupResponse(h1_m=h1, contact=contact, material=material, stats=stats, mesh=mesh,
+    return CupResponse(h1_m=h1, contact=contact, friction=friction, material=material, stats=stats, mesh=mesh,
                        **per_step, **{name: tuple(getattr(st, name) for st in steps)
                                       for name in _PER_STEP_OBJECTS})
 
@@ -202,6 +209,7 @@ class _StepOutputs:
     newton_iterations: int
     unstable: bool
     min_stretch: float
+    cone_excess: float
     pressure: PressureProfile
     displacements: np.ndarray
     nodal_pressure_Pa: np.ndarray
@@ -227,6 +235,7 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
         penetration_m=plane.largest_penetration(s.u), energy_J=s.energy_J,
         newton_iterations=s.iterations, unstable=s.unstable,
         min_stretch=float(np.min(smallest_stretch(mech.kin.deformation_gradient(s.u)))),
+        cone_excess=plane.cone_excess(s.contact, s.r_int),
         pressure=prof, displacements=s.u, nodal_pressure_Pa=p_nodes)
 
 

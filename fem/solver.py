@@ -48,6 +48,12 @@ sticking law the frozen radial positions of the nodes held on the plane). Newton
   of 1e-6 on that shift removed this instance but neither made the case run (a later snap
   needs ~460 iterations) nor saved iterations over the robustness cases (28922 against 28223;
   round-off in the linear solves alone moves that total by ~7 %), so it is not used.
+* Coulomb friction (`fem.contact`, `fem.friction`): at every iterate the stick/slide set is
+  updated from the reactions the last Newton step predicted, the sliding nodes carry the friction
+  -mu lambda s of the iterate (part of the load, so the line search's energy is that of fixed
+  friction forces), and their coupling to lambda enters the Newton matrix as a rank-m update
+  (Woodbury on the same Cholesky factor); a coupled step is accepted by the energy or, since it
+  need not descend in it, by a fall of the residual. Like the sticking law, no extrapolation.
 * Jumps: the energy lost in a step, W0 + work - W1 (trapezoid work), is summed over the steps as
   `SolverStats.dissipated_J`. For frictionless contact (conservative: only a snap loses
   energy), a step across an instability that loses more than jump_tol = 0.5 % of W is redone
@@ -77,6 +83,7 @@ from scipy.optimize import nnls
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
 from .condensation import make_solver
+from .friction import CoupledFactor, friction_iterate, sliding_coupling
 from .linsolve import NotPositiveDefinite
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
@@ -222,6 +229,8 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         unstable += indefinite
         dissipated += defect
         dt_ok = t1 - t
+        if plane is not None:
+            state1 = plane.commit(state1, u1)
         u0, r0, W0, state, t, jumps = u1, r1, W1, state1, t1, 0
         if on_step:
             on_step(StepResult(t, u1, r1, W1, state1, its, bool(indefinite)))
@@ -276,7 +285,7 @@ def _newton(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, poli
 def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags):
     n = mech.kin.ndofs
     fixed_dofs, fixed_vals = dirichlet(t)
-    fext = f_ext(t)
+    fext0 = fext = f_ext(t)
     history: list[float] = []
     try:
         u = plane.project(u_start, u_start, state, state.active) if plane is not None else u_start
@@ -286,15 +295,26 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
                            "the deformation, or the mesh is too coarse", history) from None
     it, shift, indefinite = 0, 0.0, False
     released = np.zeros(len(plane.nodes), bool) if plane is not None else None
+    lin = None          # the linearized reactions of the last Newton step (Coulomb's stick/slide)
+    flips = np.zeros(len(plane.nodes), int) if plane is not None else None
     while True:
-        res = r - fext
+        res = r - fext0
         free, dofs, du_fixed = _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state)
-        f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext), _force_floor(mech))
+        f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext0), _force_floor(mech))
+        if plane is not None and plane.law == "coulomb":
+            state, fric, flips = friction_iterate(plane, state, u, res if lin is None else lin,
+                                                  res, K, opts.rtol * f_ref, flips)
+            Pi += (fext - fext0 - fric) @ u           # the same W, the new load
+            fext = fext0 + fric
+            res = r - fext
+            free, dofs, du_fixed = _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state)
         rnorm = np.linalg.norm(res[free])
         history.append(rnorm / f_ref)
         if not np.all(np.isfinite(res)):
             raise _StepFailure("the residual is not finite", history)
-        step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref)
+        step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref,
+                     sliding_coupling(plane, state, res) if plane is not None else None)
+        step.friction = fext - fext0
         shift = step.solve(solver, K, shift, history, policy)
         indefinite |= shift > 0.0
         flags["indefinite"] = indefinite
@@ -310,13 +330,14 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
             raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely cause: a "
                                "structural instability (snap-through/buckling) that the step jumps "
                                "across, or a too-large step", history)
-        u_prev = u
+        u_prev, Kdu, res0 = u, K @ step.du, res + (fext - fext0)
         alpha, u, Pi, r, K, shift = _line_search(mech, solver, policy, step, u_start, u, Pi, res,
                                                  K, fext, shift, held, history)
         if plane is not None:
             released |= step.release
             state = plane.hold(state, step.holds(alpha), u, u_start,
                                u_prev + max(alpha, 1.0) * step.du0, released)
+            lin = res0 + alpha * Kdu
 
 
 def _balanced(rnorm: float, tol: float, du: np.ndarray, u: np.ndarray) -> bool:
@@ -338,9 +359,32 @@ class _Step:
     linearized reaction lambda + (K du)_z would turn tensile (these are freed in K_ff, if it
     stays positive definite without them)."""
 
-    def __init__(self, plane, state, u, res, free, du_fixed, tol):
+    def __init__(self, plane, state, u, res, free, du_fixed, tol, coupling=None):
         self.plane, self.state, self.u, self.res, self.du_fixed = plane, state, u, res, du_fixed
-        self.free, self.tol = free, tol
+        self.free, self.tol, self.coupling, self.coupled = free, tol, coupling, False
+
+    def _coupled(self, fac, K) -> None:
+        """Coulomb's sliding nodes: the step again with the Newton matrix K_ff + U V^T
+        (`fem.friction`), the nodes the QP pressed held on the plane (g + du_z = 0). Kept only if
+        it descends in the energy the line search judges (the friction forces fixed)."""
+        cf = CoupledFactor(fac, K, self.coupling)
+        du = cf.solve(-self.res, self.du_fixed)
+        pressed = self.qp[self.lam > 0.0]
+        if pressed.size:
+            zdof = 2 * self.plane.nodes[pressed] + 1
+            E = np.zeros((len(du), len(pressed)))
+            E[zdof, np.arange(len(pressed))] = 1.0
+            cols = cf.solve(E)
+            lam = np.linalg.solve(cols[zdof], -(self.plane.gap(self.u)[pressed] + du[zdof]))
+            du = du + cols @ lam
+        self.du, self.coupled = du, True
+
+    def reduces_residual(self, r_trial: np.ndarray, fext0: np.ndarray, alpha: float) -> bool:
+        """The merit test of a coupled (non-symmetric) step, which need not descend in the
+        energy: the free residual, friction included, falls by 1e-4 alpha of itself."""
+        base = r_trial - fext0
+        res = base - self.plane.friction_force(self.state, base)
+        return bool(np.linalg.norm(res[self.free]) <= (1.0 - 1e-4 * alpha) * np.linalg.norm(self.res[self.free]))
 
     def solve(self, solver, K, shift, history, policy, lower=True) -> float:
         """Factor (with a diagonal shift if K_ff is not positive definite), solve, and add
@@ -364,6 +408,8 @@ class _Step:
                 fac, shift = _factor(solver, K, free, shift, history, policy, lower=False)
             self._constrained(fac, np.flatnonzero(tensile))
             self.release = tensile
+        if self.coupling is not None:
+            self._coupled(fac, K)
         return shift
 
     def _constrained(self, fac, candidates: np.ndarray) -> None:
@@ -532,7 +578,8 @@ def _line_search(mech, solver, policy, step, u_start, u, Pi, res, K, fext, shift
             except FloatingPointError:
                 alpha *= 0.5
                 continue
-            if not held or Pi1 - Pi <= 1e-4 * (res @ (trial - u)) + slack:
+            if not held or Pi1 - Pi <= 1e-4 * (res @ (trial - u)) + slack or (
+                    step.coupled and step.reduces_residual(r1, fext - step.friction, alpha)):
                 if held and alpha == 1.0 and shift > 0.0 and _conservative(plane):
                     return _extrapolate(mech, step, u_start, u, Pi, res, fext, trial, Pi1, r1, K1,
                                         slack) + (shift,)

@@ -212,7 +212,9 @@ def test_fields_are_written(frictionless, tmp_path):
 
 @pytest.mark.parametrize("kwargs, field", [({"u_max_m": -1e-3}, "u_max_m"),
                                             ({"u_max_m": 1.01 * H1}, "u_max_m"),
-                                            ({"contact": "coulomb"}, "contact"),
+                                            ({"contact": "slippery"}, "contact"),
+                                            ({"contact": "coulomb", "friction": -0.1}, "friction"),
+                                            ({"contact": "sticking", "friction": 0.5}, "friction"),
                                             ({"max_step": 0.0}, "max_step")])
 def test_bad_input_names_the_field(mesh, kwargs, field):
     with pytest.raises(ValueError, match=field):

@@ -46,6 +46,7 @@ def provenance(response: CupResponse, *, geometry: Mapping[str, Any], mesh: Mapp
         "material": {"law": "compressible neo-Hookean", "E_Pa": m.E_Pa, "nu": m.nu,
                      "formulation": m.formulation},
         "contact": response.contact,
+        **({"friction": response.friction} if response.contact == "coulomb" else {}),
         "fidelity": fidelity,
         "mesh": dict(mesh),
         "l_definition": "force-quartile width 2 (r_75 - r_25) of the radial line force int p dr "

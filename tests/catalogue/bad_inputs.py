@@ -74,6 +74,10 @@ for opt, value, expected in [
     ("--cup", "C", "argument --cup: invalid cup 'C'"),
 ]:
     case("CLI option", STIFF + [opt, value], expected)
+case("CLI option", STIFF + ["--contact", "coulomb"], "friction: --contact coulomb needs --friction MU, in [0, 100]")
+case("CLI option", STIFF + ["--contact", "coulomb", "--friction", "-0.2"], "friction: Coulomb's coefficient must be in [0, 100]")
+case("CLI option", STIFF + ["--contact", "coulomb", "--friction", "nan"], "friction: Coulomb's coefficient must be in [0, 100]")
+case("CLI option", STIFF + ["--friction", "0.3"], "friction: applies to --contact coulomb only")
 case("CLI option", ["stiffness", "--out", "{d}/c.txt"], "out: the stiffness curve must be a .csv file")
 case("CLI option", STIFF + ["--fields-out", "{d}/f.png"], "fields_out: must end in .vtu or .vtk")
 case("CLI option", UC + ["--surface", "pmma-1.89", "--E-MPa", "0"], "E")

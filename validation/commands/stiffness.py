@@ -13,6 +13,7 @@ stops with one line and exit status 2; a solve that fails exits 1. Neither leave
 
 examples:
   cupcheck stiffness --cup A --contact sticking --out out/cupA_sticking.csv
+  cupcheck stiffness --cup A --contact coulomb --friction 0.5 --out out/cupA_mu05.csv
   cupcheck stiffness --geometry my_cup.toml --fidelity medium --out my_cup.csv
   cupcheck stiffness --mesh meshes/user_lip.msh --u-max-mm 3 --out lip.csv
 """
@@ -56,11 +57,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     m.add_argument("--formulation", choices=("displacement", "mixed"), default="displacement",
                    help="displacement (default; nu <= 0.495, it locks above) or mixed u-p (nearly "
                         "incompressible, nu up to 0.4999)")
-    m.add_argument("--contact", choices=("frictionless", "sticking"), default="frictionless",
-                   help="contact with the plane: frictionless, or sticking (a touching point stops "
-                        "sliding) (default frictionless: the soap-lubricated glass on which the paper "
-                        "measured F0, Sec. 5.5; `cupcheck example` defaults to sticking, Appendix A's "
-                        "no-slip assumption)")
+    m.add_argument("--contact", choices=("frictionless", "sticking", "coulomb"), default="frictionless",
+                   help="contact with the plane: frictionless, sticking (a touching point stops "
+                        "sliding), or coulomb (stick while |t| <= mu p, slide otherwise; give "
+                        "--friction) (default frictionless: the soap-lubricated glass on which the "
+                        "paper measured F0, Sec. 5.5)")
+    m.add_argument("--friction", type=float, default=None, metavar="MU",
+                   help="Coulomb's friction coefficient mu, in [0, 100] (with --contact coulomb)")
     r = parser.add_argument_group("run")
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default=None,
                    help="mesh level of a generated mesh (default medium: F0 within 1 %% of the "
@@ -88,7 +91,8 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         response = compress_cup(job["mesh"], job["material"], contact=args.contact,
-                                u_max_m=job["u_max_m"], progress=terminal_progress("stiffness"))
+                                friction=job["friction"], u_max_m=job["u_max_m"],
+                                progress=terminal_progress("stiffness"))
     except ConvergenceError as exc:
         raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
     prov = handoff.provenance(response, geometry=job["geometry"], mesh=job["mesh_info"],
@@ -138,6 +142,7 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         raise ValueError(f"nu: with the displacement formulation Poisson's ratio must be <= "
                          f"{LOCKING_NU} (above, its elements lock and stiffen F0); use "
                          f"--formulation mixed for nu up to 0.4999, got {args.nu:g}")
+    friction = _friction(args.contact, args.friction)
     fidelity = args.fidelity or DEFAULT_FIDELITY
     if args.mesh is not None:
         given = [o for o, v in (("--geometry", args.geometry), ("--fidelity", args.fidelity), ("--cup", args.cup),
@@ -170,7 +175,22 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
                              f"{1e3 * h1:.9g}] mm, got {args.u_max_mm:.9g}")
         u_max = min(u_max, h1)
     return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
-            "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json")}
+            "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json"),
+            "friction": friction}
+
+
+def _friction(contact: str, friction: float | None) -> float:
+    """Coulomb's mu for --contact coulomb (required there, refused with the other laws)."""
+    if contact != "coulomb":
+        if friction is not None:
+            raise ValueError(f"friction: applies to --contact coulomb only, got --friction "
+                             f"{friction:g} with --contact {contact}")
+        return 0.0
+    if friction is None:
+        raise ValueError("friction: --contact coulomb needs --friction MU, in [0, 100]")
+    if not (0.0 <= friction <= 100.0):
+        raise ValueError(f"friction: Coulomb's coefficient must be in [0, 100], got {friction:g}")
+    return float(friction)
 
 
 def _writable(path: Path, name: str, what: str = "") -> None:
