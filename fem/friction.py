@@ -36,7 +36,9 @@ def friction_iterate(plane: RigidPlane, state: ContactState, u: np.ndarray, lin:
     sticks for the rest of the step: where the friction bound falls steeply with the slip
     (mu dlambda/dDelta < -c: cup A with mu = 10 at 0.88 h1), the node is consistent neither
     stuck (|t| > mu lambda by a few %) nor sliding (its slide reverses), and the set would cycle
-    for ever. Its excess over the cone is what `RigidPlane.cone_excess` reports per step."""
+    for ever. A state converged so that violates the cone by more than 1e3 rtol of the largest
+    normal reaction is refused (the step is cut back, `fem.solver`); below, the excess is what
+    `RigidPlane.cone_excess` reports per step."""
     c = np.maximum(K.diagonal()[2 * plane.nodes], 1e-300)
     new = plane.slide(state, u, lin, c, tol)
     flips = flips + (new.slip != state.slip)

@@ -324,6 +324,11 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         tensile = plane is not None and np.any(plane.reactions(res)[state.active] < -opts.rtol * f_ref)
         if held and not tensile and _balanced(rnorm, opts.rtol * f_ref, step.du, u) \
                 and energy <= opts.etol * e_ref:
+            if plane is not None and plane.cone_excess(state, res) > 1e3 * opts.rtol:
+                raise _StepFailure("Coulomb's stick/slide set cycled and the node held stuck lies "
+                                   f"outside the friction cone ({plane.cone_excess(state, res):.2g} "
+                                   "of the largest normal reaction); likely cause: a too-large step, "
+                                   "or a friction bound falling steeply with the slip", history)
             return u, r, state, it, indefinite
         it += 1
         if it >= opts.max_iterations:
