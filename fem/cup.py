@@ -191,6 +191,12 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
                                       for name in _PER_STEP_OBJECTS})
 
 
+def _joined(a: SolverStats, b: SolverStats) -> SolverStats:
+    """The cost of two consecutive paths as one."""
+    return SolverStats(**{f.name: getattr(a, f.name) + getattr(b, f.name) if f.name != "dofs"
+                          else b.dofs for f in fields(SolverStats)})
+
+
 @dataclass(frozen=True, eq=False)
 class _StepOutputs:
     """The outputs of one converged state (module docstring); fields named as in `CupResponse`."""

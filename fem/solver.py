@@ -170,19 +170,27 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
                 options: SolverOptions = SolverOptions(),
                 on_step: Callable[[StepResult], None] | None = None,
                 progress: Callable[[float, str], None] | None = None,
-                name: str = "t") -> SolverStats:
+                name: str = "t", start: StepResult | None = None) -> SolverStats:
     """Follow the equilibrium path from t = 0 to t_max; call `on_step` for every converged step
     (including t = 0). `name` names t in messages (e.g. "u [m]"). Raises `ConvergenceError` if
-    a step cannot be converged."""
-    start = time.perf_counter()
+    a step cannot be converged.
+
+    start: the converged state at t = 0 (default: u = 0, no contact), e.g. the end of another
+    path. A `mech` with a method ``at(t)`` is a family of potentials Pi_t (a load that is not a
+    prescribed displacement or a fixed force, such as a ramped cavity pressure, `fem.cavity`):
+    the step to t1 minimizes ``mech.at(t1)``'s energy, and its energy balance counts the work of
+    the parameter, int dPi_t/dt dt at fixed u, by the trapezoid."""
+    begin = time.perf_counter()
     n = mech.kin.ndofs
     f_ext = f_ext or (lambda t: np.zeros(n))
-    u0 = np.zeros(n)
-    state = plane.initial_state() if plane is not None else None
-    r0 = mech.internal_force(u0)
-    solver = make_solver(mech.linearize(u0)[1], mech.kin.node_coordinates(), mech.kin.mesh)
+    at = getattr(mech, "at", lambda t: mech)
+    m0 = at(0.0)
+    u0 = np.zeros(n) if start is None else start.u
+    state = (plane.initial_state() if start is None else start.contact) if plane is not None else None
+    r0 = m0.internal_force(u0)
+    solver = make_solver(m0.linearize(u0)[1], m0.kin.node_coordinates(), m0.kin.mesh)
     policy = _ShiftPolicy()
-    t, W0 = 0.0, mech.energy(u0)
+    t, W0 = 0.0, m0.energy(u0)
     if on_step:
         on_step(StepResult(0.0, u0, r0, W0, state, 0))
     dt = dt_ok = options.initial_step * t_max
@@ -192,8 +200,9 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         t1 = min(t + dt, t_max)
         if t_max - t1 < 0.2 * dt:          # don't leave a sliver at the end
             t1 = t_max
+        m1 = at(t1)
         try:
-            u1, r1, state1, its, indefinite = _newton(mech, dirichlet, f_ext, plane, state, u0,
+            u1, r1, state1, its, indefinite = _newton(m1, dirichlet, f_ext, plane, state, u0,
                                                       t1, options, solver, policy)
         except _StepFailure as fail:
             cutbacks += 1
@@ -214,8 +223,10 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
                     step=steps + 1, t_from=t, t_to=t1, cause=fail.cause, history=fail.history,
                 ) from None
             continue
-        W1 = mech.energy(u1)
+        W1 = m1.energy(u1)
         defect = W0 + _work(dirichlet, f_ext, t, t1, u0, u1, r0, r1) - W1
+        if m1 is not m0:        # the work of the potential's own parameter, by the trapezoid
+            defect += 0.5 * (m1.energy(u0) - m0.energy(u0) + m1.energy(u1) - m0.energy(u1))
         conservative = _conservative(plane)
         if conservative and _jumped_too_far(indefinite, defect, W0, W1, t1 - t, jumps, options,
                                             t_max):
@@ -231,7 +242,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         dt_ok = t1 - t
         if plane is not None:
             state1 = plane.commit(state1, u1)
-        u0, r0, W0, state, t, jumps = u1, r1, W1, state1, t1, 0
+        u0, r0, W0, state, t, jumps, m0 = u1, r1, W1, state1, t1, 0, m1
         if on_step:
             on_step(StepResult(t, u1, r1, W1, state1, its, bool(indefinite)))
         if progress:
@@ -239,7 +250,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         if its <= options.easy_iterations:
             dt = min(dt * options.growth, options.max_step * t_max)
         dt = min(dt, options.max_step * t_max)
-    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - start, int(n), unstable,
+    return SolverStats(steps, iterations, cutbacks, time.perf_counter() - begin, int(n), unstable,
                        float(dissipated), policy.factorizations, policy.failed)
 
 

@@ -1,0 +1,255 @@
+"""The cavity's gas pressure as a conservative load: Pi(u) = W(u) + dp V_cav(u).
+
+The cavity of the cup is the region of revolution bounded by the rigid plate's roof (z = h from
+the axis to the plate edge r_0), the deformed cavity-facing surface from the plate edge down to
+its first point on the plane (the seal, r_k), the vertical drop from there to z = 0 (zero length
+when the seal touches, as it does at equilibrium) and the plane back to the axis. Its volume,
+by the divergence theorem in the meridian plane, is the line integral over the open chain
+
+    V_cav = pi r_k^2 z_k - pi int_chain r^2 dz,                        (the region of eq. 4)
+
+the roof, axis and plane contributing nothing. With the pressure difference dp = p_a - p_b > 0
+(the gas inside below the ambient) acting on the cavity surface, the load is conservative: the
+gas does work p_b dV on the surface and the uniform ambient pressure none on the closed body,
+so the potential energy gains dp V_cav and the equilibrium minimizes W(u) + dp V_cav(u) under the
+plate displacement and the contact conditions. `PressurizedMechanics` adds dp V_cav, its exact
+gradient and Hessian on the quadratic edges (3-point Gauss per edge: the integrand r^2 dz/dxi is
+a quintic) to `fem.forms.Mechanics`; the solver (`fem.solver`) needs nothing else.
+
+The chain is cut at its first node on the plane (z <= a round-off tolerance): beyond the seal the
+surface lies outside the gas region (a lifted pocket outside a mid-wall touchdown carries no
+cavity pressure). V_cav is continuous as the seal moves from node to node (z_k = 0 at the cut)
+and piecewise smooth like the contact conditions it follows.
+
+Global equilibrium (tested): the vertical resultant of the pressure on any surface of revolution
+between radii r_0 and r_k is dp pi (r_k^2 - r_0^2), pulling the wall towards the plane, so the
+plate's force on the body P_z, the contact force N and the suction balance:
+
+    P_z + N = dp pi (r_k^2 - r_0^2),
+
+and with the roof's share dp pi r_0^2 on the rigid plate, the pull on the handle is
+F1 = dp pi r_0^2 + P_z = dp pi r_k^2 - N (eq. 5 with the FEM's N and r_k in place of kappa F0 and r).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Mesh
+
+from .forms import Mechanics
+from .mesh import boundary_path
+
+__all__ = ["CavitySurface", "PressurizedMechanics"]
+
+_XI, _W = np.polynomial.legendre.leggauss(6)
+
+
+def _shape(xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Quadratic line shape functions (start, mid, end) and their xi-derivatives, [3, nq]."""
+    N = np.stack([0.5 * xi * (xi - 1.0), 1.0 - xi**2, 0.5 * xi * (xi + 1.0)])
+    dN = np.stack([xi - 0.5, -2.0 * xi, xi + 0.5])
+    return N, dN
+
+
+def _rule(upper: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """N, dN/dxi and weights of the Gauss rule on xi in [-1, upper]."""
+    half = 0.5 * (upper + 1.0)
+    xi = -1.0 + half * (_XI + 1.0)
+    N, dN = _shape(xi)
+    return N, dN, _W * half
+
+
+_FULL, _HALF = _rule(1.0), _rule(0.0)
+
+
+def wetted_fraction(z: np.ndarray, z_ref: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """phi(z): the share of the cavity pressure acting at height z above the plane, rising
+    smoothly (C1) from 0 on the plane to 1 at z_ref; returns (Phi = int_0^z phi, phi, phi', phi'')."""
+    if z_ref <= 0.0:
+        one = np.ones_like(z)
+        return z, one, 0.0 * one, 0.0 * one
+    s = np.clip(z / z_ref, 0.0, 1.0)
+    inside = (z > 0.0) & (z < z_ref)
+    Phi = np.where(z >= z_ref, z - 0.5 * z_ref, z_ref * (s**3 - 0.5 * s**4))
+    phi = 3.0 * s**2 - 2.0 * s**3
+    dphi = np.where(inside, (6.0 * s - 6.0 * s**2) / z_ref, 0.0)
+    d2phi = np.where(inside, (6.0 - 12.0 * s) / z_ref**2, 0.0)
+    return Phi, phi, dphi, d2phi
+
+
+@dataclass(frozen=True)
+class CavitySurface:
+    """The cavity-facing chain of quadratic edges, from the plate edge to the rim.
+
+    `nodes` [n] are the mesh nodes along the chain (vertices and mid-side nodes interleaved,
+    `fem.mesh.boundary_path`); edge e has nodes nodes[2e], nodes[2e + 1], nodes[2e + 2].
+    `wetting_m` is z_ref of `wetted_fraction` (0: the pressure acts up to the seal node).
+    """
+
+    nodes: np.ndarray
+    tolerance_m: float
+    wetting_m: float = 0.0
+
+    @classmethod
+    def of(cls, mesh: Mesh, wetting_m: float = 0.0) -> "CavitySurface":
+        nodes = boundary_path(mesh, "cavity")
+        if nodes.size % 2 == 0:
+            raise ValueError("mesh: the cavity chain must consist of quadratic edges (odd node count)")
+        if not (np.isfinite(wetting_m) and wetting_m >= 0.0):
+            raise ValueError(f"wetting_m: must be >= 0 m, got {wetting_m}")
+        size = float(np.max(np.ptp(mesh.doflocs, axis=1)))
+        return cls(nodes, 1e-12 * size, float(wetting_m))
+
+    def seal_index(self, x: np.ndarray) -> int:
+        """Position along the chain of the first node on the plane, the seal (the last node if
+        none is)."""
+        on = np.flatnonzero(x[1, self.nodes] <= self.tolerance_m)
+        return int(on[0]) if on.size else self.nodes.size - 1
+
+    def cut_index(self, x: np.ndarray) -> int:
+        """Position of the last node of the first run of nodes on the plane: the load acts on
+        the chain up to here (module docstring)."""
+        on = x[1, self.nodes] <= self.tolerance_m
+        k = self.seal_index(x)
+        while k + 1 < on.size and on[k + 1]:
+            k += 1
+        return k
+
+    def sealed(self, x: np.ndarray) -> bool:
+        """Whether any node of the chain lies on the plane (else the cavity is open)."""
+        return bool(np.any(x[1, self.nodes] <= self.tolerance_m))
+
+    def seal_radius(self, x: np.ndarray) -> float:
+        """r_k: the deformed radius of the seal node [m]."""
+        return float(x[0, self.nodes[self.seal_index(x)]])
+
+    def volume(self, x: np.ndarray) -> float:
+        """The geometric V_cav [m^3] of the deformed node coordinates x [2, nnodes]."""
+        return self._terms(x, 0, 0.0)[0]
+
+    def loaded_volume(self, x: np.ndarray) -> float:
+        """V_phi = int phi(z) dV over the cavity [m^3], whose dp-multiple is the load's potential
+        (= `volume` for wetting_m = 0)."""
+        return self._terms(x, 0, self.wetting_m)[0]
+
+    def derivatives(self, x: np.ndarray) -> tuple[float, tuple, np.ndarray, np.ndarray]:
+        """(V_phi, (dofs, dV_phi/dx there), the Hessian's entries, their dof pairs [2, m]):
+        dofs 2n (r) and 2n + 1 (z) of node n, as in `fem.kinematics`."""
+        return self._terms(x, 2, self.wetting_m)
+
+    def _terms(self, x: np.ndarray, order: int, z_ref: float):
+        """V_phi = pi r_k^2 Phi(z_k) - pi int_chain r^2 phi(z) dz and its derivatives, the chain
+        cut at `cut_index`."""
+        k = self.cut_index(x)
+        full_edges, half = divmod(k, 2)
+        pieces = [(self.nodes[2 * e: 2 * e + 3], _FULL) for e in range(full_edges)]
+        if half:
+            pieces.append((self.nodes[2 * full_edges: 2 * full_edges + 3], _HALF))
+        seal = self.nodes[k]
+        rk, zk = x[:, seal]
+        Phi_k, phi_k, dphi_k, _ = (float(v) for v in wetted_fraction(np.array(zk), z_ref))
+        V = np.pi * rk**2 * Phi_k
+        grads, hess, pairs = [], [], []
+        for nodes, (N, dN, w) in pieces:
+            r, z = N.T @ x[0, nodes], N.T @ x[1, nodes]
+            dz = dN.T @ x[1, nodes]
+            _, phi, dphi, d2phi = wetted_fraction(z, z_ref)
+            V -= np.pi * np.sum(w * r**2 * phi * dz)
+            if not order:
+                continue
+            dofs = np.concatenate([2 * nodes, 2 * nodes + 1])
+            g_r = (N * (2.0 * r * phi * dz * w)).sum(axis=1)
+            g_z = (N * (r**2 * dphi * dz * w) + dN * (r**2 * phi * w)).sum(axis=1)
+            grads.append((dofs, -np.pi * np.concatenate([g_r, g_z])))
+            H = np.zeros((6, 6))
+            H[:3, :3] = (N * (2.0 * phi * dz * w)) @ N.T
+            H[:3, 3:] = (N * (2.0 * r * dphi * dz * w)) @ N.T + (N * (2.0 * r * phi * w)) @ dN.T
+            H[3:, :3] = H[:3, 3:].T
+            B = (N * (r**2 * dphi * w)) @ dN.T
+            H[3:, 3:] = (N * (r**2 * d2phi * dz * w)) @ N.T + B + B.T
+            hess.append(-np.pi * H.ravel())
+            pairs.append(np.stack(np.meshgrid(dofs, dofs, indexing="ij")).reshape(2, -1))
+        if not order:
+            return (float(V),)
+        d = np.array([2 * seal, 2 * seal + 1])
+        grads.append((d, np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])))
+        hess.append(np.array([2.0 * np.pi * Phi_k, 2.0 * np.pi * rk * phi_k,
+                              2.0 * np.pi * rk * phi_k, np.pi * rk**2 * dphi_k]))
+        pairs.append(np.stack(np.meshgrid(d, d, indexing="ij")).reshape(2, -1))
+        dofs = np.concatenate([g[0] for g in grads])
+        grad = np.concatenate([g[1] for g in grads])
+        return float(V), (dofs, grad), np.concatenate(hess), np.concatenate(pairs, axis=1)
+
+
+@dataclass
+class PressurizedMechanics:
+    """`fem.forms.Mechanics` of the cup loaded by dp = p_a - p_b [Pa] on its cavity surface:
+    energy W + dp V_cav, force r + dp dV/du, tangent K + dp d2V/du2 (module docstring), with the
+    tangent in the body's own CSR pattern (the solver's factorization is built for it).
+
+    schedule: dp as a function of the path parameter t (e.g. a ramp at fixed plate position);
+    `at(t)` is then the potential at t, which `fem.solver.follow_path` minimizes step by step."""
+
+    body: Mechanics
+    cavity: CavitySurface
+    dp_Pa: float
+    schedule: Callable[[float], float] | None = None
+    _table: dict = field(default_factory=dict, repr=False)     # CSR positions, shared by `at`
+
+    def at(self, t: float) -> "PressurizedMechanics":
+        if self.schedule is None:
+            return self
+        return replace(self, dp_Pa=float(self.schedule(t)), schedule=None)
+
+    @property
+    def kin(self):
+        return self.body.kin
+
+    @property
+    def material(self):
+        return self.body.material
+
+    def coordinates(self, u: np.ndarray) -> np.ndarray:
+        """Deformed node coordinates x = X + u [2, nnodes]."""
+        return self.kin.node_coordinates() + np.stack([u[0::2], u[1::2]])
+
+    def energy(self, u: np.ndarray) -> float:
+        return self.body.energy(u) + self.dp_Pa * self.cavity.loaded_volume(self.coordinates(u))
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        return self.evaluate(u)[1]
+
+    def linearize(self, u: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
+        return self.evaluate(u)[1:]
+
+    def evaluate(self, u: np.ndarray) -> tuple[float, np.ndarray, sp.csr_matrix]:
+        W, r, K = self.body.evaluate(u)
+        if self.dp_Pa == 0.0:
+            return W, r, K
+        V, (dofs, grad), hess, pairs = self.cavity.derivatives(self.coordinates(u))
+        r = r + self.dp_Pa * np.bincount(dofs, grad, minlength=r.size)
+        data = K.data + self.dp_Pa * np.bincount(self._positions(K, pairs), hess,
+                                                 minlength=K.nnz)
+        return W + self.dp_Pa * V, r, sp.csr_matrix((data, K.indices, K.indptr), shape=K.shape)
+
+    def _positions(self, K: sp.csr_matrix, pairs: np.ndarray) -> np.ndarray:
+        """Positions of the dof pairs (i, j) in K's CSR data (sorted column indices per row)."""
+        table = self._lookup(K)
+        keys = pairs[0].astype(np.int64) * K.shape[0] + pairs[1]
+        pos = np.searchsorted(table, keys)
+        if np.any(pos >= table.size) or np.any(table[np.minimum(pos, table.size - 1)] != keys):
+            raise ValueError("cavity: an edge's dofs are not coupled in the tangent's pattern")
+        return pos
+
+    def _lookup(self, K: sp.csr_matrix) -> np.ndarray:
+        table = self._table.get(K.nnz)
+        if table is None:
+            rows = np.repeat(np.arange(K.shape[0], dtype=np.int64), np.diff(K.indptr))
+            table = self._table[K.nnz] = rows * K.shape[0] + K.indices
+            if np.any(np.diff(table) <= 0):
+                raise ValueError("cavity: the tangent's CSR column indices must be sorted")
+        return table

@@ -1,0 +1,150 @@
+"""The cup under suction: its response on a grid of plate displacement u and cavity pressure dp.
+
+    grid = suction_grid(mesh, NeoHookean(), u_m=[0.5e-3, 1e-3, 2e-3], dp_Pa=[0, 2e4, 5e4, 1e5])
+    grid.F1_N[i, j], grid.V_m3[i, j], grid.seal_r_m[i, j], grid.profiles[i][j]
+
+For every u_i the cup is pressed to u_i with no suction (one displacement-controlled path
+through all the u_i), then, with the plate held, dp = p_a - p_b is ramped through the dp_j on
+the cavity surface (`fem.cavity`: the conservative load dp V_cav). Each grid value is a
+converged state reached exactly (the paths are cut at the grid points), so no interpolation
+enters here. Ramping dp at fixed u keeps the plate's reaction continuous; at u = 0 only the
+rim corner touches and the ramp is degenerate, so u must be > 0.
+
+The state (u, dp) is what the coupled reduced model needs (`reduced.coupled`): the pull on the
+handle F1 = dp pi r_k^2 - N (eq. 5 with the FEM's contact force N and seal radius r_k), the gas
+volume V, and the contact-pressure profile through which the gas leaks. Frictionless contact is
+path independent, so the order of loading (press, then suck) does not matter; with sticking or
+Coulomb contact it does, and the grid is the response to that order.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from skfem import Mesh
+
+from .cavity import CavitySurface, PressurizedMechanics
+from .contact import CONTACT_LAWS, PressureProfile, RigidPlane
+from .cup import _boundary_nodes, _joined, _measure, cup_height
+from .forms import Mechanics
+from .kinematics import Kinematics
+from .material import NeoHookean
+from .mesh import boundary_path
+from .solver import SolverOptions, SolverStats, StepResult, follow_path
+
+__all__ = ["SuctionGrid", "suction_grid"]
+
+
+@dataclass(frozen=True, eq=False)
+class SuctionGrid:
+    """The cup's converged states on the grid (module docstring); arrays are [len(u), len(dp)]."""
+
+    h1_m: float
+    contact: str
+    material: NeoHookean
+    u_m: np.ndarray
+    dp_Pa: np.ndarray
+    F1_N: np.ndarray            # pull on the handle (> 0 pulls the cup off the plane)
+    contact_force_N: np.ndarray  # N: the plane's reaction less dp on the zone beyond the seal
+    V_m3: np.ndarray            # cavity volume (geometric)
+    seal_r_m: np.ndarray        # r_k: radius of the seal node (the cavity's edge)
+    cut_r_m: np.ndarray         # outer end of the innermost contact zone (the load's extent)
+    r_c_m: np.ndarray           # inner contact radius of the pressure profile
+    potential_J: np.ndarray     # W + dp V_cav at the state (its dp-derivative is V_cav)
+    profiles: tuple[tuple[PressureProfile, ...], ...] = field(repr=False)
+    stats: SolverStats = field(repr=False)
+
+
+def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: Sequence[float],
+                 contact: Literal["frictionless", "sticking", "coulomb"] = "frictionless",
+                 friction: float = 0.0, wetting_m: float = 0.0,
+                 progress: Callable[[float, str], None] | None = None,
+                 **solver_opts: Any) -> SuctionGrid:
+    """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in (0, h1];
+    dp_Pa: increasing, starting at 0. Raises ValueError for bad input, `fem.solver.ConvergenceError`
+    naming u and dp where a state cannot be reached."""
+    h1 = cup_height(mesh)
+    u = np.asarray(u_m, float)
+    dp = np.asarray(dp_Pa, float)
+    _check_axes(u, dp, h1, material)
+    if contact not in CONTACT_LAWS:
+        raise ValueError(f"contact: must be one of {', '.join(CONTACT_LAWS)}, got {contact!r}")
+    options = SolverOptions(**solver_opts)
+    kin = Kinematics.of(mesh)
+    body = Mechanics(kin, material)
+    top = _boundary_nodes(mesh, "top_plate")
+    plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top, friction=friction)
+    top_dofs = np.concatenate([2 * top, 2 * top + 1])
+    path = boundary_path(mesh, "cavity")
+    cavity = CavitySurface.of(mesh, wetting_m)
+
+    def plate_at(u0: float, moving: bool) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
+        """The plate at u0 (+ t while pressing)."""
+        return lambda t: (top_dofs, np.concatenate([np.zeros(len(top)),
+                                                    np.full(len(top), -(u0 + moving * t))]))
+
+    def segment(mech, dirichlet, t_max, start, where) -> tuple[StepResult, SolverStats]:
+        last: list[StepResult] = []
+        try:
+            stats = follow_path(mech, dirichlet, t_max, plane=plane, options=options,
+                                on_step=last.append, start=start)
+        except RuntimeError as err:
+            raise type(err)(f"{where}: {err}") from None
+        end = last[-1]
+        return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0), stats
+
+    outputs = np.empty((u.size, dp.size), dtype=object)
+    total: SolverStats | None = None
+    pressed, u_prev = None, 0.0
+    for i, u_i in enumerate(u):
+        pressed, stats = segment(body, plate_at(u_prev, True), u_i - u_prev, pressed,
+                                 f"pressing to u = {u_i * 1e3:.4g} mm")
+        total = stats if total is None else _joined(total, stats)
+        u_prev, state = u_i, pressed
+        outputs[i, 0] = _outputs(state, body, plane, top, path, cavity)
+        for j in range(1, dp.size):
+            lo, hi = dp[j - 1], dp[j]
+            mech = PressurizedMechanics(body, cavity, hi, schedule=lambda t, lo=lo, hi=hi: lo + t * (hi - lo))
+            state, stats = segment(mech, plate_at(u_i, False), 1.0, state,
+                                   f"u = {u_i * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {hi / 1e3:.4g} kPa")
+            total = _joined(total, stats)
+            outputs[i, j] = _outputs(state, mech.at(1.0), plane, top, path, cavity)
+            if progress:
+                progress((i * (dp.size - 1) + j) / (u.size * (dp.size - 1)),
+                         f"u = {u_i * 1e3:.4g} mm, dp = {hi / 1e3:.4g} kPa")
+    take = np.vectorize(lambda o, k: o[k], otypes=[float])
+    return SuctionGrid(
+        h1_m=h1, contact=contact, material=material, u_m=u, dp_Pa=dp,
+        F1_N=take(outputs, 0), contact_force_N=take(outputs, 1), V_m3=take(outputs, 2),
+        seal_r_m=take(outputs, 3), cut_r_m=take(outputs, 4), r_c_m=take(outputs, 5),
+        potential_J=take(outputs, 6),
+        profiles=tuple(tuple(o[7] for o in row) for row in outputs), stats=total)
+
+
+def _outputs(state: StepResult, mech, plane, top, path, cavity) -> tuple:
+    """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile) of a converged state. F1 = -F0, the plate's
+    reaction, which with suction includes the roof's share dp pi r_0^2; N is the plane's
+    reaction less the suction dp pi (r_cut^2 - r_k^2) that the load puts on the flat contact
+    zone beyond the seal (there the interface is outside the cavity), so F1 + N = dp pi r_k^2
+    (`fem.cavity`). The profile is the plane's reaction per area (the gap at p_b)."""
+    m = _measure(state, mech, plane, top, path)
+    x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])
+    dp = getattr(mech, "dp_Pa", 0.0)
+    r_k = cavity.seal_radius(x)
+    r_cut = float(x[0, cavity.nodes[cavity.cut_index(x)]])
+    N = m.F0_contact_N - dp * np.pi * (r_cut**2 - r_k**2)
+    return (-m.F0_N, N, cavity.volume(x), r_k, r_cut, m.r_c_m, state.energy_J, m.pressure)
+
+
+def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, material: NeoHookean) -> None:
+    if u.ndim != 1 or u.size == 0 or not np.all(np.isfinite(u)) or np.any(np.diff(u) <= 0) \
+            or u[0] <= 0.0 or u[-1] > h1:
+        raise ValueError(f"u_m: plate displacements must increase within (0, h1] = (0, "
+                         f"{h1 * 1e3:.4g} mm], got {np.round(u * 1e3, 4).tolist()} mm")
+    if dp.ndim != 1 or dp.size == 0 or not np.all(np.isfinite(dp)) or dp[0] != 0.0 \
+            or np.any(np.diff(dp) <= 0) or dp[-1] > 10.0 * material.E_Pa:
+        raise ValueError(f"dp_Pa: cavity pressures must start at 0 and increase, at most 10 E = "
+                         f"{10 * material.E_Pa:.4g} Pa, got {dp.tolist()}")
