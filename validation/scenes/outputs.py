@@ -75,15 +75,9 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
         if kind == "lifetimes":
             return [_file(name, kind, _lifetime_table(results, products, tmp / f"{name}.csv"))]
         return [_file(name, kind, _trajectory(r, tmp / f"{name}_F1_{r.force_N:g}N.csv")) for r in results]
-    if kind == "render":
-        state = products.fem_state(output["u_mm"])
-        if tmp is None:
-            return []
-        from validation.render import render_cup
-        png = render_cup(state["r_m"], state["z_m"], tmp / f"{name}.png", scalar=state["p_Pa"] / 1e3,
-                         scalar_name="contact pressure (kPa)",
-                         title=f"u = {1e3 * state['u_m']:.3g} mm, {products.scene['contact']['law']}")
-        return [_file(name, kind, png)]
+    if kind in ("render", "footprint", "squeeze"):
+        from validation.scenes.views3d import write_view
+        return write_view(output, products, tmp)
     figure = {"lifetime_vs_force": _lifetime_figure, "uc_vs_pressure": _uc_figure, "F0_vs_u": _F0_figure,
               "lifetime_vs_parameter": _parameter_figure}
     fig = figure[output["figure"]](products)
