@@ -15,12 +15,15 @@ one loaded node (the rim corner alone) is a line contact of zero width.
 
 from __future__ import annotations
 
+import contextlib
+import io
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["CupFrame", "frame_from_response", "frame_from_fields_file", "contact_zones_of", "boundary_loop"]
+__all__ = ["CupFrame", "frame_from_response", "frame_from_fields_file", "fields_file_steps", "contact_zones_of",
+           "boundary_loop"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,7 +65,6 @@ def frame_from_fields_file(path: str | Path, u_mm: float | None = None,
     step of an .xdmf series nearest `u_mm` (default its last). The von Mises stress is the L2
     projection of the file's element-mean Cauchy stress, the smallest stretch that of the file's
     displacement, the contact pressure the recovery of its lumped nodal pressure."""
-    import meshio
     from skfem import MeshQuad2, MeshTri2
 
     from fem.kinematics import Kinematics
@@ -72,18 +74,10 @@ def frame_from_fields_file(path: str | Path, u_mm: float | None = None,
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"fields: no such file '{path}'")
-    try:
-        if path.suffix.lower() == ".xdmf":
-            with meshio.xdmf.TimeSeriesReader(str(path)) as series:
-                points, cells = series.read_points_cells()
-                times = [series.read_data(k)[0] for k in range(series.num_steps)]
-                k = len(times) - 1 if u_mm is None else int(np.argmin(np.abs(np.array(times) - 1e-3 * u_mm)))
-                t, point_data, cell_data = series.read_data(k)
-        else:
-            m = meshio.read(str(path))
-            points, cells, point_data, cell_data = m.points, m.cells, m.point_data, m.cell_data
-            t = None
-    except Exception as exc:                     # meshio raises many kinds on a damaged file
+    try:      # meshio prints and may sys.exit() on an unreadable file: keep both inside
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            points, cells, point_data, cell_data, t = _read(path, u_mm)
+    except (Exception, SystemExit) as exc:
         raise ValueError(f"fields: cannot read '{path}': {exc}".replace("\n", " ")) from None
     block = next((c for c in cells if c.type in ("quad9", "triangle6")), None)
     missing = [k for k in ("displacement", "contact_pressure") if k not in point_data]
@@ -108,6 +102,37 @@ def frame_from_fields_file(path: str | Path, u_mm: float | None = None,
         sig = np.stack([np.asarray(cell_data[f"sigma_{c}"][0], float) for c in ("rr", "zz", "tt", "rz")])
         data["von_mises"] = project_to_nodes(kin, np.repeat(von_mises(sig)[:, None], kin.dV.shape[1], axis=1))
     return _frame(mesh, u, plate_u, p_lumped, data)
+
+
+def _read(path: Path, u_mm: float | None):
+    """(points, cells, point data, cell data, u [m] or None) of a fields file's step."""
+    import meshio
+
+    if path.suffix.lower() == ".xdmf":
+        with meshio.xdmf.TimeSeriesReader(str(path)) as series:
+            points, cells = series.read_points_cells()
+            times = [series.read_data(k)[0] for k in range(series.num_steps)]
+            k = len(times) - 1 if u_mm is None else int(np.argmin(np.abs(np.array(times) - 1e-3 * u_mm)))
+            t, point_data, cell_data = series.read_data(k)
+        return points, cells, point_data, cell_data, t
+    m = meshio.read(str(path))
+    return m.points, m.cells, m.point_data, m.cell_data, None
+
+
+def fields_file_steps(path: str | Path) -> list[float]:
+    """The plate displacements u [m] of the steps in a fields file (one, unknown, for .vtu/.vtk: [nan])."""
+    import meshio
+
+    path = Path(path)
+    if path.suffix.lower() != ".xdmf":
+        return [float("nan")]
+    try:
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()), \
+                meshio.xdmf.TimeSeriesReader(str(path)) as series:
+            series.read_points_cells()
+            return [float(series.read_data(k)[0]) for k in range(series.num_steps)]
+    except (Exception, SystemExit) as exc:
+        raise ValueError(f"fields: cannot read '{path}': {exc}".replace("\n", " ")) from None
 
 
 def _frame(mesh, u: np.ndarray, u_plate_m: float, p_lumped: np.ndarray, data: dict) -> CupFrame:
