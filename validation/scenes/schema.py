@@ -14,7 +14,9 @@
                      values = [...]                  (optional: one parameter varied for a figure)
     [[outputs]]      kind = "curve" | "lifetimes" | "trajectories" | "figure"
                      name = "..." (file stem), figure = "lifetime_vs_force" | "uc_vs_pressure" | "F0_vs_u"
-                     | "lifetime_vs_parameter" (needs [sweep]: one line per F1)
+                     | "lifetime_vs_parameter" (needs [sweep]: one line per F1) | "r_pb_vs_time" (r(t),
+                     p_b(t)) | "p_Ndot_vs_time" (p(t), Ndot(t)): one line per F1; uc_vs_pressure and F0_vs_u
+                     with a [sweep] of surface.preset or cup.preset draw one line per value
                      kind = "render" with u_mm = 3: the revolved deformed FEM cup at u, cut open and
                      coloured by field = "contact_pressure" (default) | "von_mises" | "min_stretch"
                      (pyvista off-screen; the FEM runs only to u)
@@ -46,7 +48,8 @@ OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure", "render", "footp
 STATE_KINDS = ("render", "footprint", "squeeze")
 FIELDS = ("contact_pressure", "von_mises", "min_stretch")
 MAX_FRAMES = 60
-FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parameter")
+FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parameter", "r_pb_vs_time",
+           "p_Ndot_vs_time")
 SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset", "contact.friction")
 MAX_FRICTION = 100.0
 _TABLES: dict[str, dict[str, Any]] = {
@@ -125,7 +128,8 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
     sweep = _sweep(data["sweep"], tables) if "sweep" in data else None
     if sweep is None and any(o["figure"] == "lifetime_vs_parameter" for o in parsed):
         raise ValueError("outputs: the figure lifetime_vs_parameter needs a [sweep] table")
-    if sweep is not None and any(o["kind"] in ("curve", "trajectories", *STATE_KINDS) for o in parsed):
+    if sweep is not None and any(o["kind"] in ("curve", "trajectories", *STATE_KINDS)
+                                 or o["figure"] in ("r_pb_vs_time", "p_Ndot_vs_time") for o in parsed):
         raise ValueError("sweep: a swept scene writes lifetimes and figures; drop the curve, trajectories and 3D outputs")
     return Scene(tables=tables, outputs=parsed, source=source, sweep=sweep)
 
