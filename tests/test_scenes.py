@@ -173,3 +173,24 @@ def test_a_coulomb_scene_is_the_command_lines_coulomb_curve(tmp_path, capsys):
                  "--out", str(tmp_path / "cli.csv")]) == 0
     a, b = pd.read_csv(tmp_path / "scene" / "c.csv"), pd.read_csv(tmp_path / "cli.csv")
     assert len(a) == len(b) and abs(a["F0_N"] - b["F0_N"]).max() <= 1e-9 * b["F0_N"].abs().max()
+
+
+@pytest.mark.parametrize("tty,quiet", [(True, False), (True, True), (False, False)])
+def test_the_progress_bar_shows_on_a_terminal_only(tmp_path, monkeypatch, capsys, tty, quiet):
+    """On a terminal a tqdm bar over the outputs names what runs (the product, the lifetimes k of n);
+    with --quiet or without a terminal stderr stays empty."""
+    import io
+
+    class Term(io.StringIO):
+        def isatty(self):
+            return tty
+
+    err = Term()
+    monkeypatch.setattr(sys, "stderr", err)
+    argv = ["run", str(ROOT / "scenes" / "appendix_a_lifetimes.toml"), "--out", str(tmp_path / "o"), "--no-cache"]
+    assert main(argv + (["--quiet"] if quiet else [])) == 0
+    text = err.getvalue()
+    if tty and not quiet:
+        assert "run" in text and "output" in text and "lifetime 2 of 2 done" in text
+    else:
+        assert text == ""

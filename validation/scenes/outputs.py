@@ -42,11 +42,18 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
         scene = scene_from_mapping(scene) if isinstance(scene, dict) else load_scene(scene)
     products = Products(scene, cache_dir=cache_dir, progress=progress)
     t0 = time.perf_counter()
+    def each(tmp):
+        n = len(scene.outputs)
+        for k, o in enumerate(scene.outputs):
+            if progress is not None:
+                progress(f"output {k + 1} of {n}: {o['name']}")
+            yield from _write(o, products, tmp)
+
     if out is None:
-        files = [f for o in scene.outputs for f in _write(o, products, None)]
+        files = list(each(None))
         return SceneResult(scene, products.computed(), files, dict(products.timings))
     with atomic_directory(out) as tmp:
-        files = [f for o in scene.outputs for f in _write(o, products, Path(tmp))]
+        files = list(each(Path(tmp)))
         manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
                     "scene": scene.resolved(), "source": scene.source,
                     "versions": software_versions(), "timings_s": {**products.timings,

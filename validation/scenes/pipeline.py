@@ -95,11 +95,16 @@ def _fem_frames(cup: dict, material: dict, contact: dict, fidelity: str, u_mm: f
     return [frame_from_response(response, k) for k in steps]
 
 
-def _lifetimes(tables: dict, curve, uc, code: str):
+def _lifetimes(tables: dict, curve, uc, code: str, progress=None):
     COMPUTED["lifetimes"] += 1
     from reduced.lifetime import lifetime_sweep
     model = _model(tables, curve, uc)
-    return lifetime_sweep(model, tables["loads"]["F1_N"], refine=2)
+    forces = tables["loads"]["F1_N"]
+
+    def each(fraction: float, message: str) -> None:
+        if progress is not None:
+            progress(f"lifetime {round(fraction * len(forces))} of {len(forces)} done ({message})")
+    return lifetime_sweep(model, forces, refine=2, progress=each)
 
 
 def _geometry(cup: dict):
@@ -149,7 +154,7 @@ class Products:
         return self._memory.cache(func, ignore=ignore) if self._memory is not None else func
 
     def _fem_progress(self, fraction: float, message: str) -> None:
-        self._progress(f"FEM {message}")
+        self._progress(f"FEM {message.split(': ', 1)[-1].split(',')[0]}")     # FEM u = .. mm of .. mm
 
     def _get(self, name: str, compute):
         if name not in self._done:
@@ -186,9 +191,9 @@ class Products:
             package_version("fem") + package_version("validation"), progress=self._fem_progress))
 
     def lifetimes(self):
-        return self._get("lifetimes", lambda: self._cached(_lifetimes)(
+        return self._get("lifetimes", lambda: self._cached(_lifetimes, ignore=["progress"])(
             self.scene.tables, self.curve(), self.uc_table(),
-            package_version("reduced") + package_version("validation")))
+            package_version("reduced") + package_version("validation"), progress=self._progress))
 
     def variants(self) -> list[tuple[Any, "Products"]]:
         """For a swept scene: (value, the products of the scene with that value), sharing the cache."""
