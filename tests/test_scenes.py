@@ -27,6 +27,26 @@ SHIPPED = sorted(p for p in (ROOT / "scenes").glob("*.toml") if not p.name.start
     ({"camera": {}, "outputs": [{"kind": "curve"}]}, "camera: unknown table"),
     ({}, "outputs: a scene needs a non-empty list of [[outputs]]"),
     ({"outputs": [{"kind": "curve"}, {"kind": "curve"}]}, "outputs: two outputs would write the same file 'curve'"),
+    ({"outputs": [{"kind": "render", "u_mm": 3, "field": "stress"}]},
+     "outputs[0].field: expected one of contact_pressure, von_mises, min_stretch, got 'stress'"),
+    ({"outputs": [{"kind": "curve", "field": "von_mises"}]}, "outputs[0].field: only for kind = \"render\" or \"squeeze\""),
+    ({"outputs": [{"kind": "footprint"}]}, "outputs[0].u_mm: render, footprint, squeeze need u_mm"),
+    ({"outputs": [{"kind": "squeeze", "u_mm": 3, "frames": 1}]}, "outputs[0].frames: expected a whole number in [2, 60], got 1"),
+    ({"outputs": [{"kind": "squeeze", "u_mm": 3, "frames": 2.5}]}, "outputs[0].frames: expected a whole number in [2, 60]"),
+    ({"contact": {"law": "sticking", "friction": 0.3}, "outputs": [{"kind": "curve"}]},
+     "contact.friction: applies to law = \"coulomb\" only, got law = 'sticking'"),
+    ({"contact": {"law": "coulomb"}, "outputs": [{"kind": "curve"}]},
+     "contact.friction: law = \"coulomb\" needs friction = MU, in [0, 100]"),
+    ({"contact": {"law": "coulomb", "friction": 101}, "outputs": [{"kind": "curve"}]},
+     "contact.friction: Coulomb's friction coefficient must be in [0, 100], got 101"),
+    ({"contact": {"law": "coulomb", "friction": -0.1}, "outputs": [{"kind": "curve"}]},
+     "contact.friction: Coulomb's friction coefficient must be in [0, 100], got -0.1"),
+    ({"contact": {"law": "coulomb", "friction": 0.3}, "stiffness": {"source": "appendix-a"},
+      "outputs": [{"kind": "lifetimes"}]}, "contact.law: Coulomb friction is a FEM contact law"),
+    ({"sweep": {"key": "contact.friction", "values": [0.1]}, "outputs": [{"kind": "lifetimes"}]},
+     "sweep.key: contact.friction needs contact.law = \"coulomb\""),
+    ({"contact": {"law": "coulomb"}, "sweep": {"key": "contact.friction", "values": [0.1, 200]},
+      "outputs": [{"kind": "lifetimes"}]}, "sweep.values[1]: Coulomb's friction coefficient must be in [0, 100]"),
 ])
 def test_bad_scenes_are_refused_with_the_key_path(data, message):
     with pytest.raises(ValueError) as exc:
@@ -119,7 +139,7 @@ def test_a_swept_scene_is_the_same_model_as_the_command_line(tmp_path, capsys):
 
 def test_a_render_runs_the_fem_only_to_its_displacement_and_shows_the_contact(tmp_path):
     """The render at u = 3 mm: the FEM stops at 3 mm (no stiffness curve is computed), and the
-    image shows the cup (not blank) with the contact strip in the colour map's top (yellow)."""
+    image (seen from below through the substrate) shows the contact strip in the colour map's top (yellow)."""
     import numpy as np
     from matplotlib.image import imread
 
@@ -130,8 +150,8 @@ def test_a_render_runs_the_fem_only_to_its_displacement_and_shows_the_contact(tm
         pytest.skip(probe.message)
     pipeline.COMPUTED.clear()
     result = run_scene(ROOT / "scenes" / "render_cupA_3mm.toml", tmp_path / "out")
-    state = result.products["fem_state_3mm"]
-    assert state["u_m"] == pytest.approx(3e-3, rel=1e-12) and dict(pipeline.COMPUTED) == {"fem_state": 1}
+    state = result.products["fem_state_3mm"][-1]
+    assert state.u_m == pytest.approx(3e-3, rel=1e-12) and dict(pipeline.COMPUTED) == {"fem_state": 1}
     img = imread(tmp_path / "out" / "cupA_3mm.png")[..., :3]
     assert img.shape[:2] == (700, 900) and img.std() > 0.05
     # viridis' top, shaded by the lights: red and green well above blue (the plane is grey-blue,
@@ -139,3 +159,38 @@ def test_a_render_runs_the_fem_only_to_its_displacement_and_shows_the_contact(tm
     yellow = (img[..., 0] > 0.6) & (img[..., 1] > 0.55) & (img[..., 2] < 0.3)
     above_bar = yellow[:600]                   # the colour bar sits at the bottom of the window
     assert above_bar.sum() > 3                 # the contact strip, coloured by its peak pressure
+
+
+def test_a_coulomb_scene_is_the_command_lines_coulomb_curve(tmp_path, capsys):
+    """[contact] law = "coulomb", friction = 0.3: the scene's FEM curve is `cupcheck stiffness
+    --contact coulomb --friction 0.3` at the same level, to round-off."""
+    import pandas as pd
+
+    scene = {"contact": {"law": "coulomb", "friction": 0.3}, "loads": {"F1_N": [10]},
+             "outputs": [{"kind": "curve", "name": "c"}]}
+    run_scene(scene, tmp_path / "scene")
+    assert main(["stiffness", "--cup", "A", "--contact", "coulomb", "--friction", "0.3", "--fidelity", "coarse",
+                 "--out", str(tmp_path / "cli.csv")]) == 0
+    a, b = pd.read_csv(tmp_path / "scene" / "c.csv"), pd.read_csv(tmp_path / "cli.csv")
+    assert len(a) == len(b) and abs(a["F0_N"] - b["F0_N"]).max() <= 1e-9 * b["F0_N"].abs().max()
+
+
+@pytest.mark.parametrize("tty,quiet", [(True, False), (True, True), (False, False)])
+def test_the_progress_bar_shows_on_a_terminal_only(tmp_path, monkeypatch, capsys, tty, quiet):
+    """On a terminal a tqdm bar over the outputs names what runs (the product, the lifetimes k of n);
+    with --quiet or without a terminal stderr stays empty."""
+    import io
+
+    class Term(io.StringIO):
+        def isatty(self):
+            return tty
+
+    err = Term()
+    monkeypatch.setattr(sys, "stderr", err)
+    argv = ["run", str(ROOT / "scenes" / "appendix_a_lifetimes.toml"), "--out", str(tmp_path / "o"), "--no-cache"]
+    assert main(argv + (["--quiet"] if quiet else [])) == 0
+    text = err.getvalue()
+    if tty and not quiet:
+        assert "run" in text and "output" in text and "lifetime 2 of 2 done" in text
+    else:
+        assert text == ""

@@ -26,7 +26,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--cache-dir", type=Path, default=Path(".cupcheck-cache/scenes"), metavar="DIR",
                    help="where products are cached (default .cupcheck-cache/scenes)")
     p.add_argument("--no-cache", action="store_true", help="compute every product afresh, cache nothing")
-    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bar (there is none either when stderr is not a terminal)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -37,11 +38,28 @@ def run(args: argparse.Namespace) -> int:
     if args.out.exists() and not args.out.is_dir():
         raise ValueError(f"--out: '{args.out}' exists and is not a directory")
 
-    def progress(message: str) -> None:
-        if not args.quiet:
-            print(f"run: {message}", file=sys.stderr)
+    bar = None
+    if not args.quiet and sys.stderr.isatty():       # quiet when not on a terminal
+        import shutil
 
-    result = run_scene(scene, args.out, cache_dir=None if args.no_cache else args.cache_dir, progress=progress)
+        from tqdm import tqdm
+        size = shutil.get_terminal_size((100, 20))     # a terminal that reports 0 x 0 hides tqdm's bar
+        bar = tqdm(total=len(scene.outputs), desc="run", unit="output", file=sys.stderr, leave=False,
+                   ncols=size.columns or 100, nrows=size.lines or 20)
+
+    def progress(message: str) -> None:
+        """'output k of n: name' advances the bar; the rest (product, FEM u reached, force k of n) is its note."""
+        if message.startswith("output "):
+            bar.n = int(message.split()[1]) - 1
+            bar.set_description(f"run {message.split(': ', 1)[1]}")
+        bar.set_postfix_str(message if not message.startswith("output ") else "", refresh=True)
+
+    try:
+        result = run_scene(scene, args.out, cache_dir=None if args.no_cache else args.cache_dir,
+                           progress=progress if bar is not None else None)
+    finally:
+        if bar is not None:
+            bar.close()
     timing = ", ".join(f"{k} {v:.2f} s" for k, v in result.timings.items())
     print(f"run: wrote {len(result.files)} files and manifest.json to {args.out} ({timing or 'nothing computed'})")
     return 0

@@ -1,4 +1,4 @@
-"""The gallery of the shipped scenes: run each one, keep its first image, write scenes/README.md.
+"""The gallery of the shipped scenes: run each one, keep its GIF or first image, write scenes/README.md.
 
     python -m validation.scenes.gallery [--scenes scenes] [--no-cache]
 
@@ -24,7 +24,7 @@ def main() -> None:
     images = args.scenes / "gallery"
     images.mkdir(exist_ok=True)
     lines = ["# Scene gallery", "",
-             "Each shipped scene, its first image and the command that made it (regenerate this page with",
+             "Each shipped scene, its animation or first image and the command that made it (regenerate this page with",
              "`python -m validation.scenes.gallery`). Scene keys: `validation/scenes/schema.py`.", ""]
     for scene_path in sorted(args.scenes.glob("*.toml")):
         if scene_path.name.startswith("sweep_"):
@@ -33,11 +33,13 @@ def main() -> None:
         with tempfile.TemporaryDirectory() as tmp:
             cache = None if args.no_cache else Path(".cupcheck-cache/scenes")
             result = run_scene(scene, Path(tmp) / "out", cache_dir=cache)
-            png = next((Path(f["path"]) for f in result.files if f["path"].endswith(".png")), None)
+            paths = [Path(f["path"]) for f in result.files]
+            image = next((p for p in paths if p.suffix == ".gif"), None) or \
+                next((p for p in paths if p.suffix == ".png"), None)        # an animation first
             kept = None
-            if png is not None:
-                kept = images / f"{scene_path.stem}.png"
-                shutil.copyfile(png, kept)
+            if image is not None:
+                kept = images / f"{scene_path.stem}{image.suffix}"
+                shutil.copyfile(image, kept)
         head = []
         for ln in scene_path.read_text().splitlines():
             if not ln.startswith("#"):

@@ -42,11 +42,18 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
         scene = scene_from_mapping(scene) if isinstance(scene, dict) else load_scene(scene)
     products = Products(scene, cache_dir=cache_dir, progress=progress)
     t0 = time.perf_counter()
+    def each(tmp):
+        n = len(scene.outputs)
+        for k, o in enumerate(scene.outputs):
+            if progress is not None:
+                progress(f"output {k + 1} of {n}: {o['name']}")
+            yield from _write(o, products, tmp)
+
     if out is None:
-        files = [f for o in scene.outputs for f in _write(o, products, None)]
+        files = list(each(None))
         return SceneResult(scene, products.computed(), files, dict(products.timings))
     with atomic_directory(out) as tmp:
-        files = [f for o in scene.outputs for f in _write(o, products, Path(tmp))]
+        files = list(each(Path(tmp)))
         manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
                     "scene": scene.resolved(), "source": scene.source,
                     "versions": software_versions(), "timings_s": {**products.timings,
@@ -75,17 +82,12 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
         if kind == "lifetimes":
             return [_file(name, kind, _lifetime_table(results, products, tmp / f"{name}.csv"))]
         return [_file(name, kind, _trajectory(r, tmp / f"{name}_F1_{r.force_N:g}N.csv")) for r in results]
-    if kind == "render":
-        state = products.fem_state(output["u_mm"])
-        if tmp is None:
-            return []
-        from validation.render import render_cup
-        png = render_cup(state["r_m"], state["z_m"], tmp / f"{name}.png", scalar=state["p_Pa"] / 1e3,
-                         scalar_name="contact pressure (kPa)",
-                         title=f"u = {1e3 * state['u_m']:.3g} mm, {products.scene['contact']['law']}")
-        return [_file(name, kind, png)]
+    if kind in ("render", "footprint", "squeeze"):
+        from validation.scenes.views3d import write_view
+        return write_view(output, products, tmp)
     figure = {"lifetime_vs_force": _lifetime_figure, "uc_vs_pressure": _uc_figure, "F0_vs_u": _F0_figure,
-              "lifetime_vs_parameter": _parameter_figure}
+              "lifetime_vs_parameter": _parameter_figure, "r_pb_vs_time": _r_pb_figure,
+              "p_Ndot_vs_time": _p_Ndot_figure}
     fig = figure[output["figure"]](products)
     if tmp is None:
         import matplotlib.pyplot as plt
@@ -171,26 +173,71 @@ def _lifetime_figure(products: Products):
     return fig
 
 
+def _lines(products: Products) -> list[tuple[str, Products]]:
+    """(label, products) per line: one per swept value, or the scene itself."""
+    if products.scene.sweep is None:
+        return [("", products)]
+    return [(str(v), p) for v, p in products.variants()]
+
+
 def _uc_figure(products: Products):
     import numpy as np
-    table = products.uc_table()
     fig, ax = _axes("$p/E$", "$u_c$ (nm)")
     x = np.geomspace(1e-4, 0.1, 200)
-    u = np.array([table(v) for v in x])
-    ax.loglog(x[u > 0], 1e9 * u[u > 0])
-    ax.set_title(products.scene["surface"]["preset"] or "u_c table", fontsize=7)
+    for label, p in _lines(products):
+        table = p.uc_table()
+        u = np.array([table(v) for v in x])
+        ax.loglog(x[u > 0], 1e9 * u[u > 0], label=label or None)
+    if products.scene.sweep is not None:
+        ax.legend(fontsize=6)
+    else:
+        ax.set_title(products.scene["surface"]["preset"] or "u_c table", fontsize=7)
     return fig
 
 
 def _F0_figure(products: Products):
     from reduced.appendix_a import appendix_a_curve
     from reduced.cup import CUPS
-    curve = products.curve()
     fig, ax = _axes("plate displacement $u$ (mm)", "stiffness force $F_0$ (N)")
-    ax.plot(1e3 * curve.u_m, curve.F0_N, label=products.scene["stiffness"]["source"])
-    if curve.design is None or not products.scene["cup"]["geometry"]:
-        ref = appendix_a_curve(CUPS[products.scene["cup"]["preset"]])
-        keep = ref.u_m <= curve.u_m[-1]
-        ax.plot(1e3 * ref.u_m[keep], ref.F0_N[keep], "--", label="Appendix A")
+    for i, (label, p) in enumerate(_lines(products)):
+        curve, s = p.curve(), p.scene
+        name = f"cup {label}: " if label else ""
+        line, = ax.plot(1e3 * curve.u_m, curve.F0_N, label=f"{name}{s['stiffness']['source']}")
+        if curve.design is None or not s["cup"]["geometry"]:
+            ref = appendix_a_curve(CUPS[s["cup"]["preset"]])
+            keep = ref.u_m <= curve.u_m[-1]
+            ax.plot(1e3 * ref.u_m[keep], ref.F0_N[keep], "--", color=line.get_color(), label=f"{name}Appendix A")
     ax.legend(fontsize=6)
+    return fig
+
+
+def _time_figure(products: Products, top: tuple[str, str, float], bottom: tuple[str, str, float]):
+    """Two panels over time, one line per F1: (column, axis label, factor) each."""
+    import matplotlib.pyplot as plt
+    results = products.lifetimes()
+    fig, axes = plt.subplots(2, 1, figsize=(COLUMN_IN[0], 1.6 * COLUMN_IN[1]), sharex=True, constrained_layout=True)
+    water = products.scene["fluid"]["kind"] == "water"
+    for r in results:
+        cols = r.trajectory_columns()
+        t = cols["t_s"]
+        for ax, (col, label, factor) in zip(axes, (top, bottom)):
+            col = {"N_dot_per_s": "V_dot_mm3_per_s"}.get(col, col) if water else col
+            keep = t > 0
+            ax.plot(t[keep], factor * cols[col][keep], label=f"$F_1$ = {r.force_N:g} N")
+            ax.set_ylabel(label if not water or col == top[0] else "$\\dot V$ (mm$^3$/s)")
+    axes[0].set_xscale("log")
+    axes[1].set_xlabel("time $t$ (s)")
+    axes[0].legend(fontsize=5)
+    return fig
+
+
+def _r_pb_figure(products: Products):
+    return _time_figure(products, ("r_mm", "contact radius $r$ (mm)", 1.0),
+                        ("p_b_Pa", "cavity pressure $p_b$ (kPa)", 1e-3))
+
+
+def _p_Ndot_figure(products: Products):
+    fig = _time_figure(products, ("p_Pa", "contact pressure $p$ (kPa)", 1e-3),
+                       ("N_dot_per_s", "leak rate $\\dot N$ (1/s)", 1.0))
+    fig.axes[1].set_yscale("log")
     return fig

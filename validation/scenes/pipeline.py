@@ -52,45 +52,59 @@ def _uc_table(surface: dict, code: str):
     return uc_table(preset(surface["preset"]).spectrum(), 0.5)
 
 
-def _fem_curve(cup: dict, material: dict, contact: str, fidelity: str, code: str):
-    COMPUTED["fem_curve"] += 1
+def _compress(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float | None, progress=None):
+    """The FEM response of the scene's cup pressed to u_max_m (default 0.9 h1), and its geometry."""
     from fem.cup import compress_cup
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
-    from validation import handoff
 
     geometry = _geometry(cup)
-    response = compress_cup(cup_mesh(geometry, fidelity), NeoHookean(E_Pa=material["E_MPa"] * 1e6,
-                            nu=material["nu"], formulation="mixed" if material["nu"] > 0.495 else "displacement"),
-                            contact=contact, u_max_m=0.9 * geometry.h1_m)
+    if u_max_m is not None and not 0 < u_max_m <= geometry.h1_m:
+        raise ValueError(f"outputs: u_mm must be in (0, h1] = (0, {1e3 * geometry.h1_m:.4g}] mm, got {1e3 * u_max_m:g}")
+    law = contact["law"]
+    return geometry, compress_cup(
+        cup_mesh(geometry, fidelity), NeoHookean(E_Pa=material["E_MPa"] * 1e6, nu=material["nu"],
+                                                 formulation="mixed" if material["nu"] > 0.495 else "displacement"),
+        contact=law, friction=float(contact["friction"] or 0.0) if law == "coulomb" else 0.0,
+        u_max_m=0.9 * geometry.h1_m if u_max_m is None else u_max_m, progress=progress)
+
+
+def _fem_curve(cup: dict, material: dict, contact: dict, fidelity: str, code: str, progress=None):
+    COMPUTED["fem_curve"] += 1
+    from validation import handoff
+
+    geometry, response = _compress(cup, material, contact, fidelity, None, progress)
     prov = handoff.provenance(response, geometry=geometry.describe(), mesh={"fidelity": fidelity},
                               fidelity=fidelity)
     return handoff.stiffness_curve(response, prov)
 
 
-def _fem_state(cup: dict, material: dict, contact: str, fidelity: str, u_mm: float, code: str) -> dict:
-    """The deformed cross-section at the plate displacement u (the FEM run only that far)."""
+def _fem_frames(cup: dict, material: dict, contact: dict, fidelity: str, u_mm: float, n_frames: int,
+                code: str, progress=None) -> list:
+    """The deformed states (`validation.render.frames.CupFrame`, every field) at n_frames plate
+    displacements evenly spaced up to u_mm (1 frame: u_mm itself; more: from 0, each the converged
+    step nearest its target): the FEM runs only to u_mm."""
     COMPUTED["fem_state"] += 1
-    from fem.cup import compress_cup
-    from fem.material import NeoHookean
-    from fem.mesh import cup_mesh
-    from validation.crosscheck.runs import deformed_outline
+    import numpy as np
 
-    geometry = _geometry(cup)
-    if not 0 < u_mm * 1e-3 <= geometry.h1_m:
-        raise ValueError(f"outputs: render u_mm must be in (0, h1] = (0, {1e3 * geometry.h1_m:.4g}] mm, got {u_mm:g}")
-    response = compress_cup(cup_mesh(geometry, fidelity), NeoHookean(E_Pa=material["E_MPa"] * 1e6,
-                            nu=material["nu"], formulation="mixed" if material["nu"] > 0.495 else "displacement"),
-                            contact=contact, u_max_m=u_mm * 1e-3)
-    r, z, p = deformed_outline(response)
-    return {"u_m": float(response.u_m[-1]), "r_m": r, "z_m": z, "p_Pa": p}
+    from validation.render.frames import frame_from_response
+
+    _, response = _compress(cup, material, contact, fidelity, u_mm * 1e-3, progress)
+    targets = [u_mm * 1e-3] if n_frames == 1 else np.linspace(0.0, u_mm * 1e-3, n_frames)
+    steps = [int(np.argmin(np.abs(response.u_m - t))) for t in targets]
+    return [frame_from_response(response, k) for k in steps]
 
 
-def _lifetimes(tables: dict, curve, uc, code: str):
+def _lifetimes(tables: dict, curve, uc, code: str, progress=None):
     COMPUTED["lifetimes"] += 1
     from reduced.lifetime import lifetime_sweep
     model = _model(tables, curve, uc)
-    return lifetime_sweep(model, tables["loads"]["F1_N"], refine=2)
+    forces = tables["loads"]["F1_N"]
+
+    def each(fraction: float, message: str) -> None:
+        if progress is not None:
+            progress(f"lifetime {round(fraction * len(forces))} of {len(forces)} done ({message})")
+    return lifetime_sweep(model, forces, refine=2, progress=each)
 
 
 def _geometry(cup: dict):
@@ -136,8 +150,11 @@ class Products:
             from joblib import Memory
             self._memory = Memory(str(cache_dir), verbose=0)
 
-    def _cached(self, func):
-        return self._memory.cache(func) if self._memory is not None else func
+    def _cached(self, func, ignore: list[str] | None = None):
+        return self._memory.cache(func, ignore=ignore) if self._memory is not None else func
+
+    def _fem_progress(self, fraction: float, message: str) -> None:
+        self._progress(f"FEM {message.split(': ', 1)[-1].split(',')[0]}")     # FEM u = .. mm of .. mm
 
     def _get(self, name: str, compute):
         if name not in self._done:
@@ -155,8 +172,9 @@ class Products:
         s = self.scene
         if s["stiffness"]["source"] == "appendix-a":
             return self._get("curve", self._appendix_a)
-        return self._get("curve", lambda: self._cached(_fem_curve)(
-            s["cup"], s["material"], s["contact"]["law"], s["stiffness"]["fidelity"], package_version("fem")))
+        return self._get("curve", lambda: self._cached(_fem_curve, ignore=["progress"])(
+            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], package_version("fem"),
+            progress=self._fem_progress))
 
     def _appendix_a(self):
         from reduced.appendix_a import appendix_a_curve
@@ -164,15 +182,18 @@ class Products:
         return appendix_a_curve(CUPS[self.scene["cup"]["preset"]], E_Pa=self.scene["material"]["E_MPa"] * 1e6,
                                 d0_m=2e-3)
 
-    def fem_state(self, u_mm: float) -> dict:
+    def fem_frames(self, u_mm: float, n_frames: int = 1) -> list:
+        """The deformed states at n_frames plate displacements up to u_mm (`_fem_frames`)."""
         s = self.scene
-        return self._get(f"fem_state_{u_mm:g}mm", lambda: self._cached(_fem_state)(
-            s["cup"], s["material"], s["contact"]["law"], s["stiffness"]["fidelity"], u_mm, package_version("fem")))
+        name = f"fem_state_{u_mm:g}mm" + (f"_{n_frames}frames" if n_frames > 1 else "")
+        return self._get(name, lambda: self._cached(_fem_frames, ignore=["progress"])(
+            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_mm, n_frames,
+            package_version("fem") + package_version("validation"), progress=self._fem_progress))
 
     def lifetimes(self):
-        return self._get("lifetimes", lambda: self._cached(_lifetimes)(
+        return self._get("lifetimes", lambda: self._cached(_lifetimes, ignore=["progress"])(
             self.scene.tables, self.curve(), self.uc_table(),
-            package_version("reduced") + package_version("validation")))
+            package_version("reduced") + package_version("validation"), progress=self._progress))
 
     def variants(self) -> list[tuple[Any, "Products"]]:
         """For a swept scene: (value, the products of the scene with that value), sharing the cache."""

@@ -2,19 +2,28 @@
 
     [cup]            preset = "A" | geometry = "my_cup.toml"        (one of them)
     [material]       E_MPa = 4.0, nu = 0.49, relaxation = "none" | "default"
-    [contact]        law = "frictionless" | "sticking"
+    [contact]        law = "frictionless" | "sticking" | "coulomb", friction = MU (Coulomb's mu in
+                     [0, 100], with law = "coulomb" only, which needs it)
     [surface]        preset = "pmma-1.89" | uc_table = "uc.csv"     (one of them)
     [fluid]          kind = "air" | "water"
     [loads]          F1_N = [5, 10, 20], r_start_mm = 12 (optional), kappa = 1.0
     [stiffness]      source = "fem" | "appendix-a", route = "paper" | "profile",
                      fidelity = "coarse" | "medium" | "fine"
-    [sweep]          key = "loads.kappa" | "loads.r_start_mm" | "surface.preset" | "cup.preset",
+    [sweep]          key = "loads.kappa" | "loads.r_start_mm" | "surface.preset" | "cup.preset"
+                     | "contact.friction" (with law = "coulomb"),
                      values = [...]                  (optional: one parameter varied for a figure)
     [[outputs]]      kind = "curve" | "lifetimes" | "trajectories" | "figure"
                      name = "..." (file stem), figure = "lifetime_vs_force" | "uc_vs_pressure" | "F0_vs_u"
-                     | "lifetime_vs_parameter" (needs [sweep]: one line per F1)
-                     kind = "render" with u_mm = 3: the revolved deformed FEM cup at u, coloured by
-                     the contact pressure (pyvista off-screen; the FEM runs only to u)
+                     | "lifetime_vs_parameter" (needs [sweep]: one line per F1) | "r_pb_vs_time" (r(t),
+                     p_b(t)) | "p_Ndot_vs_time" (p(t), Ndot(t)): one line per F1; uc_vs_pressure and F0_vs_u
+                     with a [sweep] of surface.preset or cup.preset draw one line per value
+                     kind = "render" with u_mm = 3: the revolved deformed FEM cup at u, cut open and
+                     coloured by field = "contact_pressure" (default) | "von_mises" | "min_stretch"
+                     (pyvista off-screen; the FEM runs only to u)
+                     kind = "footprint" with u_mm: the contact seen from below through the substrate
+                     (the sealing annulus), at a fixed scale (the pixel size in the manifest)
+                     kind = "squeeze" with u_mm (the last frame) and frames = N (2 .. 60), field:
+                     N frames from u = 0 to u_mm (PNG) and their animated GIF
 
 Every table and key is optional but `outputs`; defaults are the main job's (cup A, frictionless
 FEM at the coarse level, the paper's route, pmma-1.89, air, F1 = 5 ... 80 N). Unknown keys, wrong
@@ -34,20 +43,26 @@ from typing import Any
 
 __all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES"]
 
-OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure", "render")
-FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parameter")
-SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset")
+OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure", "render", "footprint", "squeeze")
+#: the output kinds drawn from FEM states at given plate displacements (they need u_mm)
+STATE_KINDS = ("render", "footprint", "squeeze")
+FIELDS = ("contact_pressure", "von_mises", "min_stretch")
+MAX_FRAMES = 60
+FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parameter", "r_pb_vs_time",
+           "p_Ndot_vs_time")
+SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset", "contact.friction")
+MAX_FRICTION = 100.0
 _TABLES: dict[str, dict[str, Any]] = {
     "cup": {"preset": "A", "geometry": None},
     "material": {"E_MPa": 4.0, "nu": 0.49, "relaxation": "none"},
-    "contact": {"law": "frictionless"},
+    "contact": {"law": "frictionless", "friction": None},
     "surface": {"preset": "pmma-1.89", "uc_table": None},
     "fluid": {"kind": "air"},
     "loads": {"F1_N": [5.0, 10.0, 20.0, 40.0, 80.0], "r_start_mm": None, "kappa": 1.0},
     "stiffness": {"source": "fem", "route": "paper", "fidelity": "coarse"},
 }
 _CHOICES = {("cup", "preset"): ("A", "B"), ("material", "relaxation"): ("none", "default"),
-            ("contact", "law"): ("frictionless", "sticking"), ("fluid", "kind"): ("air", "water"),
+            ("contact", "law"): ("frictionless", "sticking", "coulomb"), ("fluid", "kind"): ("air", "water"),
             ("stiffness", "source"): ("fem", "appendix-a"), ("stiffness", "route"): ("paper", "profile"),
             ("stiffness", "fidelity"): ("coarse", "medium", "fine")}
 
@@ -101,20 +116,21 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
         raise ValueError(f"{unknown[0]}: unknown table; allowed: {', '.join([*_TABLES, 'sweep', 'outputs'])}")
     tables = {name: _table(name, data.get(name, {}), defaults) for name, defaults in _TABLES.items()}
     _paths(tables, Path(base))
-    _cross_checks(tables)
+    _cross_checks(tables, data.get("sweep"))
     outputs = data.get("outputs")
     if not isinstance(outputs, list) or not outputs:
         raise ValueError("outputs: a scene needs a non-empty list of [[outputs]]")
     parsed = tuple(_output(o, i) for i, o in enumerate(outputs))
-    files = [(o["name"], o["kind"] in ("figure", "render")) for o in parsed]   # tables .csv, images .png
+    files = [(o["name"], o["kind"] in ("figure", *STATE_KINDS)) for o in parsed]   # tables .csv, images .png
     if len(set(files)) != len(files):
         twice = next(n for n, f in files if files.count((n, f)) > 1)
         raise ValueError(f"outputs: two outputs would write the same file '{twice}'; give one a name")
     sweep = _sweep(data["sweep"], tables) if "sweep" in data else None
     if sweep is None and any(o["figure"] == "lifetime_vs_parameter" for o in parsed):
         raise ValueError("outputs: the figure lifetime_vs_parameter needs a [sweep] table")
-    if sweep is not None and any(o["kind"] in ("curve", "trajectories") for o in parsed):
-        raise ValueError("sweep: a swept scene writes lifetimes and figures; drop the curve and trajectories outputs")
+    if sweep is not None and any(o["kind"] in ("curve", "trajectories", *STATE_KINDS)
+                                 or o["figure"] in ("r_pb_vs_time", "p_Ndot_vs_time") for o in parsed):
+        raise ValueError("sweep: a swept scene writes lifetimes and figures; drop the curve, trajectories and 3D outputs")
     return Scene(tables=tables, outputs=parsed, source=source, sweep=sweep)
 
 
@@ -137,8 +153,12 @@ def _sweep(table: Any, tables: dict[str, dict[str, Any]]) -> dict[str, Any]:
     elif field == "preset":
         if not all(isinstance(v, str) for v in values):
             raise ValueError("sweep.values: expected surface preset names")
-    else:
+    elif key != "contact.friction":
         values = [_number(v, f"sweep.values[{i}]", positive=True) for i, v in enumerate(values)]
+    if key == "contact.friction":
+        if tables["contact"]["law"] != "coulomb":
+            raise ValueError("sweep.key: contact.friction needs contact.law = \"coulomb\"")
+        values = [_friction(v, f"sweep.values[{i}]") for i, v in enumerate(values)]
     if key == "cup.preset" and tables["cup"]["geometry"]:
         raise ValueError("sweep.key: cup.preset cannot be swept with a design file (cup.geometry)")
     return {"key": key, "values": values}
@@ -178,7 +198,24 @@ def _paths(tables: dict[str, dict[str, Any]], base: Path) -> None:
         tables[name][key] = str(path)
 
 
-def _cross_checks(tables: dict[str, dict[str, Any]]) -> None:
+def _friction(value: Any, where: str) -> float:
+    value = _number(value, where, positive=False)
+    if not 0.0 <= value <= MAX_FRICTION:
+        raise ValueError(f"{where}: Coulomb's friction coefficient must be in [0, {MAX_FRICTION:g}], got {value:g}")
+    return value
+
+
+def _cross_checks(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
+    contact = tables["contact"]
+    swept = isinstance(sweep, Mapping) and sweep.get("key") == "contact.friction"
+    if contact["friction"] is not None:
+        if contact["law"] != "coulomb":
+            raise ValueError(f"contact.friction: applies to law = \"coulomb\" only, got law = {contact['law']!r}")
+        contact["friction"] = _friction(contact["friction"], "contact.friction")
+    elif contact["law"] == "coulomb" and not swept:
+        raise ValueError(f"contact.friction: law = \"coulomb\" needs friction = MU, in [0, {MAX_FRICTION:g}]")
+    if contact["law"] == "coulomb" and tables["stiffness"]["source"] != "fem":
+        raise ValueError("contact.law: Coulomb friction is a FEM contact law; it needs stiffness.source = \"fem\"")
     if tables["cup"]["geometry"] is not None and tables["stiffness"]["source"] != "fem":
         raise ValueError("stiffness.source: a design file (cup.geometry) needs source = \"fem\"; Appendix A "
                          "is for the Table 1 presets")
@@ -194,9 +231,10 @@ def _output(output: Any, i: int) -> dict[str, Any]:
     where = f"outputs[{i}]"
     if not isinstance(output, Mapping):
         raise ValueError(f"{where}: expected a table")
-    unknown = sorted(set(output) - {"kind", "name", "figure", "u_mm"})
+    allowed = ("kind", "name", "figure", "u_mm", "field", "frames")
+    unknown = sorted(set(output) - set(allowed))
     if unknown:
-        raise ValueError(f"{where}.{unknown[0]}: unknown key; allowed: kind, name, figure, u_mm")
+        raise ValueError(f"{where}.{unknown[0]}: unknown key; allowed: {', '.join(allowed)}")
     kind = output.get("kind")
     if kind not in OUTPUT_KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(OUTPUT_KINDS)}, got {kind!r}")
@@ -206,14 +244,29 @@ def _output(output: Any, i: int) -> dict[str, Any]:
     if kind != "figure" and figure is not None:
         raise ValueError(f"{where}.figure: only for kind = \"figure\"")
     u_mm = output.get("u_mm")
-    if (kind == "render") != (u_mm is not None):
-        raise ValueError(f"{where}.u_mm: a render needs u_mm (the plate displacement shown), and only a render")
+    if (kind in STATE_KINDS) != (u_mm is not None):
+        raise ValueError(f"{where}.u_mm: {', '.join(STATE_KINDS)} need u_mm (the plate displacement shown), "
+                         "and only they")
     if u_mm is not None:
         u_mm = _number(u_mm, f"{where}.u_mm", positive=True)
+    field = output.get("field")
+    if field is not None and kind not in ("render", "squeeze"):
+        raise ValueError(f"{where}.field: only for kind = \"render\" or \"squeeze\"")
+    if kind in ("render", "squeeze"):
+        field = "contact_pressure" if field is None else field
+        if field not in FIELDS:
+            raise ValueError(f"{where}.field: expected one of {', '.join(FIELDS)}, got {field!r}")
+    frames = output.get("frames")
+    if frames is not None and kind != "squeeze":
+        raise ValueError(f"{where}.frames: only for kind = \"squeeze\"")
+    if kind == "squeeze":
+        frames = 8 if frames is None else frames
+        if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= MAX_FRAMES:
+            raise ValueError(f"{where}.frames: expected a whole number in [2, {MAX_FRAMES}], got {frames!r}")
     name = output.get("name", figure if kind == "figure" else kind)
     if not isinstance(name, str) or not name or "/" in name or name.startswith("."):
         raise ValueError(f"{where}.name: expected a plain file stem, got {name!r}")
-    return {"kind": kind, "name": name, "figure": figure, "u_mm": u_mm}
+    return {"kind": kind, "name": name, "figure": figure, "u_mm": u_mm, "field": field, "frames": frames}
 
 
 def _number(value: Any, where: str, positive: bool) -> float:

@@ -1,5 +1,11 @@
 """Headless 3D scenes of the axisymmetric cup (pyvista, off-screen through EGL).
 
+- this module: the child-process GL probe, `revolve_cross_section` and `render_cup` (an outline);
+- `frames`: a deformed state as plain data (`CupFrame`: positions, cells, nodal fields recovered
+  by `fem.recovery`, contact zones), from a FEM response or a ``--fields-out`` file;
+- `views`: the cut-away coloured by a chosen field, the footprint from below at a fixed scale,
+  the squeeze sequence (frames and an animated GIF).
+
 A missing OpenGL stack does not raise in VTK: it aborts the whole process. So before the first render
 window of a process, `require_offscreen_rendering` runs a tiny render in a *child* process. If that
 fails, it raises a `RuntimeError` that names the Debian packages to install, instead of crashing.

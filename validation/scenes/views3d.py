@@ -1,0 +1,49 @@
+"""The scene outputs drawn in 3D from FEM states: render (cut-away), footprint, squeeze.
+
+Each pulls only the deformed states it shows (`Products.fem_frames`: the FEM run only to the
+largest u asked for) and draws them with `validation.render.views`. The footprint's scale (metres
+per pixel, the axis pixel and the contact zones drawn) goes into a JSON file beside the image, so
+the image can be measured.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from validation.scenes.pipeline import Products
+
+__all__ = ["write_view"]
+
+
+def write_view(output: dict, products: Products, tmp: Path | None) -> list[dict[str, str]]:
+    """Compute the states of a render, footprint or squeeze output and (with `tmp`) draw them."""
+    kind, name, u_mm = output["kind"], output["name"], output["u_mm"]
+    frames = products.fem_frames(u_mm, output["frames"] if kind == "squeeze" else 1)
+    if tmp is None:
+        return []
+    from validation.render import views
+
+    scene = products.scene
+    law = scene["contact"]["law"] + (f", mu = {scene['contact']['friction']:g}" if scene["contact"]["law"] == "coulomb"
+                                     else "")
+    files = []
+    if kind == "render":
+        png = views.cutaway(frames[-1], output["field"], tmp / f"{name}.png",
+                            title=f"u = {1e3 * frames[-1].u_m:.3g} mm, {law}")
+        files.append(_file(name, kind, png))
+    elif kind == "footprint":
+        image = views.footprint(frames[-1], tmp / f"{name}.png",
+                                title=f"from below, u = {1e3 * frames[-1].u_m:.3g} mm, {law}")
+        scale = tmp / f"{name}.json"
+        scale.write_text(json.dumps({"m_per_px": image.m_per_px, "centre_px": image.centre_px,
+                                     "contact_zones_m": image.zones_m, "u_m": frames[-1].u_m}, indent=1) + "\n")
+        files += [_file(name, kind, image.path), _file(name, kind, scale)]
+    else:
+        seq = views.squeeze(frames, output["field"], tmp / name)
+        files += [_file(name, kind, p) for p in seq.frames] + [_file(name, kind, seq.gif)]
+    return files
+
+
+def _file(name: str, kind: str, path: Path) -> dict[str, str]:
+    return {"name": name, "kind": kind, "path": str(path)}
