@@ -36,7 +36,7 @@ FIDELITY = "medium"               # the default level of `cupcheck stiffness`
 QUICK_FIDELITY = "coarse"
 PAPER_DRY_N_PER_MM = 2.5          # Appendix A's worked example, the paper's dry measurement
 U_SMALL_M = 1e-3
-SAMPLE_U_MM = (1.0, 3.0, 5.0, 7.0)
+SAMPLE_U_OVER_H1 = (0.3, 0.5, 0.7, 0.9)   # F0 sampled there and at u = 1 mm
 MU_REL_TOL, QUICK_MU_REL_TOL = 5e-3, 0.25
 JUMP = 0.05                       # a jump of k inside the final bracket, relative to 2.5 N/mm
 FORCES_N = (5.0, 10.0, 20.0, 40.0, 60.0, 80.0)
@@ -116,7 +116,7 @@ def run(ctx: Context) -> None:
 
 def _curve_table(ctx: Context, curves, free, fid: str) -> None:
     rows, summary = [], {}
-    blank = [math.nan] * (len(SAMPLE_U_MM) + 2)
+    blank = [math.nan] * (len(SAMPLE_U_OVER_H1) + 3)
     for cup, by_mu in curves.items():
         ok = {m: r for m, r in by_mu.items() if not isinstance(r, Exception)}
         stick = ok.get(None)
@@ -125,20 +125,26 @@ def _curve_table(ctx: Context, curves, free, fid: str) -> None:
                 rows.append([cup, _mu_text(m), "failed", math.nan, math.nan, 0, *blank,
                              str(r).splitlines()[0][:200]])
                 continue
-            F = [_at(r, u * 1e-3) for u in SAMPLE_U_MM]
+            F = [_at(r, u) for u in _samples(r.h1_m)]
             excess = 0.0 if r.cone_excess is None else float(np.max(r.cone_excess))
             ratio = r.wall_s / stick.wall_s if stick is not None else math.nan
             rows.append([cup, _mu_text(m), "converged", r.wall_s, ratio, r.newton_iterations, *F,
-                         F[0] / SAMPLE_U_MM[0], excess, f"u_end {1e3 * r.u_m[-1]:.3g} mm"])
-            summary.setdefault(cup, {})[_mu_text(m)] = F[0] / SAMPLE_U_MM[0]
+                         F[0] / (1e3 * U_SMALL_M), excess, f"u_end {1e3 * r.u_m[-1]:.3g} mm"])
+            summary.setdefault(cup, {})[_mu_text(m)] = F[0] / (1e3 * U_SMALL_M)
         rows += _limit_checks(cup, ok, free[cup], blank)
     cols = ["cup", "mu", "outcome", "wall_s", "time_over_sticking", "newton_iterations"] + \
-           [f"F0_{u:g}mm_N" for u in SAMPLE_U_MM] + ["F0_1mm_over_1mm_N_per_mm", "max_cone_excess", "note"]
+           ["F0_1mm_N"] + [f"F0_{x:g}h1_N" for x in SAMPLE_U_OVER_H1] + \
+           ["F0_1mm_over_1mm_N_per_mm", "max_cone_excess", "note"]
     ctx.report.table(NAME, "friction_F0_by_mu", cols, rows,
                      f"F0(u) by Coulomb's mu ({fid} mesh, to 0.9 h1; time_over_sticking: wall time / the "
                      f"sticking run's, one run each on a shared machine; max_cone_excess: the largest "
                      f"tangential reaction of a stuck node beyond mu lambda, / max lambda)")
     ctx.report.summary["friction_small_u_stiffness_N_per_mm"] = summary
+
+
+def _samples(h1_m: float) -> list[float]:
+    """The sampled plate displacements [m]: 1 mm, then SAMPLE_U_OVER_H1 of h1."""
+    return [U_SMALL_M] + [x * h1_m for x in SAMPLE_U_OVER_H1]
 
 
 def _at(res: FemResult, u_m: float) -> float:
@@ -149,7 +155,7 @@ def _limit_checks(cup: str, ok: dict, free, blank: list) -> list[list]:
     """Rows saying how mu = 0 compares with frictionless and the largest mu with sticking, and
     where F0 at the sampled u is not monotone in mu (information, not a pass/fail)."""
     rows = []
-    us = np.array(SAMPLE_U_MM) * 1e-3
+    us = _samples(next(iter(ok.values())).h1_m) if ok else []
     if 0.0 in ok and not isinstance(free, Exception):
         dev = max(abs(_at(ok[0.0], u) / _at(free, u) - 1) for u in us)
         rows.append([cup, "0 vs frictionless", "check", math.nan, math.nan, 0, *blank,
@@ -160,10 +166,10 @@ def _limit_checks(cup: str, ok: dict, free, blank: list) -> list[list]:
     for u in us:
         seq = [_at(ok[m], u) for m in finite] + ([_at(ok[None], u)] if None in ok else [])
         if any(b < a for a, b in zip(seq, seq[1:])):
-            bad.append(f"{1e3 * u:g}")
+            bad.append(f"{1e3 * u:.3g}")
     rows.append([cup, "monotone in mu", "check", math.nan, math.nan, 0, *blank,
                  "F0 nondecreasing in mu (then sticking) at every sampled u" if not bad else
-                 f"F0 not monotone in mu at u = {', '.join(bad)} mm (path dependence)"])
+                 f"F0 not monotone in mu (then sticking) at u = {', '.join(bad)} mm (path dependence)"])
     return rows
 
 
