@@ -14,7 +14,10 @@ state. h1 is the height of the lowest top-plate node.
 
 Loading (Sec. 5.3): the plate moves down by u (displacement control), h = h1 - u; the top-plate
 nodes follow it rigidly (u_r = 0, u_z = -u). Every boundary node except those on the plate may
-touch the plane (`fem.contact`); the contact zones are whatever the solution makes them.
+touch the plane (`fem.contact`); the contact zones are whatever the solution makes them. A
+converged state in which a facet dips below the plane between its nodes, beyond 5 % of the rim's
+thickness, or in which the wall's outline crosses itself (a fold: no self-contact is modelled)
+ends the path with `fem.integrity.StateRejected` saying where and why (`fem.integrity`).
 
 The pressure profile p(r) (`fem.contact.PressureProfile`) holds the lumped nodal pressure of the
 nodes in contact, sorted by deformed radius, and the consistent L2 projection at the boundary
@@ -68,6 +71,7 @@ from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
 from .postprocess import (BIOT_STRETCH, enclosed_volume, half_maximum_width, inner_contact_radius,
                           median_force_width, quartile_width, smallest_stretch, weighted_width)
 from .forms import Mechanics
+from .integrity import check_state
 from .kinematics import Kinematics
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
@@ -136,13 +140,16 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
                  contact: Literal["frictionless", "sticking", "coulomb"] = "frictionless",
                  u_max_m: float | None = None, friction: float = 0.0,
                  progress: Callable[[float, str], None] | None = None,
-                 **solver_opts: Any) -> CupResponse:
+                 admissible_only: bool = True, **solver_opts: Any) -> CupResponse:
     """Press the cup from u = 0 to u_max_m (default 0.9 h1, at most h1: there the plate's edge
     reaches the plane; the steep rise of F0 where the wall is squeezed flat lies just below it)
     and return its `CupResponse`.
 
     contact: the law at the plane (`fem.contact`): frictionless, sticking, or coulomb with
     Coulomb's coefficient `friction` (mu >= 0).
+    admissible_only: end the path with `fem.integrity.StateRejected` at the first converged state
+    that violates contact between the nodes or crosses itself (module docstring); False follows
+    the solver's path regardless (for studies of the solver itself).
     solver_opts: fields of `fem.solver.SolverOptions` (rtol, etol, max_iterations, initial_step,
     max_step, min_step, growth). Raises ValueError for bad input, `fem.solver.ConvergenceError`
     (a RuntimeError) if a step cannot be converged.
@@ -177,6 +184,9 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     steps: list[_StepOutputs] = []
 
     def on_step(s: StepResult) -> None:
+        # a converged state that violates contact (between the nodes, or self-contact) ends the path
+        if admissible_only:
+            check_state(mesh, s.u, s.t, len(steps), steps[-1].u_m if steps else 0.0)
         steps.append(_measure(s, mech, plane, top, path))
         if progress and s.t > 0.0:
             progress(s.t / u_max, f"step {len(steps) - 1}: u = {s.t * 1e3:.4g} mm of {u_max * 1e3:.4g} mm, "

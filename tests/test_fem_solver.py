@@ -120,8 +120,11 @@ def _thin_steep_cone(**solver_opts):
     thickness = LinearThickness(5e-3, k * PRESETS["A"]["d_inner_mm"] * 1e-3,
                                 20e-3, k * PRESETS["A"]["d_outer_mm"] * 1e-3)
     geometry = cup_geometry("A", alpha_deg=60.0, thickness=thickness)
+    # the solver's path regardless of admissibility: from u = 3.08 mm the contact edge lies inside
+    # a facet that dips 0.053 rim thicknesses below the plane, which `fem.integrity` refuses by
+    # default (beyond 0.05; tests/test_fem_integrity.py); these tests are about the solver
     return geometry, compress_cup(cup_mesh(geometry, "coarse"), NeoHookean(), "frictionless",
-                                  u_max_m=0.9 * geometry.h1_m, **solver_opts)
+                                  u_max_m=0.9 * geometry.h1_m, admissible_only=False, **solver_opts)
 
 
 @pytest.fixture(scope="module")

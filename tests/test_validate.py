@@ -105,6 +105,25 @@ def test_quick_report_numbers(quick_report):
     assert "E scaling" in outcomes and outcomes.count(",pass") >= 5
 
 
+def test_quick_report_friction(quick_report):
+    """The friction section on the coarse mesh: tables, figures, summary; k(mu) rises from the
+    frictionless slope at mu = 0 to the sticking slope beyond the bracket of 2.5 N/mm."""
+    names = {p.name for p in quick_report.iterdir()}
+    for stem in ("friction_F0_by_mu", "friction_small_u_stiffness", "friction_geometry", "friction_lifetimes"):
+        assert f"{stem}.csv" in names
+    for png in ("friction_F0_by_mu.png", "friction_geometry.png"):
+        assert (quick_report / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    s = json.loads((quick_report / "summary.json").read_text())
+    m = s["friction_matching_mu"]
+    assert m["lo"] < m["hi"] and m["k_lo"] < 2.5 <= m["k_hi"]
+    k = s["friction_small_u_stiffness_N_per_mm"]["A"]
+    # mu = 0 is the frictionless slope, and no friction is stiffer than sticking (to the PCHIP's error)
+    assert k["0"] == pytest.approx(s["fem_slope_frictionless_N_per_mm"], rel=1e-2)
+    assert k["0"] < k["1.5"] <= k["inf (sticking)"] * (1 + 1e-2)
+    assert k["inf (sticking)"] == pytest.approx(s["fem_slope_sticking_N_per_mm"], rel=1e-9)
+    assert {"mu_0_cone_s", "sticking_cone_s"} <= set(s["friction_lifetime_s"])
+
+
 # --------------------------------------------------------------------------- scaling
 def test_force_over_modulus_is_independent_of_E():
     """F0 is proportional to E: the neo-Hookean law has no other stress scale (nu fixed), so with
@@ -173,7 +192,7 @@ def test_energy_check_halves_the_step_for_a_quadrature_error_but_not_for_a_defec
     assert value <= tol and text.count("->") == 2
     bad = _QuadraticForce(defect=1.05)            # W off by 5 %: halving the step cannot fix it
     (value, tol), _ = _energy_with_step_halving(bad, req, fem_checks(bad.outcome(req), 3e-4)["energy"])
-    assert value > tol and bad.steps[1:] == [0.05, 0.025]
+    assert value > tol and bad.steps[1:] == [0.05, 0.025, 0.0125]      # three halvings, then judged
 
 
 def _snapping(sign):

@@ -16,6 +16,8 @@ def solver_failure(exc: Exception, log_path: Path) -> RuntimeError:
               "cause": getattr(exc, "cause", ""), "residual_history": history}
     log_path.parent.mkdir(parents=True, exist_ok=True)
     log_path.write_text(json.dumps(record, indent=1) + "\n")
+    if not history:      # a converged state refused (fem.integrity.StateRejected): where and why
+        return RuntimeError(f"stopped {exc}; the record is in {log_path}")
     last = f"{history[-1]:.2e}" if history else "n/a"
     return RuntimeError(f"load step {record['step']} from u = {record['u_from_mm']:.4g} to "
                         f"{record['u_to_mm']:.4g} mm did not converge (residual {last} after "

@@ -3,7 +3,14 @@
 FEM cases (cup A's r0, r1 and taper, frictionless, pressed to full flattening u = h1 unless the solver
 stops first): the grid alpha x root thickness at nu = 0.49, E = 4 MPa; the nu axis (0.3, 0.49 and
 0.4999, the last with the mixed u-p formulation, which does not lock) and the E axis (10 kPa, 4 MPa,
-100 MPa) on cup A. Checks per FEM case, each with its tolerance:
+100 MPa) on cup A; Coulomb friction mu = 0.5 on the grid's four corners (alpha 5 and 70 deg, root
+0.1 and 5 mm); the mixed formulation at nu = 0.4999 on the grid's thin walls (root 0.1 and 0.5 mm).
+The FEM refuses a converged state that violates the contact conditions (`fem.integrity`): a
+boundary facet dipping below the plane between its nodes by more than 5 % of the rim thickness
+(node-based contact holds the nodes; where the contact edge falls inside a facet whose wall leaves
+the plane steeply, the facet dips), or the wall's outline crossing itself (a fold: no
+self-contact is modelled). The path ends there with the cause, the u and the place: a "failed
+fast" row. Checks per FEM case that runs to the end, each with its tolerance:
 
 * energy: the work int F0 du (trapezoid over the load steps) equals the stored energy W(u) where
   W > 1 % of its final value, to 2 %, summed over the stable steps (frictionless contact does no
@@ -12,11 +19,16 @@ stops first): the grid alpha x root thickness at nu = 0.49, E = 4 MPa; the nu ax
   of the final W, and the details give what the snaps dissipated; the budget is the
   trapezoid's O(du^2) error at load steps of <= 1 % of u_max, 5 % in --quick, which the steep end
   u -> h1 and a kink of F0, where the wall lands flat, make largest); if it is exceeded the case is
-  rerun with the load step halved, up to twice, and judged on the finest run: a quadrature error
+  rerun with the load step halved, up to three times, and judged on the finest run: a quadrature error
   drops ~4x per halving, a real energy defect does not (the table shows the sequence);
 * reaction: the plate reaction equals the integrated contact pressure, to 1e-4 of max F0 (equilibrium;
   the Newton tolerance is 1e-6 of the reaction);
-* penetration: the largest violation of z >= 0 is below 5 % of the rim thickness;
+* penetration: the largest violation of z >= 0 is below 5 % of the rim thickness (the FEM ends a
+  path that violates it, so this re-checks `fem.integrity` by the report's own sampling);
+* Coulomb rows: instead of the energy equality, "dissipation >= 0": work - stored energy may not
+  fall below -2 % of W anywhere (friction only dissipates; the budget is the trapezoid's), and
+  "cone excess": no stuck node's tangential reaction beyond mu lambda by more than 1e-3 of the
+  largest normal reaction (the solver's own refusal threshold);
 * mesh (full run, geometry grid): F0 at u = 0.5 u_end of the coarse and medium meshes agree to 5 %;
 * scaling (E axis): F0/E is the same for every E to 1e-5 of max F0/E. The neo-Hookean law has no
   stress scale but E, so any difference is solver error.
@@ -58,6 +70,10 @@ FULL = 1.0                       # u_max / h1: full flattening
 QUICK_GRID = ((5.0, 5.0), (45.0, 0.5))
 VAPOUR_PRESSURE_PA = 2339.0      # water at 20 C
 STEP = 0.01                      # largest load step / u_max: the energy quadrature's resolution
+CORNERS = ((5.0, 0.1), (5.0, 5.0), (70.0, 0.1), (70.0, 5.0))
+CORNER_MU = 0.5
+THIN_ROOTS_MM = (0.1, 0.5)
+CONE_EXCESS_TOL = 1e-3           # the solver refuses a stuck node beyond 1e3 rtol of max lambda
 
 
 def _base(**kw) -> FemRun:
@@ -80,8 +96,22 @@ def e_axis(quick: bool) -> list[FemRun]:
     return [_base(E_Pa=E) for E in MODULI]
 
 
+def coulomb_axis(quick: bool) -> list[FemRun]:
+    """Coulomb's mu = 0.5 on the grid's corners (the extreme cone angles and root thicknesses)."""
+    corners = QUICK_GRID[:1] if quick else CORNERS
+    return [_base(alpha_deg=a, d_root_mm=d, contact="coulomb", friction=CORNER_MU,
+                  **({"max_step": 0.05} if quick else {})) for a, d in corners]
+
+
+def mixed_thin_axis(quick: bool) -> list[FemRun]:
+    """The mixed u-p formulation at nu = 0.4999 on the grid's thin walls (not in --quick: 7x the
+    displacement formulation's cost)."""
+    return [] if quick else [_base(alpha_deg=a, d_root_mm=d, nu=0.4999, formulation="mixed")
+                             for a in ALPHAS for d in THIN_ROOTS_MM]
+
+
 def requests(quick: bool) -> tuple[FemRun, ...]:
-    runs = grid(quick) + nu_axis(quick) + e_axis(quick)
+    runs = grid(quick) + nu_axis(quick) + e_axis(quick) + coulomb_axis(quick) + mixed_thin_axis(quick)
     if not quick:
         runs += [FemRun(**{**r.__dict__, "fidelity": "medium"}) for r in grid(quick)]
     return tuple(runs)
@@ -97,6 +127,15 @@ def fem_checks(res, rim_m: float) -> dict[str, tuple[float, float]]:
     reaction = float(np.max(np.abs(res.F0_N - res.F0_contact_N)) / max(np.max(np.abs(res.F0_N)), 1e-300))
     pen = float(np.max(np.maximum(res.penetration_m, 0.0)) / rim_m)
     checks = {"energy": (energy, 2e-2), "reaction": (reaction, 1e-4), "penetration/rim": (pen, 5e-2)}
+    if res.request.contact == "coulomb":
+        # friction dissipates: work - stored energy >= 0 (the trapezoid's budget below 0), and no
+        # stuck node outside the cone
+        del checks["energy"]
+        total = np.concatenate([[0.0], np.cumsum(steps)])            # every step dissipates
+        dissipated = float(-np.min(total[big] / res.energy_J[big])) if big.any() else math.nan
+        checks = {"dissipation >= 0": (max(dissipated, 0.0), 2e-2), **checks,
+                  "cone excess": (float(np.max(res.cone_excess, initial=0.0))
+                                  if res.cone_excess is not None else 0.0, CONE_EXCESS_TOL)}
     if not stable.all():
         # a snap across an instability may only lose energy (to the dynamics the quasi-static path
         # skips): work - stored energy change >= 0 at each unstable step, to the trapezoid's budget
@@ -138,16 +177,19 @@ def _first_line(exc: Exception) -> str:
 
 def fem_row(ctx: Context, req: FemRun, axis: str) -> list:
     params = f"alpha {req.geometry_alpha():g} deg, d0 {req.thickness_at_ends_m()[0] * 1e3:g} mm, " \
-             f"nu {req.nu:g} ({req.formulation}), E {req.E_Pa / 1e6:g} MPa"
+             f"nu {req.nu:g} ({req.formulation}), E {req.E_Pa / 1e6:g} MPa" + \
+             (f", Coulomb mu {req.friction:g}" if req.friction is not None else "")
     try:
         req.geometry()
     except ValueError as exc:
         return [axis, params, "rejected (invalid geometry)", "", _first_line(exc)]
     out = ctx.outcome(req)
     if isinstance(out, Exception):
-        return [axis, params, "failed fast (solver)", "", _first_line(out)[:300]]
+        return [axis, params, "failed fast (solver)", "", _first_line(out)[:700]]
     checks = fem_checks(out, req.thickness_at_ends_m()[1])
-    checks["energy"], halvings = _energy_with_step_halving(ctx, req, checks["energy"])
+    halvings = ""
+    if "energy" in checks:
+        checks["energy"], halvings = _energy_with_step_halving(ctx, req, checks["energy"])
     if axis == "grid" and not ctx.quick:
         fine = ctx.outcome(FemRun(**{**req.__dict__, "fidelity": "medium"}))
         if isinstance(fine, Exception):
@@ -164,9 +206,10 @@ def fem_row(ctx: Context, req: FemRun, axis: str) -> list:
 
 
 def _energy_with_step_halving(ctx: Context, req: FemRun, energy: tuple[float, float],
-                              halvings: int = 2) -> tuple[tuple[float, float], str]:
+                              halvings: int = 3) -> tuple[tuple[float, float], str]:
     """The energy check's budget is the trapezoid's O(du^2) error, largest at the steep end
-    (u -> h1). If it is exceeded, rerun with the load step halved (up to `halvings` times): a
+    (u -> h1). If it is exceeded, rerun with the load step halved (up to `halvings` times; the
+    thinnest flat cone, 5 deg / 0.1 mm, needs three: 0.5 -> 0.14 -> 0.037 -> ..., 3.6x and 3.8x): a
     quadrature error drops ~4x per halving and the check is judged on the finest run; a real
     energy defect (a non-conservative solution) would not drop. Returns the check and the
     sequence of mismatches ("" if no rerun was needed)."""
@@ -293,6 +336,8 @@ def run(ctx: Context) -> None:
     rows = [fem_row(ctx, r, "grid") for r in grid(ctx.quick)]
     rows += [fem_row(ctx, r, "nu") for r in nu_axis(ctx.quick)]
     rows += [fem_row(ctx, r, "E") for r in e_axis(ctx.quick)]
+    rows += [fem_row(ctx, r, "coulomb") for r in coulomb_axis(ctx.quick)]
+    rows += [fem_row(ctx, r, "mixed thin") for r in mixed_thin_axis(ctx.quick)]
     rows.append(scaling_row(ctx, e_axis(ctx.quick)))
     rows += reduced_rows(ctx)
     rep.table(NAME, "extremes_outcomes", ["axis", "case", "outcome", "checks", "details"], rows,

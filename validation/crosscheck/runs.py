@@ -33,7 +33,8 @@ class FemRun:
     """One FEM compression of a cup, from u = 0 to u_max = u_max_over_h1 * h1 (plain data).
 
     cup: preset 'A' or 'B'; alpha_deg, d_root_mm: overrides of the preset's cone angle and of its
-    thickness at r0 (None: the preset's); contact: 'frictionless' or 'sticking'; fidelity: mesh
+    thickness at r0 (None: the preset's); contact: 'frictionless', 'sticking' or 'coulomb' (with
+    Coulomb's coefficient `friction`; None for the other laws); fidelity: mesh
     level; element: 'quad' (Q2) or 'tri' (P2); E_Pa, nu, formulation: the neo-Hookean material;
     max_step: the largest load step as a fraction of u_max (the curve's sampling).
     """
@@ -49,9 +50,16 @@ class FemRun:
     formulation: str = "displacement"
     u_max_over_h1: float = 0.9
     max_step: float = 0.05
+    friction: float | None = None
+
+    def __post_init__(self) -> None:
+        if (self.contact == "coulomb") != (self.friction is not None):
+            raise ValueError(f"FemRun: friction is Coulomb's mu, given with contact='coulomb' only "
+                             f"(contact={self.contact!r}, friction={self.friction!r})")
 
     def label(self) -> str:
-        parts = [f"cup {self.cup}", self.contact, self.fidelity]
+        law = self.contact if self.friction is None else f"coulomb mu {self.friction:.6g}"
+        parts = [f"cup {self.cup}", law, self.fidelity]
         if self.element != "quad":
             parts.append(self.element)
         if self.alpha_deg is not None:
@@ -126,6 +134,7 @@ class FemResult:
     outline_p_Pa: np.ndarray = field(repr=False)  # contact pressure on it (0 off contact)
     unstable: np.ndarray | None = field(default=None, repr=False)   # per step: tangent indefinite
     pressure: tuple = field(default=(), repr=False)   # per step: fem.contact.PressureProfile
+    cone_excess: np.ndarray | None = field(default=None, repr=False)   # Coulomb (fem.cup)
 
     def F0_at(self, u_m) -> np.ndarray:
         """F0 at plate displacements u [N], monotone cubic (PCHIP) between the steps."""
@@ -159,6 +168,7 @@ def compute(request: FemRun, progress: Callable[[float, str], None] | None = Non
     mesh = cup_mesh(geometry, request.fidelity, element=request.element)
     t0 = time.perf_counter()
     resp = compress_cup(mesh, request.material(), contact=request.contact,
+                        friction=request.friction or 0.0,
                         u_max_m=request.u_max_over_h1 * geometry.h1_m, progress=progress,
                         max_step=request.max_step)
     wall = time.perf_counter() - t0
@@ -168,7 +178,8 @@ def compute(request: FemRun, progress: Callable[[float, str], None] | None = Non
                      energy_J=resp.energy_J, penetration_m=resp.penetration_m, wall_s=wall,
                      steps=int(resp.stats.steps), newton_iterations=int(resp.stats.newton_iterations),
                      dofs=int(resp.stats.dofs), outline_r_m=r, outline_z_m=z, outline_p_Pa=p,
-                     unstable=resp.unstable, pressure=tuple(resp.pressure))
+                     unstable=resp.unstable, pressure=tuple(resp.pressure),
+                     cone_excess=resp.cone_excess)
 
 
 def deformed_outline(resp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -264,5 +275,8 @@ class RunMemo:
     def _cache_path(self, request: FemRun) -> Path | None:
         if self.cache_dir is None:
             return None
-        key = hashlib.sha256(f"{self._version}|{sorted(asdict(request).items())}".encode()).hexdigest()
+        fields = asdict(request)
+        if fields["friction"] is None:       # the key of a request from before Coulomb runs
+            del fields["friction"]
+        key = hashlib.sha256(f"{self._version}|{sorted(fields.items())}".encode()).hexdigest()
         return self.cache_dir / f"fem-{key[:24]}.pkl"
