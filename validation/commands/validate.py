@@ -21,7 +21,8 @@ import sys
 from pathlib import Path
 
 NAME = "validate"
-HELP = "cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes (CSV, MD, PNG, JSON)"
+HELP = ("cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes, the paper's "
+        "numbers, Coulomb friction (CSV, MD, PNG, JSON)")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

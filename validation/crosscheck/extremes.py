@@ -347,6 +347,8 @@ def run(ctx: Context) -> None:
         key = r[2].split(":")[0].split(" (")[0]
         counts[key] = counts.get(key, 0) + 1
     rep.summary["extremes_outcomes"] = counts
+    rep.text(NAME, f"**Outcomes**: {len(rows)} cases, " + ", ".join(f"{n} {k}" for k, n in sorted(counts.items()))
+             + ("" if "FAIL" in counts else ", none FAILs a check") + ".")
     rep.summary["extremes_lifetime_span_s"] = _lifetime_span(rows)
 
 

@@ -123,7 +123,7 @@ def _curve_table(ctx: Context, curves, free, fid: str) -> None:
         for m, r in by_mu.items():
             if isinstance(r, Exception):
                 rows.append([cup, _mu_text(m), "failed", math.nan, math.nan, 0, *blank,
-                             str(r).splitlines()[0][:200]])
+                             str(r).splitlines()[0][:500]])
                 continue
             F = [_at(r, u) for u in _samples(r.h1_m)]
             excess = 0.0 if r.cone_excess is None else float(np.max(r.cone_excess))
@@ -140,6 +140,15 @@ def _curve_table(ctx: Context, curves, free, fid: str) -> None:
                      f"sticking run's, one run each on a shared machine; max_cone_excess: the largest "
                      f"tangential reaction of a stuck node beyond mu lambda, / max lambda)")
     ctx.report.summary["friction_small_u_stiffness_N_per_mm"] = summary
+    ratios = {cup: [r[4] for r in rows if r[0] == cup and r[2] == "converged" and r[1] != "inf (sticking)"]
+              for cup in curves}
+    text = "; ".join(f"cup {c} {min(v):.3g}-{max(v):.3g}x" for c, v in ratios.items() if v)
+    failed = [f"cup {r[0]} mu {r[1]}" for r in rows if r[2] == "failed"]
+    ctx.report.text(NAME, f"Cost: a Coulomb curve takes {text} the sticking curve's time (one run "
+                          f"each; the issue's target is 2x)."
+                    + (f" Not converged: {', '.join(failed)} (the row gives the step and the cause)."
+                       if failed else ""))
+    ctx.report.summary["friction_time_over_sticking"] = {c: [min(v), max(v)] for c, v in ratios.items() if v}
 
 
 def _samples(h1_m: float) -> list[float]:

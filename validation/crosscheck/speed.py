@@ -122,7 +122,7 @@ def run(ctx: Context) -> None:
                   f"{contact}: FEM levels and Appendix A against the reference (the reference row holds the "
                   f"reference values and, in the error columns, the observed orders; nan rows failed)")
         for name, msg in failed:
-            rep.text(NAME, f"*{contact}, {name} did not converge:* {msg}")
+            rep.text(NAME, f"*{contact}, {name} did not run to the end:* {msg}")
         all_rows[contact] = rows
         references[contact] = how
 
