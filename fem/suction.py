@@ -30,6 +30,7 @@ from .cavity import CavitySurface, PressurizedMechanics
 from .contact import CONTACT_LAWS, PressureProfile, RigidPlane
 from .cup import _boundary_nodes, _joined, _measure, cup_height
 from .forms import Mechanics
+from .integrity import check_state
 from .kinematics import Kinematics
 from .material import NeoHookean
 from .mesh import boundary_path
@@ -65,7 +66,8 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
                  **solver_opts: Any) -> SuctionGrid:
     """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in (0, h1];
     dp_Pa: increasing, starting at 0. Raises ValueError for bad input, `fem.solver.ConvergenceError`
-    naming u and dp where a state cannot be reached."""
+    naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
+    converged state violates contact between the nodes or folds onto itself."""
     h1 = cup_height(mesh)
     u = np.asarray(u_m, float)
     dp = np.asarray(dp_Pa, float)
@@ -92,14 +94,18 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
             stats = follow_path(mech, dirichlet, t_max, plane=plane, options=options,
                                 on_step=last.append, start=start)
         except RuntimeError as err:
-            raise type(err)(f"{where}: {err}") from None
+            err.args = (f"{where}: {err}",)
+            raise
         end = last[-1]
+        check_state(mesh, end.u, u_i_now[0], 0, u_i_now[0])     # contact kept between the nodes
         return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0), stats
 
+    u_i_now = [0.0]         # the plate displacement of the running segment, for messages
     outputs = np.empty((u.size, dp.size), dtype=object)
     total: SolverStats | None = None
     pressed, u_prev = None, 0.0
     for i, u_i in enumerate(u):
+        u_i_now[0] = u_i
         pressed, stats = segment(body, plate_at(u_prev, True), u_i - u_prev, pressed,
                                  f"pressing to u = {u_i * 1e3:.4g} mm")
         total = stats if total is None else _joined(total, stats)

@@ -46,7 +46,7 @@ def add_cup_arguments(parser: argparse.ArgumentParser, role: str):
     return g
 
 
-ROUTES = {"paper": "strip", "profile": "profile"}
+ROUTES = {"paper": "strip", "profile": "profile", "coupled": "coupled"}
 
 
 def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = "paper") -> None:
@@ -56,7 +56,9 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = 
                    help="what the leak crosses: paper (eqs 3-7: one strip at the uniform pressure of "
                         "eq 6, beta = 0.8), or profile (the FEM curve's own contact-pressure profile "
                         "p(r) + beta (p_a - p_b), ring by ring, with its r_c and V; needs an FEM curve; "
-                        "not mesh-converged where only the sharp rim corner touches, see docs/lifetime.md) "
+                        "not mesh-converged where only the sharp rim corner touches, see docs/lifetime.md), "
+                        "or coupled (lifetime only: the cup's state from the FEM's (u, dp) suction table of "
+                        "`cupcheck suction`, --suction-table; replaces eqs 3-7 and beta) "
                         f"(default: {default_route})")
     g.add_argument("--cup-laws", default=None, choices=("cone", "curve"),
                    help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 with the cup's r0, r1, "
@@ -77,6 +79,8 @@ def route_model(args: argparse.Namespace) -> tuple[str, str]:
     """(geometry, seal) of the `LeakageModel` the route and cup-law options ask for; fills
     ``args.cup_laws`` with the route's default."""
     seal = ROUTES[args.route]
+    if seal == "coupled":
+        raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
     if args.cup_laws is None:
         args.cup_laws = "curve" if seal == "profile" else "cone"
     if seal == "profile" and args.cup_laws != "curve":

@@ -39,6 +39,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="stiffness force F0: the Appendix A formula, or a StiffnessCurve CSV "
                         "(columns u_mm,F0_N[,h_mm,r_c_mm,l_mm,V_mm3]; its JSON sidecar, if any, "
                         "names the cup design) (default: appendix-a)")
+    p.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
+                   help="for --route coupled: the FEM's (u, dp) table written by `cupcheck suction`")
+    p.add_argument("--interface", default="linear", choices=("linear", "p_b", "p_a"),
+                   help="for --route coupled: the gas pressure in the contact zone next to the seal, "
+                        "rising linearly from p_b to p_a across it, or the bounds p_b, p_a (default: linear)")
     p.add_argument("--E-MPa", dest="E_MPa", type=float, default=4.0,
                    help="Young's modulus in MPa for Appendix A and for p/E without relaxation (default: 4)")
     p.add_argument("--d0-mm", dest="d0_mm", type=float, default=2.0,
@@ -231,6 +236,13 @@ def run(args: argparse.Namespace) -> int:
     from reduced.lifetime import lifetime_sweep
     from validation.output import atomic_directory, terminal_progress
 
+    if args.route == "coupled":
+        from validation.coupled.route import run_coupled
+        return run_coupled(args)
+    for option, value, default in (("--suction-table", args.suction_table, None),
+                                   ("--interface", args.interface, "linear")):
+        if value != default:
+            raise ValueError(f"{option}: applies to --route coupled only")
     model = build_model(args)
     choice = args.cup_choice
     cup = {**choice.describe(), "laws": args.cup_laws, "route": args.route}

@@ -1,0 +1,278 @@
+"""The coupled cavity ("fluid cavity"): the cup's state from its (u, dp) table instead of eqs (3)-(7).
+
+The state is the gas content N of the cavity. Pulled by F1, the cup sits where the table says the
+pull balances and the gas fills the cavity:
+
+    F1(u, dp) = F1,        (p_a - dp) V(u, dp) = N k_B T,
+
+two equations for the plate displacement u and dp = p_a - p_b (`SuctionTable`: F1 and V as the
+FEM computes them with the suction acting on the deformed cup, so the rigid cone of eqs 3-4, the
+force balance of eq 5 and eq 6's beta are all replaced). At fixed F1 the states form a branch
+parametrised by dp: u(dp) from the first equation (F1 rises with dp and falls with u), N(dp) from
+the second; gas leaks in, N rises, dp falls. The cup starts like the paper's (Sec. 3): released at
+u_start with F1 = 0, which fixes N0; F1 is then applied at fixed N0. It lets go where the branch
+ends: at a fold of N(dp) (no state holds more gas), or where u reaches the table's smallest u (the
+plate back near its free height: the end of the data, reported as such).
+
+The leak rate at a state is the series flow through its own contact-pressure profile
+(`reduced.profile_leak`), computed at the table's nodes (p_b = p_a - dp_j exactly there) and
+interpolated bilinearly in ln Ndot, like F1 and V (bilinear: monotone data stay monotone, so the
+branch is unique); the interpolation error is measured by grid refinement. The solid pressure in
+the contact zone next to the seal is the table's (the plane's reaction with the interface gas at
+p_b) less the gas pressure rise across the zone, P - p_b = dp (r - r_k) / (r_cut - r_k), linear from
+the seal to the zone's outer edge (``interface="linear"``; "p_b" keeps the table's, "p_a" takes the
+whole dp off: the two bounds).
+
+The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a dp
+grid of `samples` points. A stiffness factor kappa scales the modulus exactly (a neo-Hookean body
+with frictionless contact: forces and pressures scale with E at fixed dp / E): F1(u, dp) =
+kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa). Relaxation is not modelled here.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from scipy.optimize import brentq
+
+from reduced.gas import AIR, Gas
+from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
+from reduced.suction_table import SuctionTable
+
+__all__ = ["CoupledCavity", "CoupledLifetime", "INTERFACES"]
+
+INTERFACES = ("linear", "p_b", "p_a")
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledLifetime:
+    """Lifetime [s] (inf if the interface seals) and the trajectory along the branch (SI)."""
+
+    force_N: float
+    lifetime_s: float
+    reason: str              # "table_edge", "fold", "sealed", "over_force"
+    message: str
+    N0: float
+    t_s: np.ndarray
+    u_m: np.ndarray
+    dp_Pa: np.ndarray        # p_a - p_b
+    N: np.ndarray
+    N_dot_per_s: np.ndarray
+    V_m3: np.ndarray
+    p_a_Pa: float = 1e5
+
+    @property
+    def p_b_Pa(self) -> np.ndarray:
+        return self.p_a_Pa - self.dp_Pa
+
+    def summary(self) -> dict:
+        """JSON-ready summary (lifetime_s null when infinite)."""
+        return {"force_N": self.force_N,
+                "lifetime_s": self.lifetime_s if math.isfinite(self.lifetime_s) else None,
+                "reason": self.reason, "sealed": self.reason == "sealed", "N0": self.N0,
+                "u_final_mm": 1e3 * float(self.u_m[-1]) if self.u_m.size else None,
+                "p_b_final_Pa": float(self.p_b_Pa[-1]) if self.dp_Pa.size else None,
+                "message": self.message}
+
+    def trajectory_columns(self) -> dict[str, np.ndarray]:
+        """Trajectory arrays under CSV column names that carry their units."""
+        return {"t_s": self.t_s, "u_mm": 1e3 * self.u_m, "p_b_Pa": self.p_b_Pa, "N": self.N,
+                "N_dot_per_s": self.N_dot_per_s, "V_mm3": 1e9 * self.V_m3}
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledCavity:
+    """The coupled reduced model (module docstring). u_c: critical gap [m] of p/E; E_Pa: the
+    modulus in p/E (default: the table's times kappa)."""
+
+    table: SuctionTable
+    u_c: Callable[[float], float]
+    gas: Gas = AIR
+    p_a_Pa: float = 1e5
+    kappa: float = 1.0
+    interface: str = "linear"
+    radial: str = "annulus"
+    samples: int = 801
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.kappa) and self.kappa > 0):
+            raise ValueError(f"kappa: stiffness factor must be > 0, got {self.kappa}")
+        if self.interface not in INTERFACES:
+            raise ValueError(f"interface: expected one of {', '.join(INTERFACES)}, got {self.interface!r}")
+        if not (math.isfinite(self.p_a_Pa) and self.p_a_Pa > 0):
+            raise ValueError(f"p_a_Pa: ambient pressure must be > 0 Pa, got {self.p_a_Pa}")
+        if not (isinstance(self.samples, int) and self.samples >= 11):
+            raise ValueError(f"samples: need an integer >= 11, got {self.samples}")
+
+    # -------------------------------------------------------------- the table, interpolated
+    @property
+    def _u(self) -> np.ndarray:
+        return self.table.u_m
+
+    @cached_property
+    def _dp(self) -> np.ndarray:
+        """The table's dp axis in the model's units (kappa dp_tab), cut at p_a (p_b >= 0)."""
+        return self.kappa * self.table.dp_Pa
+
+    def F1(self, u: float, dp: float) -> float:
+        """Pull on the handle [N] at (u, dp)."""
+        return self.kappa * _bilinear(self._u, self._dp, self.table.F1_N, u, dp)
+
+    def V(self, u: float, dp: float) -> float:
+        """Cavity volume [m^3] at (u, dp)."""
+        return _bilinear(self._u, self._dp, self.table.V_m3, u, dp)
+
+    def Ndot(self, u: float, dp: float) -> float:
+        """Molecules per second leaking in at (u, dp) (bilinear in ln Ndot between the nodes)."""
+        q = self._node_rates
+        i, j, a, b = _cell(self._u, self._dp, u, dp)
+        corners = q[i:i + 2, j:j + 2]
+        w = np.array([[(1 - a) * (1 - b), (1 - a) * b], [a * (1 - b), a * b]])
+        if np.all(corners > 0):
+            return float(np.exp(np.sum(w * np.log(corners))))
+        return float(np.sum(w * corners))
+
+    @cached_property
+    def _node_rates(self) -> np.ndarray:
+        """Ndot at every node (u_i, dp_j) through its profile, p_b = p_a - dp_j (nan beyond p_a)."""
+        E = self.kappa * self.table.E_Pa
+        out = np.full((self._u.size, self._dp.size), np.nan)
+        for i in range(self._u.size):
+            for j, dp in enumerate(self._dp):
+                if dp > self.p_a_Pa:
+                    continue
+                prof = self._solid_profile(i, j)
+                if prof is None:
+                    raise ValueError(f"suction table: no contact profile at u = {1e3 * self._u[i]:.4g} mm, "
+                                     f"dp = {dp / 1e3:.4g} kPa (the cavity is open)")
+                gaps = ring_gaps(prof, self.u_c, E)
+                out[i, j] = profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - dp, prof.r_m, gaps,
+                                              self.radial)
+        return out
+
+    def _solid_profile(self, i: int, j: int) -> ContactProfile | None:
+        """The solid contact pressure at node (i, j): kappa p_tab less the interface gas's rise
+        over p_b across the zone [r_k, r_cut] (module docstring)."""
+        prof = self.table.profiles[i][j]
+        if prof is None:
+            return None
+        dp = self._dp[j]
+        r, p = prof.r_m, self.kappa * prof.p_Pa
+        rk, rcut = self.table.seal_r_m[i, j], self.table.cut_r_m[i, j]
+        zone = (r >= rk) & (r <= rcut)
+        rise = {"p_b": 0.0, "p_a": 1.0}.get(self.interface)
+        if rise is None:
+            rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
+        return ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
+
+    # -------------------------------------------------------------- the branch at fixed F1
+    def u_at(self, F1: float, dp: float) -> float:
+        """u with F1(u, dp) = F1 (F1 falls with u); ValueError where the table ends."""
+        lo, hi = self.F1(self._u[-1], dp), self.F1(self._u[0], dp)
+        slack = 1e-9 * max(abs(lo), abs(hi), 1.0)       # the bracket ends, found by brentq on dp
+        if lo - slack <= F1 < lo:
+            return float(self._u[-1])
+        if hi < F1 <= hi + slack:
+            return float(self._u[0])
+        if not lo <= F1 <= hi:
+            raise ValueError(f"F1 = {F1:.4g} N at dp = {dp / 1e3:.4g} kPa lies outside the table's "
+                             f"[{lo:.4g}, {hi:.4g}] N over u = {1e3 * self._u[0]:.4g} ... "
+                             f"{1e3 * self._u[-1]:.4g} mm")
+        return brentq(lambda u: self.F1(u, dp) - F1, self._u[0], self._u[-1], xtol=1e-15, rtol=1e-13)
+
+    def content(self, F1: float, dp: float) -> tuple[float, float]:
+        """(u, N) of the state on the F1 branch at dp."""
+        u = self.u_at(F1, dp)
+        return u, (self.p_a_Pa - dp) * self.V(u, dp) / self.gas.kT_J
+
+    def _dp_range(self, F1: float) -> tuple[float, float]:
+        """The dp interval of the branch inside the table: u from u_min (low dp) to u_max."""
+        top = min(self._dp[-1], self.p_a_Pa)
+        if F1 > self.F1(self._u[0], top):
+            return math.nan, math.nan
+        lo = 0.0 if F1 <= self.F1(self._u[0], 0.0) else brentq(
+            lambda d: self.F1(self._u[0], d) - F1, 0.0, top, xtol=1e-9)
+        hi = top if F1 >= self.F1(self._u[-1], top) else brentq(
+            lambda d: self.F1(self._u[-1], d) - F1, lo, top, xtol=1e-9)
+        return lo, hi
+
+    def start(self, u_start_m: float) -> tuple[float, float]:
+        """(dp, N0) of the cup released at u_start with F1 = 0 (Sec. 3's start)."""
+        if not self._u[0] <= u_start_m <= self._u[-1]:
+            raise ValueError(f"u_start: must lie in the table's u range [{1e3 * self._u[0]:.4g}, "
+                             f"{1e3 * self._u[-1]:.4g}] mm, got {1e3 * u_start_m:.4g} mm")
+        top = min(self._dp[-1], self.p_a_Pa)
+        if self.F1(u_start_m, top) < 0:
+            raise ValueError(f"u_start: the table's dp <= {top / 1e3:.4g} kPa cannot hold the cup "
+                             f"released at u = {1e3 * u_start_m:.4g} mm")
+        dp = brentq(lambda d: self.F1(u_start_m, d), 0.0, top, xtol=1e-9)
+        return dp, (self.p_a_Pa - dp) * self.V(u_start_m, dp) / self.gas.kT_J
+
+    def largest_holdable_force(self, u_start_m: float) -> float:
+        """The largest F1 [N] the cup released at u_start holds at t = 0: the branch at that F1
+        just reaches the start content at its low-dp end (bisection on F1)."""
+        _, N0 = self.start(u_start_m)
+
+        def holds(F1: float) -> bool:
+            lo, _ = self._dp_range(F1)
+            return bool(np.isfinite(lo)) and N0 <= self.content(F1, lo)[1]
+        lo, hi = 0.0, self.F1(self._u[0], min(self._dp[-1], self.p_a_Pa))
+        if holds(hi):
+            return hi
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if holds(mid) else (lo, mid)
+        return lo
+
+    def lifetime(self, force_N: float, u_start_m: float) -> CoupledLifetime:
+        """Lifetime of the cup released at u_start and pulled by F1 = force_N (module docstring)."""
+        F1 = float(force_N)
+        if not (math.isfinite(F1) and F1 > 0):
+            raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
+        _, N0 = self.start(u_start_m)
+        lo, hi = self._dp_range(F1)
+        empty = np.zeros(0)
+        if not np.isfinite(lo) or N0 > self.content(F1, lo)[1]:
+            return CoupledLifetime(F1, 0.0, "over_force", f"F1 = {F1:g} N exceeds what the cup holds "
+                                   f"with its start content: it detaches at once", N0,
+                                   *(empty,) * 6, p_a_Pa=self.p_a_Pa)
+        if N0 < self.content(F1, hi)[1]:
+            raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
+                             f"{1e3 * self._u[-1]:.4g} mm; extend the table")
+        dp0 = brentq(lambda d: self.content(F1, d)[1] - N0, lo, hi, xtol=1e-10 * max(hi, 1.0))
+        dps = np.linspace(dp0, lo, self.samples)
+        u, N = np.array([self.content(F1, d) for d in dps]).T
+        rising = np.diff(N) > 0
+        end, reason = self.samples, "table_edge"
+        if not np.all(rising):
+            end, reason = int(np.argmin(rising)) + 1, "fold"
+        dps, u, N = dps[:end], u[:end], N[:end]
+        q = np.array([self.Ndot(a, b) for a, b in zip(u, dps)])
+        V = np.array([self.V(a, b) for a, b in zip(u, dps)])
+        if np.any(q <= 0):
+            k = int(np.argmax(q <= 0))
+            return CoupledLifetime(F1, math.inf, "sealed", f"the interface seals at u = "
+                                   f"{1e3 * u[k]:.4g} mm, dp = {dps[k] / 1e3:.4g} kPa", N0,
+                                   np.zeros(1), u[:1], dps[:1], N[:1], q[:1], V[:1], p_a_Pa=self.p_a_Pa)
+        t = np.concatenate([[0.0], np.cumsum(0.5 * (1 / q[1:] + 1 / q[:-1]) * np.diff(N))])
+        where = ("u reached the table's smallest u = " f"{1e3 * self._u[0]:.4g} mm" if reason == "table_edge"
+                 else "the branch folds: no state holds more gas")
+        return CoupledLifetime(F1, float(t[-1]), reason, f"detached at t = {t[-1]:.4g} s: {where}", N0,
+                               t, u, dps, N, q, V, p_a_Pa=self.p_a_Pa)
+
+
+def _cell(x: np.ndarray, y: np.ndarray, a: float, b: float) -> tuple[int, int, float, float]:
+    """Cell (i, j) and local coordinates of (a, b) on the grid x by y (clamped to it)."""
+    i = min(max(bisect.bisect_right(x, a) - 1, 0), x.size - 2)
+    j = min(max(bisect.bisect_right(y, b) - 1, 0), y.size - 2)
+    return i, j, (a - x[i]) / (x[i + 1] - x[i]), (b - y[j]) / (y[j + 1] - y[j])
+
+
+def _bilinear(x: np.ndarray, y: np.ndarray, z: np.ndarray, a: float, b: float) -> float:
+    i, j, s, t = _cell(x, y, a, b)
+    return float((1 - s) * ((1 - t) * z[i, j] + t * z[i, j + 1]) + s * ((1 - t) * z[i + 1, j] + t * z[i + 1, j + 1]))

@@ -1,0 +1,98 @@
+"""`cupcheck lifetime --route coupled`: the lifetimes from an FEM suction table (`cupcheck suction`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+#: lifetime options that the coupled route replaces or does not model: (option, value, default)
+_NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--relaxation", "relaxation", "none"),
+             ("--fluid", "fluid", "air"), ("--cavitation-kPa", "cavitation_kPa", None),
+             ("--cup-laws", "cup_laws", None), ("--d0-mm", "d0_mm", 2.0), ("--phi0-s", "phi0_s", None),
+             ("--l0-mm", "l0_mm", None), ("--l1-mm", "l1_mm", None))
+
+
+@dataclass(frozen=True)
+class _TableDesign:
+    """What `validation.design.resolve_cup` reads of a curve: the recorded design and h1."""
+
+    design: dict[str, Any] | None
+    h1_m: float
+
+
+def coupled_model(args: argparse.Namespace):
+    """(CoupledCavity, u_start [m], cup description) from the options; ValueError on bad input."""
+    from reduced.coupled import CoupledCavity
+    from reduced.gas import Gas
+    from reduced.suction_table import SuctionTable
+    from validation.commands.lifetime import build_uc
+    from validation.design import resolve_cup
+
+    if args.reference_mode:
+        raise ValueError("--reference-mode: the reference conventions are the paper route's; "
+                         "drop it with --route coupled")
+    given = [opt for opt, name, default in _NOT_HERE if getattr(args, name) != default]
+    if given:
+        raise ValueError(f"--route: coupled takes F1, V, r and the contact profile from the suction "
+                         f"table and models neither relaxation nor water; drop {', '.join(given)}")
+    if args.suction_table is None:
+        raise ValueError("--suction-table: --route coupled needs the FEM table of `cupcheck suction` (.json)")
+    if not Path(args.suction_table).is_file():
+        raise ValueError(f"--suction-table: no such file '{args.suction_table}'")
+    for F in args.force_N:
+        if not (math.isfinite(F) and F > 0):
+            raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
+    if not (math.isfinite(args.kappa) and args.kappa > 0):
+        raise ValueError(f"--kappa: stiffness factor must be > 0, got {args.kappa:g}")
+    table = SuctionTable.from_json(args.suction_table)
+    h1 = 1e-3 * float(table.provenance.get("h1_mm", math.nan))
+    recorded = _TableDesign(table.provenance.get("geometry"), h1)
+    choice = resolve_cup(recorded if recorded.design else None, cup=args.cup,
+                         geometry_file=args.geometry, r_start_mm=args.r_start_mm,
+                         curve_label=f"'{args.suction_table}'", laws="curve")
+    cup = choice.cup
+    u_start = (h1 if math.isfinite(h1) else cup.h1_m) - cup.h_start_m
+    model = CoupledCavity(table, build_uc(args), Gas(T_K=args.T_K), args.p_a_Pa, kappa=args.kappa,
+                          interface=args.interface)
+    description = {**choice.describe(), "route": "coupled", "u_start_mm": 1e3 * u_start,
+                   "interface": args.interface, "suction_table": str(args.suction_table)}
+    return model, u_start, choice, description
+
+
+def run_coupled(args: argparse.Namespace) -> int:
+    """The coupled route of `cupcheck lifetime` (its table, --json and --out as for the others)."""
+    from validation.output import atomic_directory, write_table
+
+    model, u_start, choice, cup = coupled_model(args)
+    for note in choice.notes:
+        print(f"note: {note}", file=sys.stderr)
+    if args.out:
+        with atomic_directory(args.out) as tmp:
+            results = [model.lifetime(F, u_start) for F in args.force_N]
+            for r in results:
+                write_table(tmp / f"trajectory_F1_{r.force_N:g}N.csv",
+                            {"cup": cup["name"], **r.trajectory_columns()},
+                            stage=f"lifetime at F1 = {r.force_N:g} N")
+            (tmp / "summary.json").write_text(json.dumps([{**r.summary(), "cup": cup} for r in results],
+                                                         indent=2, allow_nan=False) + "\n")
+    else:
+        results = [model.lifetime(F, u_start) for F in args.force_N]
+    if args.json:
+        print(json.dumps([{**r.summary(), "cup": cup} for r in results], indent=2))
+        return 0
+    print(f"cup: {choice.label}; released at u = {1e3 * u_start:.4g} mm (r_start "
+          f"{cup['r_start_mm']:.4g} mm by eq 3); route coupled: F1, V and the contact profile from "
+          f"{args.suction_table}, interface gas {args.interface}; largest holdable force "
+          f"{model.largest_holdable_force(u_start):.4g} N")
+    print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'u_end_mm':>8} {'p_b_end_kPa':>11}")
+    for r in results:
+        life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"
+        u_end = f"{1e3 * r.u_m[-1]:8.3f}" if r.u_m.size else f"{'-':>8}"
+        pb = f"{r.p_b_Pa[-1] / 1e3:11.4g}" if r.dp_Pa.size else f"{'-':>11}"
+        print(f"{r.force_N:8.4g} {life:>12} {r.reason:>11} {u_end} {pb}")
+    return 0

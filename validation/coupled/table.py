@@ -1,0 +1,52 @@
+"""From the FEM's `SuctionGrid` to the reduced model's `SuctionTable`, and beta as the FEM sees it."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from fem.suction import SuctionGrid
+from reduced.profile_leak import ContactProfile
+from reduced.suction_table import SuctionTable
+
+__all__ = ["suction_table", "fem_beta"]
+
+
+def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -> SuctionTable:
+    """The hand-off table of an FEM grid: F1, V, r_k, r_cut and the lumped nodal contact
+    pressures (radii strictly increasing, duplicates at a node shared by two facets dropped)."""
+    m = grid.material
+    prov = {"source": "fem.suction", "contact": grid.contact, "E_Pa": m.E_Pa, "nu": m.nu,
+            "formulation": m.formulation, "h1_mm": 1e3 * grid.h1_m,
+            "solver": {"newton_iterations": grid.stats.newton_iterations,
+                       "wall_time_s": grid.stats.wall_time_s, "dofs": grid.stats.dofs},
+            **(provenance or {})}
+    return SuctionTable(u_m=grid.u_m, dp_Pa=grid.dp_Pa, F1_N=grid.F1_N, V_m3=grid.V_m3,
+                        seal_r_m=grid.seal_r_m, cut_r_m=grid.cut_r_m,
+                        profiles=tuple(tuple(_profile(p) for p in row) for row in grid.profiles),
+                        E_Pa=m.E_Pa, provenance=prov)
+
+
+def _profile(p) -> ContactProfile | None:
+    r, pr = np.asarray(p.r_m), np.asarray(p.p_Pa)
+    keep = np.concatenate([[True], np.diff(r) > 0]) if r.size else np.zeros(0, bool)
+    r, pr = r[keep], pr[keep]
+    if r.size < 2 or not np.any(pr > 0):
+        return None
+    return ContactProfile(r, np.maximum(pr, 0.0))
+
+
+def fem_beta(table: SuctionTable) -> np.ndarray:
+    """Eq (6)'s beta as the FEM sees it, [len(u), len(dp) - 1]: the extra contact force the
+    suction puts on the contact at fixed u, per unit dp and per area of the sealing strip
+    2 pi r_k l, with l the strip's force-quartile width without suction (`fem.postprocess`);
+    N = dp pi r_k^2 - F1 is the contact force with the interface outside the seal at ambient
+    pressure (`fem.suction`). nan where the unsucked cup resolves no strip."""
+    from fem.postprocess import quartile_width
+
+    N = table.dp_Pa * np.pi * table.seal_r_m**2 - table.F1_N
+    l = np.array([quartile_width(p.r_m, p.p_Pa) if p is not None else np.nan
+                  for p in (row[0] for row in table.profiles)])
+    area = 2 * np.pi * table.seal_r_m[:, 0] * np.where(l > 0, l, np.nan)
+    return (N[:, 1:] - N[:, :1]) / (table.dp_Pa[1:] * area[:, None])
