@@ -1,0 +1,97 @@
+"""The coupled route's accuracy and cost: lifetimes of cup A on pmma-1.89 from FEM suction tables
+of several grids and meshes, beside the paper route, and beta as the FEM sees it.
+
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled.py [--tables DIR]
+
+Tables (frictionless cup A, `fem.suction`; built once and kept as JSON in --tables, default
+out/bench_coupled): the default grid of `cupcheck suction` (u = 0.005 ... 0.8 h1, 13 values;
+dp = 0 ... 100 kPa in 10 kPa) on the coarse and medium meshes, and on the coarse mesh the same
+with every u interval halved, every dp interval halved, and one more u at 0.0025 h1. Prints per
+table its build time and the lifetimes at F1 = 5, 10, 20, 30 N (interface gas linear), their
+differences from the refined grids (the interpolation error) and from the medium mesh, the
+largest holdable force, the lifetime cost, and eq 6's beta from the medium table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from fem.cup import cup_height
+from fem.geometry import cup_geometry
+from fem.material import NeoHookean
+from fem.mesh import cup_mesh
+from fem.suction import suction_grid
+from reduced.coupled import CoupledCavity
+from reduced.lifetime import lifetime
+from reduced.suction_table import SuctionTable
+from validation.cli import build_parser
+from validation.commands.lifetime import build_model, build_uc
+from validation.commands.suction import DP_KPA, U_FRACTIONS
+from validation.coupled.table import fem_beta, suction_table
+
+FORCES_N = (5.0, 10.0, 20.0, 30.0)
+
+
+def _halved(x: np.ndarray) -> np.ndarray:
+    return np.sort(np.concatenate([x, 0.5 * (x[1:] + x[:-1])]))
+
+
+def grids() -> dict[str, tuple[str, np.ndarray, np.ndarray]]:
+    u, dp = np.array(U_FRACTIONS), np.array(DP_KPA)
+    return {"coarse": ("coarse", u, dp), "coarse u/2": ("coarse", _halved(u), dp),
+            "coarse dp/2": ("coarse", u, _halved(dp)),
+            "coarse +u_min/2": ("coarse", np.concatenate([[u[0] / 2], u]), dp),
+            "medium": ("medium", u, dp)}
+
+
+def table(name: str, level: str, u_frac: np.ndarray, dp_kPa: np.ndarray, folder: Path) -> tuple[SuctionTable, float]:
+    path = folder / f"{name.replace(' ', '_').replace('/', '-')}.json"
+    if path.exists():
+        t = SuctionTable.from_json(path)
+        return t, float(t.provenance["solver"]["wall_time_s"])
+    mesh = cup_mesh(cup_geometry("A"), level)
+    g = suction_grid(mesh, NeoHookean(), u_frac * cup_height(mesh), 1e3 * dp_kPa)
+    t = suction_table(g, {"fidelity": level})
+    folder.mkdir(parents=True, exist_ok=True)
+    t.to_json(path)
+    return t, g.stats.wall_time_s
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--tables", type=Path, default=Path("out/bench_coupled"))
+    args = parser.parse_args()
+    cli = build_parser().parse_args(["lifetime", "--surface", "pmma-1.89", "--force", "5"])
+    uc, paper = build_uc(cli), build_model(cli)
+    u_start = paper.cup.h1_m - paper.cup.h_start_m
+    print(f"paper route: " + ", ".join(f"{lifetime(paper, F).lifetime_s:.4g}" for F in FORCES_N)
+          + f" s at F1 = {', '.join(f'{F:g}' for F in FORCES_N)} N")
+    rows = {}
+    for name, (level, u, dp) in grids().items():
+        t, build_s = table(name, level, u, dp, args.tables)
+        model = CoupledCavity(t, uc, paper.gas, paper.p_a_Pa)
+        start = time.perf_counter()
+        life = np.array([model.lifetime(F, u_start).lifetime_s for F in FORCES_N])
+        cost = (time.perf_counter() - start) / len(FORCES_N)
+        rows[name] = life
+        print(f"{name:>16}: {t.u_m.size:2d} x {t.dp_Pa.size:2d} states, table {build_s:6.1f} s; lifetimes "
+              + ", ".join(f"{x:.4g}" for x in life) + f" s ({1e3 * cost:.0f} ms each); largest "
+              f"holdable force {model.largest_holdable_force(u_start):.4g} N")
+    base = rows["coarse"]
+    for name in ("coarse u/2", "coarse dp/2", "coarse +u_min/2", "medium"):
+        diff = 100 * (base / rows[name] - 1)
+        print(f"coarse default grid against {name:>16}: " + ", ".join(f"{d:+.2f} %" for d in diff))
+    medium, _ = table("medium", *grids()["medium"], args.tables)
+    beta = fem_beta(medium)
+    with np.printoptions(precision=2, suppress=True, linewidth=150):
+        print("beta (medium; rows u/h1 = " + ", ".join(f"{f:g}" for f in U_FRACTIONS)
+              + "; columns dp = 10 ... 100 kPa):")
+        print(beta)
+
+
+if __name__ == "__main__":
+    main()
