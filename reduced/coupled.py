@@ -15,9 +15,10 @@ ends: at a fold of N(dp) (no state holds more gas), or where u reaches the table
 plate back near its free height: the end of the data, reported as such).
 
 The leak rate at a state is the series flow through its own contact-pressure profile
-(`reduced.profile_leak`), computed at the table's nodes (p_b = p_a - dp_j exactly there) and
-interpolated bilinearly in ln Ndot, like F1 and V (bilinear: monotone data stay monotone, so the
-branch is unique); the interpolation error is measured by grid refinement. The solid pressure in
+(`reduced.profile_leak`), computed at the table's nodes (p_b = p_a - dp_j exactly there) as the
+conductance Ndot / dp and interpolated in its logarithm; F1, V and ln(Ndot / dp) are monotone
+cubic (PCHIP) along u and linear along dp (monotone data stay monotone, so the branch is unique).
+The interpolation error is measured by grid refinement (benchmarks/bench_coupled.py). The solid pressure in
 the contact zone next to the seal is the table's (the plane's reaction with the interface gas at
 p_b) less the gas pressure rise across the zone, P - p_b = dp (r - r_k) / (r_cut - r_k), linear from
 the seal to the zone's outer edge (``interface="linear"``; "p_b" keeps the table's, "p_a" takes the
@@ -38,6 +39,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 from scipy.optimize import brentq
 
 from reduced.gas import AIR, Gas
@@ -98,6 +100,7 @@ class CoupledCavity:
     interface: str = "linear"
     radial: str = "annulus"
     samples: int = 801
+    along_u: str = "pchip"
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.kappa) and self.kappa > 0):
@@ -106,6 +109,8 @@ class CoupledCavity:
             raise ValueError(f"interface: expected one of {', '.join(INTERFACES)}, got {self.interface!r}")
         if not (math.isfinite(self.p_a_Pa) and self.p_a_Pa > 0):
             raise ValueError(f"p_a_Pa: ambient pressure must be > 0 Pa, got {self.p_a_Pa}")
+        if self.along_u not in ("pchip", "linear"):
+            raise ValueError(f"along_u: expected 'pchip' or 'linear', got {self.along_u!r}")
         if not (isinstance(self.samples, int) and self.samples >= 11):
             raise ValueError(f"samples: need an integer >= 11, got {self.samples}")
 
@@ -121,25 +126,38 @@ class CoupledCavity:
 
     def F1(self, u: float, dp: float) -> float:
         """Pull on the handle [N] at (u, dp)."""
-        return self.kappa * _bilinear(self._u, self._dp, self.table.F1_N, u, dp)
+        return self.kappa * self._surfaces["F1"](u, dp)
 
     def V(self, u: float, dp: float) -> float:
         """Cavity volume [m^3] at (u, dp)."""
-        return _bilinear(self._u, self._dp, self.table.V_m3, u, dp)
+        return self._surfaces["V"](u, dp)
 
     def Ndot(self, u: float, dp: float) -> float:
-        """Molecules per second leaking in at (u, dp) (bilinear in ln Ndot between the nodes)."""
-        q = self._node_rates
-        i, j, a, b = _cell(self._u, self._dp, u, dp)
-        corners = q[i:i + 2, j:j + 2]
-        w = np.array([[(1 - a) * (1 - b), (1 - a) * b], [a * (1 - b), a * b]])
-        if np.all(corners > 0):
-            return float(np.exp(np.sum(w * np.log(corners))))
-        return float(np.sum(w * corners))
+        """Molecules per second leaking in at (u, dp): dp times the conductance Ndot / dp,
+        interpolated in ln (it varies exponentially with the contact pressure; dividing by dp
+        removes the zero of the driving force at dp = 0). A sealed node enters as 1e-30 of the
+        largest conductance, and a conductance below 1e-20 of it is a seal (0)."""
+        g = float(np.exp(self._surfaces["Ndot"](u, dp)))
+        return dp * g if g > 1e-20 * self._largest_conductance else 0.0
 
     @cached_property
-    def _node_rates(self) -> np.ndarray:
-        """Ndot at every node (u_i, dp_j) through its profile, p_b = p_a - dp_j (nan beyond p_a)."""
+    def _largest_conductance(self) -> float:
+        g = self._node_conductance
+        return float(np.max(g[np.isfinite(g)]))
+
+    @cached_property
+    def _surfaces(self) -> dict[str, "_Surface"]:
+        g = self._node_conductance          # inf: no contact (1e3 x the largest); nan: p_b < 0
+        top, floor = 1e3 * self._largest_conductance, 1e-30 * self._largest_conductance
+        rates = np.log(np.clip(np.where(np.isnan(g), floor, g), floor, top))
+        return {"F1": _Surface(self._u, self._dp, self.table.F1_N, self.along_u),
+                "V": _Surface(self._u, self._dp, self.table.V_m3, self.along_u),
+                "Ndot": _Surface(self._u, self._dp, rates, self.along_u)}
+
+    @cached_property
+    def _node_conductance(self) -> np.ndarray:
+        """Ndot / dp [1/(s Pa)] at every node (u_i, dp_j) through its profile with p_b = p_a - dp_j;
+        at dp = 0 its limit, from a 1 Pa difference (nan beyond p_a)."""
         E = self.kappa * self.table.E_Pa
         out = np.full((self._u.size, self._dp.size), np.nan)
         for i in range(self._u.size):
@@ -150,9 +168,13 @@ class CoupledCavity:
                 if prof is None:
                     raise ValueError(f"suction table: no contact profile at u = {1e3 * self._u[i]:.4g} mm, "
                                      f"dp = {dp / 1e3:.4g} kPa (the cavity is open)")
+                drive = max(dp, 1.0)
                 gaps = ring_gaps(prof, self.u_c, E)
-                out[i, j] = profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - dp, prof.r_m, gaps,
-                                              self.radial)
+                if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
+                    out[i, j] = np.inf           # open): no resistance, see _surfaces
+                    continue
+                out[i, j] = profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - drive, prof.r_m, gaps,
+                                              self.radial) / drive
         return out
 
     def _solid_profile(self, i: int, j: int) -> ContactProfile | None:
@@ -273,6 +295,25 @@ def _cell(x: np.ndarray, y: np.ndarray, a: float, b: float) -> tuple[int, int, f
     return i, j, (a - x[i]) / (x[i + 1] - x[i]), (b - y[j]) / (y[j + 1] - y[j])
 
 
-def _bilinear(x: np.ndarray, y: np.ndarray, z: np.ndarray, a: float, b: float) -> float:
-    i, j, s, t = _cell(x, y, a, b)
-    return float((1 - s) * ((1 - t) * z[i, j] + t * z[i, j + 1]) + s * ((1 - t) * z[i + 1, j] + t * z[i + 1, j + 1]))
+class _Surface:
+    """z(u, dp) on the table's grid: monotone cubic (PCHIP, Fritsch-Carlson slopes) or linear along
+    u, linear along dp. PCHIP keeps each column's monotonicity (the branch stays unique) and is
+    third order where the data are smooth; the grid refinement in benchmarks/bench_coupled.py
+    measures both."""
+
+    def __init__(self, u: np.ndarray, dp: np.ndarray, z: np.ndarray, along_u: str):
+        self.u, self.dp, self.z = u, dp, np.asarray(z, dtype=float)
+        self.slope = (PchipInterpolator(u, self.z, axis=0).derivative()(u) if along_u == "pchip"
+                      else None)
+
+    def __call__(self, a: float, b: float) -> float:
+        i, j, s, t = _cell(self.u, self.dp, a, b)
+        z0, z1 = self.z[i, j:j + 2], self.z[i + 1, j:j + 2]
+        if self.slope is None:
+            col = (1 - s) * z0 + s * z1
+        else:
+            h = self.u[i + 1] - self.u[i]
+            h00, h10, h01, h11 = (2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2,
+                                  s**3 - s**2)
+            col = h00 * z0 + h10 * h * self.slope[i, j:j + 2] + h01 * z1 + h11 * h * self.slope[i + 1, j:j + 2]
+        return float((1 - t) * col[0] + t * col[1])
