@@ -29,7 +29,7 @@ def _run(capsys, *argv):
 def table_path(tmp_path_factory):
     path = tmp_path_factory.mktemp("suction") / "cupA.json"
     code = main(["suction", "--cup", "A", "--fidelity", "coarse", "--u-mm", "0.05", "1", "3", "5",
-                 "--dp-kPa", "0", "10", "20", "40", "--out", str(path)])
+                 "--dp-kPa", "0", "2", "5", "10", "20", "40", "--out", str(path)])
     assert code == 0
     return path
 
@@ -47,7 +47,7 @@ def test_suction_table_balances(table_path):
 
 def test_coupled_route_matches_the_library(capsys, table_path, tmp_path):
     code, out, _ = _run(capsys, "lifetime", "--route", "coupled", "--suction-table", str(table_path),
-                        "--cup", "A", "--force", "2", "8", "--json", "--out", str(tmp_path / "run"))
+                        "--cup", "A", "--force", "2", "15", "--json", "--out", str(tmp_path / "run"))
     assert code == 0
     rows = json.loads(out)
     model = CoupledCavity(SuctionTable.from_json(table_path), UcTable.from_csv(ILLUSTRATIVE_UC_CSV),
