@@ -217,6 +217,20 @@ class Products:
             self.scene.tables, self.curve(), self.uc_table(),
             package_version("reduced") + package_version("validation"), progress=self._progress))
 
+    def appendix_a(self) -> "Products | None":
+        """For a FEM scene of a Table 1 preset: the same scene fed by Appendix A's F0 through the
+        paper's route (the comparison `cupcheck example` draws), sharing the cache; else None."""
+        s = self.scene
+        if s["stiffness"]["source"] != "fem" or s["cup"]["geometry"] or s.sweep is not None:
+            return None
+
+        def compute():
+            tables = {k: dict(v) for k, v in s.tables.items()}
+            tables["stiffness"].update(source="appendix-a", route="paper")
+            tables["contact"].update(law="frictionless", friction=None)
+            return Products(Scene(tables=tables, outputs=s.outputs, source=s.source), progress=self._progress)._share(self)
+        return self._get("appendix_a", compute)
+
     def variants(self) -> list[tuple[Any, "Products"]]:
         """For a swept scene: (value, the products of the scene with that value), sharing the cache."""
         def compute():
