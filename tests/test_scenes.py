@@ -214,3 +214,14 @@ def test_the_progress_bar_shows_on_a_terminal_only(tmp_path, monkeypatch, capsys
         assert "run" in text and "output" in text and "lifetime 2 of 2 done" in text
     else:
         assert text == ""
+
+
+def test_a_view_beyond_h1_exits_2_and_writes_nothing(tmp_path, capsys):
+    """u_mm past the cup's height: one line naming the key and its range, exit 2, no FEM run, no files."""
+    path = tmp_path / "s.toml"
+    path.write_text('[[outputs]]\nkind = "squeeze"\nu_mm = 50\n')
+    pipeline.COMPUTED.clear()
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--cache-dir", str(tmp_path / "c")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "u_mm must be in (0, h1] = (0, 9.092] mm, got 50" in err[0]
+    assert not (tmp_path / "out").exists() and "fem_path" not in pipeline.COMPUTED
