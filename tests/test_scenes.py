@@ -79,14 +79,15 @@ def test_a_second_run_computes_nothing_and_a_corrupt_entry_is_recomputed(tmp_pat
     cache = tmp_path / "cache"
     pipeline.COMPUTED.clear()
     first = run_scene(scene, tmp_path / "a", cache_dir=cache)
-    assert dict(pipeline.COMPUTED) == {"fem_curve": 1, "uc_table": 1, "lifetimes": 1}
+    once = {"fem_path": 1, "fem_curve": 1, "uc_table": 1, "lifetimes": 2}     # FEM-fed and Appendix A-fed
+    assert dict(pipeline.COMPUTED) == once
     run_scene(scene, tmp_path / "b", cache_dir=cache)
-    assert dict(pipeline.COMPUTED) == {"fem_curve": 1, "uc_table": 1, "lifetimes": 1}      # nothing new
+    assert dict(pipeline.COMPUTED) == once      # nothing new
     assert (tmp_path / "a" / "lifetime_vs_force.csv").read_text() == (tmp_path / "b" / "lifetime_vs_force.csv").read_text()
     for entry in cache.rglob("output.pkl"):            # damage every stored product
         entry.write_bytes(b"not a pickle")
     third = run_scene(scene, tmp_path / "c", cache_dir=cache)
-    assert dict(pipeline.COMPUTED) == {"fem_curve": 2, "uc_table": 2, "lifetimes": 2}
+    assert dict(pipeline.COMPUTED) == {"fem_path": 2, "fem_curve": 2, "uc_table": 2, "lifetimes": 4}
     assert [r.lifetime_s for r in third.products["lifetimes"]] == [r.lifetime_s for r in first.products["lifetimes"]]
 
 
@@ -151,7 +152,7 @@ def test_a_render_runs_the_fem_only_to_its_displacement_and_shows_the_contact(tm
     pipeline.COMPUTED.clear()
     result = run_scene(ROOT / "scenes" / "render_cupA_3mm.toml", tmp_path / "out")
     state = result.products["fem_state_3mm"][-1]
-    assert state.u_m == pytest.approx(3e-3, rel=1e-12) and dict(pipeline.COMPUTED) == {"fem_state": 1}
+    assert state.u_m == pytest.approx(3e-3, rel=1e-12) and dict(pipeline.COMPUTED) == {"fem_path": 1, "fem_frames": 1}
     img = imread(tmp_path / "out" / "cupA_3mm.png")[..., :3]
     assert img.shape[:2] == (700, 900) and img.std() > 0.05
     # viridis' top, shaded by the lights: red and green well above blue (the plane is grey-blue,
@@ -175,6 +176,25 @@ def test_a_coulomb_scene_is_the_command_lines_coulomb_curve(tmp_path, capsys):
     assert len(a) == len(b) and abs(a["F0_N"] - b["F0_N"]).max() <= 1e-9 * b["F0_N"].abs().max()
 
 
+def test_views_of_one_cup_at_one_u_share_one_fem_run(tmp_path):
+    """A render, a footprint and a squeeze ending at the same u (and the same cup, material,
+    contact, fidelity) draw on one FEM path: one run, one stored path product; another u is
+    another path; a second run computes nothing. Counted by the products, not by timing."""
+    scene = {"outputs": [{"kind": "render", "u_mm": 2}, {"kind": "footprint", "u_mm": 2},
+                         {"kind": "squeeze", "u_mm": 2, "frames": 3}, {"kind": "render", "name": "r1", "u_mm": 1}]}
+    cache = tmp_path / "cache"
+    stored = lambda: sorted(p.parent.parent.name for p in cache.rglob("output.pkl"))   # noqa: E731
+    pipeline.COMPUTED.clear()
+    result = run_scene(scene, None, cache_dir=cache)
+    assert dict(pipeline.COMPUTED) == {"fem_path": 2, "fem_frames": 3}       # 2 mm and 1 mm
+    assert stored() == ["_fem_frames"] * 3 + ["_fem_path"] * 2
+    assert sorted(k for k in result.products if k.startswith("fem_path")) == ["fem_path_1mm", "fem_path_2mm"]
+    assert result.products["fem_state_2mm"][-1].u_m == pytest.approx(2e-3, rel=1e-12)
+    assert result.products["fem_state_2mm_3frames"][-1].u_m == result.products["fem_state_2mm"][-1].u_m
+    run_scene(scene, None, cache_dir=cache)
+    assert dict(pipeline.COMPUTED) == {"fem_path": 2, "fem_frames": 3}       # nothing new
+
+
 @pytest.mark.parametrize("tty,quiet", [(True, False), (True, True), (False, False)])
 def test_the_progress_bar_shows_on_a_terminal_only(tmp_path, monkeypatch, capsys, tty, quiet):
     """On a terminal a tqdm bar over the outputs names what runs (the product, the lifetimes k of n);
@@ -194,3 +214,14 @@ def test_the_progress_bar_shows_on_a_terminal_only(tmp_path, monkeypatch, capsys
         assert "run" in text and "output" in text and "lifetime 2 of 2 done" in text
     else:
         assert text == ""
+
+
+def test_a_view_beyond_h1_exits_2_and_writes_nothing(tmp_path, capsys):
+    """u_mm past the cup's height: one line naming the key and its range, exit 2, no FEM run, no files."""
+    path = tmp_path / "s.toml"
+    path.write_text('[[outputs]]\nkind = "squeeze"\nu_mm = 50\n')
+    pipeline.COMPUTED.clear()
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--cache-dir", str(tmp_path / "c")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "u_mm must be in (0, h1] = (0, 9.092] mm, got 50" in err[0]
+    assert not (tmp_path / "out").exists() and "fem_path" not in pipeline.COMPUTED

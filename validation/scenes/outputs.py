@@ -166,7 +166,13 @@ def _lifetime_figure(products: Products):
     fig, ax = _axes("pull force $F_1$ (N)", "lifetime (s)")
     pts = [(r.force_N, r.lifetime_s) for r in results if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
     if pts:
-        ax.semilogy(*zip(*pts), "o-", ms=3, label=f"{s['stiffness']['source']}, {s['stiffness']['route']} route")
+        ax.semilogy(*zip(*pts), "o-", ms=3, label=f"{s['stiffness']['source']}-fed, {s['stiffness']['route']} route")
+    reference = products.appendix_a()           # a FEM scene of a Table 1 cup: Appendix A beside it
+    if reference is not None:
+        ref = [(r.force_N, r.lifetime_s) for r in reference.lifetimes() if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
+        if ref:
+            ax.semilogy(*zip(*ref), "s--", ms=3, label="appendix-a-fed, paper route")
+    if pts or reference is not None:
         ax.legend(fontsize=6)
     ax.set_title(f"cup {s['cup']['preset'] if not s['cup']['geometry'] else Path(s['cup']['geometry']).name}, "
                  f"{s['surface']['preset'] if not s['surface']['uc_table'] else 'u_c table'}", fontsize=7)

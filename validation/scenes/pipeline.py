@@ -1,12 +1,13 @@
 """The products a scene can ask for, computed lazily and cached on disk.
 
-    surface ----------------------------> u_c table ----+
-    cup, material, contact, fidelity ---> FEM curve ----+--> lifetimes (and trajectories)
-    cup (Appendix A) -------------------> curve --------+
+    surface -------------------------------------> u_c table -------+
+    cup, material, contact, fidelity, u_max ---> FEM path --> curve --+--> lifetimes (and trajectories)
+                                                          +-> frames (render, footprint, squeeze)
+    cup (Appendix A) ----------------------------> curve -------------+
 
 `Products` computes each product the first time an output asks for it and keeps it: a scene whose
 outputs need only the u_c table never builds a curve, and a lifetime fed by Appendix A never
-imports `fem`. The expensive products (u_c table, FEM curve, lifetimes) go through `joblib.Memory`
+imports `fem`. The expensive products (u_c table, FEM path, frames, lifetimes) go through `joblib.Memory`
 (a kept library: content-addressed by the function's code and arguments, written atomically,
 recomputed when an entry cannot be read); the key includes a hash of the sources of the package
 that computes the product, so a code change invalidates exactly its products. `COMPUTED` counts
@@ -52,45 +53,49 @@ def _uc_table(surface: dict, code: str):
     return uc_table(preset(surface["preset"]).spectrum(), 0.5)
 
 
-def _compress(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float | None, progress=None):
-    """The FEM response of the scene's cup pressed to u_max_m (default 0.9 h1), and its geometry."""
+def _fem_path(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
+              progress=None):
+    """The FEM path: the scene's cup pressed onto the plane to u_max_m (a `fem.cup.CupResponse`,
+    every converged step). Keyed only by what it depends on (cup, material, contact, fidelity,
+    u_max), so a curve, a render, a footprint and a squeeze ending at the same u share one run."""
+    COMPUTED["fem_path"] += 1
     from fem.cup import compress_cup
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
 
-    geometry = _geometry(cup)
-    if u_max_m is not None and not 0 < u_max_m <= geometry.h1_m:
-        raise ValueError(f"outputs: u_mm must be in (0, h1] = (0, {1e3 * geometry.h1_m:.4g}] mm, got {1e3 * u_max_m:g}")
     law = contact["law"]
-    return geometry, compress_cup(
-        cup_mesh(geometry, fidelity), NeoHookean(E_Pa=material["E_MPa"] * 1e6, nu=material["nu"],
-                                                 formulation="mixed" if material["nu"] > 0.495 else "displacement"),
+    return compress_cup(
+        cup_mesh(_geometry(cup), fidelity),
+        NeoHookean(E_Pa=material["E_MPa"] * 1e6, nu=material["nu"],
+                   formulation="mixed" if material["nu"] > 0.495 else "displacement"),
         contact=law, friction=float(contact["friction"] or 0.0) if law == "coulomb" else 0.0,
-        u_max_m=0.9 * geometry.h1_m if u_max_m is None else u_max_m, progress=progress)
+        u_max_m=u_max_m, progress=progress)
 
 
-def _fem_curve(cup: dict, material: dict, contact: dict, fidelity: str, code: str, progress=None):
+def _fem_curve(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str, path=None):
+    """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`, not part of the key)."""
     COMPUTED["fem_curve"] += 1
     from validation import handoff
 
-    geometry, response = _compress(cup, material, contact, fidelity, None, progress)
-    prov = handoff.provenance(response, geometry=geometry.describe(), mesh={"fidelity": fidelity},
+    response = path()
+    prov = handoff.provenance(response, geometry=_geometry(cup).describe(), mesh={"fidelity": fidelity},
                               fidelity=fidelity)
     return handoff.stiffness_curve(response, prov)
 
 
-def _fem_frames(cup: dict, material: dict, contact: dict, fidelity: str, u_mm: float, n_frames: int,
-                code: str, progress=None) -> list:
+def _fem_frames(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, n_frames: int,
+                code: str, path=None) -> list:
     """The deformed states (`validation.render.frames.CupFrame`, every field) at n_frames plate
-    displacements evenly spaced up to u_mm (1 frame: u_mm itself; more: from 0, each the converged
-    step nearest its target): the FEM runs only to u_mm."""
-    COMPUTED["fem_state"] += 1
+    displacements evenly spaced up to u_max_m (1 frame: u_max_m itself; more: from 0, each the
+    converged step nearest its target), drawn from the FEM path to u_max_m (`path()`, not part of
+    the key: the path is its own product)."""
+    COMPUTED["fem_frames"] += 1
     import numpy as np
 
     from validation.render.frames import frame_from_response
 
-    _, response = _compress(cup, material, contact, fidelity, u_mm * 1e-3, progress)
-    targets = [u_mm * 1e-3] if n_frames == 1 else np.linspace(0.0, u_mm * 1e-3, n_frames)
+    response = path()
+    targets = [u_max_m] if n_frames == 1 else np.linspace(0.0, u_max_m, n_frames)
     steps = [int(np.argmin(np.abs(response.u_m - t))) for t in targets]
     return [frame_from_response(response, k) for k in steps]
 
@@ -169,12 +174,12 @@ class Products:
                                                                       package_version("reduced")))
 
     def curve(self):
-        s = self.scene
-        if s["stiffness"]["source"] == "appendix-a":
+        if self.scene["stiffness"]["source"] == "appendix-a":
             return self._get("curve", self._appendix_a)
-        return self._get("curve", lambda: self._cached(_fem_curve, ignore=["progress"])(
-            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], package_version("fem"),
-            progress=self._fem_progress))
+        s, u_max_m = self.scene, self._u_max_m(None)
+        return self._get("curve", lambda: self._cached(_fem_curve, ignore=["path"])(
+            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m,
+            package_version("fem") + package_version("validation"), path=lambda: self.fem_path(None)))
 
     def _appendix_a(self):
         from reduced.appendix_a import appendix_a_curve
@@ -182,18 +187,49 @@ class Products:
         return appendix_a_curve(CUPS[self.scene["cup"]["preset"]], E_Pa=self.scene["material"]["E_MPa"] * 1e6,
                                 d0_m=2e-3)
 
+    def _u_max_m(self, u_mm: float | None) -> float:
+        """The path's end [m]: u_mm, or 0.9 h1 for the stiffness curve; checked against h1."""
+        h1_m = _geometry(self.scene["cup"]).h1_m
+        if u_mm is None:
+            return 0.9 * h1_m
+        if not 0 < u_mm * 1e-3 <= h1_m:
+            raise ValueError(f"outputs: u_mm must be in (0, h1] = (0, {1e3 * h1_m:.4g}] mm, got {u_mm:g}")
+        return u_mm * 1e-3
+
+    def fem_path(self, u_mm: float | None):
+        """The FEM path to u_mm (None: 0.9 h1), computed once per end point and scene (`_fem_path`)."""
+        s, u_max_m = self.scene, self._u_max_m(u_mm)
+        return self._get(f"fem_path_{1e3 * u_max_m:.6g}mm", lambda: self._cached(_fem_path, ignore=["progress"])(
+            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m, package_version("fem"),
+            progress=self._fem_progress))
+
     def fem_frames(self, u_mm: float, n_frames: int = 1) -> list:
-        """The deformed states at n_frames plate displacements up to u_mm (`_fem_frames`)."""
-        s = self.scene
+        """The deformed states at n_frames plate displacements up to u_mm (`_fem_frames`), drawn from
+        the FEM path to u_mm: a render, a footprint and a squeeze ending at one u share one FEM run."""
+        s, u_max_m = self.scene, self._u_max_m(u_mm)
         name = f"fem_state_{u_mm:g}mm" + (f"_{n_frames}frames" if n_frames > 1 else "")
-        return self._get(name, lambda: self._cached(_fem_frames, ignore=["progress"])(
-            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_mm, n_frames,
-            package_version("fem") + package_version("validation"), progress=self._fem_progress))
+        return self._get(name, lambda: self._cached(_fem_frames, ignore=["path"])(
+            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m, n_frames,
+            package_version("fem") + package_version("validation"), path=lambda: self.fem_path(u_mm)))
 
     def lifetimes(self):
         return self._get("lifetimes", lambda: self._cached(_lifetimes, ignore=["progress"])(
             self.scene.tables, self.curve(), self.uc_table(),
             package_version("reduced") + package_version("validation"), progress=self._progress))
+
+    def appendix_a(self) -> "Products | None":
+        """For a FEM scene of a Table 1 preset: the same scene fed by Appendix A's F0 through the
+        paper's route (the comparison `cupcheck example` draws), sharing the cache; else None."""
+        s = self.scene
+        if s["stiffness"]["source"] != "fem" or s["cup"]["geometry"] or s.sweep is not None:
+            return None
+
+        def compute():
+            tables = {k: dict(v) for k, v in s.tables.items()}
+            tables["stiffness"].update(source="appendix-a", route="paper")
+            tables["contact"].update(law="frictionless", friction=None)
+            return Products(Scene(tables=tables, outputs=s.outputs, source=s.source), progress=self._progress)._share(self)
+        return self._get("appendix_a", compute)
 
     def variants(self) -> list[tuple[Any, "Products"]]:
         """For a swept scene: (value, the products of the scene with that value), sharing the cache."""

@@ -25,8 +25,9 @@
                      kind = "squeeze" with u_mm (the last frame) and frames = N (2 .. 60), field:
                      N frames from u = 0 to u_mm (PNG) and their animated GIF
 
-Every table and key is optional but `outputs`; defaults are the main job's (cup A, frictionless
-FEM at the coarse level, the paper's route, pmma-1.89, air, F1 = 5 ... 80 N). Unknown keys, wrong
+Every table and key is optional but `outputs`; defaults: cup A, frictionless FEM at the
+coarse level, the paper's route, pmma-1.89, air, F1 = 5, 10, 20, 40, 80 N (the main job,
+scenes/main.toml, sets the medium level and F1 = 5, 10, ..., 80 N). Unknown keys, wrong
 types and contradictions are ValueErrors naming the key path (``outputs[2].kind: expected one of
 ...``): one line and exit status 2 on the command line, before anything is computed or written.
 Paths in the scene are relative to the scene file.
