@@ -20,7 +20,7 @@ Coulomb contact it does, and the grid is the response to that order.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -88,11 +88,15 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
         return lambda t: (top_dofs, np.concatenate([np.zeros(len(top)),
                                                     np.full(len(top), -(u0 + moving * t))]))
 
+    # a dp interval is one load step unless it needs cutting: the grid itself is the sampling
+    ramp_options = replace(options, initial_step=1.0, max_step=1.0)
+
     def segment(mech, dirichlet, t_max, start, where) -> tuple[StepResult, SolverStats]:
         last: list[StepResult] = []
         try:
-            stats = follow_path(mech, dirichlet, t_max, plane=plane, options=options,
-                                on_step=last.append, start=start)
+            stats = follow_path(mech, dirichlet, t_max, plane=plane, start=start,
+                                options=ramp_options if isinstance(mech, PressurizedMechanics) else options,
+                                on_step=last.append)
         except RuntimeError as err:
             err.args = (f"{where}: {err}",)
             raise
