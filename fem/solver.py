@@ -83,7 +83,7 @@ from scipy.optimize import nnls
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
 from .condensation import make_solver
-from .friction import CoupledFactor, friction_iterate, sliding_coupling
+from .friction import CoupledFactor, friction_iterate, landing_slip, sliding_coupling
 from .linsolve import NotPositiveDefinite
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
@@ -313,8 +313,11 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         free, dofs, du_fixed = _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state)
         f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext0), _force_floor(mech))
         if plane is not None and plane.law == "coulomb":
-            state, fric, flips = friction_iterate(plane, state, u, res if lin is None else lin,
-                                                  res, K, opts.rtol * f_ref, flips)
+            if lin is None:     # warm start: the committed stick/slide set (no step predicted yet)
+                fric = plane.friction_force(state, res)
+            else:
+                state, fric, flips = friction_iterate(plane, state, u, lin, res, K,
+                                                      opts.rtol * f_ref, flips)
             Pi += (fext - fext0 - fric) @ u           # the same W, the new load
             fext = fext0 + fric
             res = r - fext
@@ -351,9 +354,10 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
                                                  K, fext, shift, held, history)
         if plane is not None:
             released |= step.release
-            state = plane.hold(state, step.holds(alpha), u, u_start,
-                               u_prev + max(alpha, 1.0) * step.du0, released)
+            u_free = u_prev + max(alpha, 1.0) * step.du0
             lin = res0 + alpha * Kdu
+            state = landing_slip(plane, state, plane.hold(state, step.holds(alpha), u, u_start,
+                                                          u_free, released), u_free, lin, K)
 
 
 def _balanced(rnorm: float, tol: float, du: np.ndarray, u: np.ndarray) -> bool:
