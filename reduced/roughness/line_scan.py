@@ -23,7 +23,6 @@ import os
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from .spectrum import PowerSpectrum, line_to_isotropic
 
@@ -113,6 +112,7 @@ def spectrum_from_line_scan(x_m: np.ndarray, z_m: np.ndarray, tip_radius_m: floa
         raise ValueError("line scan: fewer than 8 usable spectral bins after the tip cutoff")
     # the Abel inversion differentiates C_1D: smooth ln C_1D over ~1/3 decade first
     win = min(2 * (per_decade // 6) + 1, qb.size - (1 - qb.size % 2))
+    from scipy.signal import savgol_filter   # here: scipy.signal costs 0.3 s to import
     Cs = np.exp(savgol_filter(np.log(Cb), max(win, 3), 2)) if win >= 3 else Cb
     C = line_to_isotropic(qb, Cs)
     good = C > 0
