@@ -89,10 +89,12 @@ def main() -> None:
         print(f"coarse default grid against {name:>16}: " + ", ".join(f"{d:+.2f} %" for d in diff))
     medium, _ = table("medium", *grids()["medium"], args.tables)
     beta = fem_beta(medium)
-    with np.printoptions(precision=2, suppress=True, linewidth=150):
-        print("beta (medium; rows u/h1 = " + ", ".join(f"{f:g}" for f in U_FRACTIONS)
-              + "; columns dp = 10 ... 100 kPa):")
-        print(beta)
+    rows_u = [0.1, 0.25, 0.4, 0.55, 0.7]
+    cols = [int(np.argmin(np.abs(medium.dp_Pa[1:] - 1e3 * d))) for d in (10, 30, 60, 100)]
+    print("beta (medium), dp = 10 / 30 / 60 / 100 kPa:")
+    for f in rows_u:
+        i = int(np.argmin(np.abs(np.array(U_FRACTIONS) - f)))
+        print(f"  u = {f:g} h1: " + " / ".join(f"{beta[i, j]:.2f}" for j in cols))
 
 
 if __name__ == "__main__":

@@ -186,7 +186,8 @@ class CoupledCavity:
         dp = self._dp[j]
         r, p = prof.r_m, self.kappa * prof.p_Pa
         rk, rcut = self.table.seal_r_m[i, j], self.table.cut_r_m[i, j]
-        zone = (r >= rk) & (r <= rcut)
+        tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too
+        zone = (r >= rk - tol) & (r <= rcut + tol)
         rise = {"p_b": 0.0, "p_a": 1.0}.get(self.interface)
         if rise is None:
             rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
