@@ -6,8 +6,8 @@ eq (6) and beta = 0.8, fed by three stiffness sources: `appendix-a` (the no-slip
 `fem-frictionless` (the FEM on a frictionless plane: the soap-lubricated glass on which the paper
 measured the F0 its lifetimes use, Sec. 5.3-5.5) and `fem-sticking` (no slip, Appendix A's
 assumption); and the profile route on the frictionless FEM (its r_c, V and contact-pressure
-profile, `reduced.seal`). The coupled route (the cavity's suction acting on the FEM cup) is not
-built yet. Lifetimes are computed as the paper computed its own: E_eff(t) relaxation (the default
+profile, `reduced.seal`). The coupled route (`cupcheck lifetime --route coupled`,
+docs/lifetime.md) is not in this table yet. Lifetimes are computed as the paper computed its own: E_eff(t) relaxation (the default
 law through 4.4 MPa at 1 s and 1.8 MPa at 3e4 s), air at 293.15 K, p_a = 1e5 Pa, Table 1's cups,
 u_c from the calibrated surface presets (Persson theory, EMT). Water runs without relaxation, with
 E = 4 MPa (the dashed lines of the paper's Fig. 1rStart). Nothing is tuned to a measured lifetime.
