@@ -119,10 +119,6 @@ class CavitySurface:
             k += 1
         return k
 
-    def sealed(self, x: np.ndarray) -> bool:
-        """Whether any node of the chain lies on the plane (else the cavity is open)."""
-        return bool(np.any(x[1, self.nodes] <= self.tolerance_m))
-
     def seal_radius(self, x: np.ndarray) -> float:
         """r_k: the deformed radius of the seal node [m]."""
         return float(x[0, self.nodes[self.seal_index(x)]])

@@ -155,13 +155,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     (a RuntimeError) if a step cannot be converged.
     """
     h1 = cup_height(mesh)
-    if contact not in CONTACT_LAWS:
-        raise ValueError(f"contact: must be one of {', '.join(CONTACT_LAWS)}, got {contact!r}")
-    if contact != "coulomb" and friction != 0.0:
-        raise ValueError(f"friction: Coulomb's coefficient applies to contact='coulomb' only, "
-                         f"got friction={friction} with contact={contact!r}")
-    if not isinstance(material, NeoHookean):
-        raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
+    cup = CupSetup.of(mesh, material, contact, friction)
     u_max = 0.9 * h1 if u_max_m is None else float(u_max_m)
     if h1 < u_max <= h1 * (1 + 1e-9):        # h1 itself, up to the round-off of a unit conversion
         u_max = h1
@@ -170,17 +164,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
                          f"{h1 * 1e3:.4g} mm] (at u = h1 the plate reaches the plane), "
                          f"got {u_max * 1e3:.4g} mm")
     options = SolverOptions(**solver_opts)
-
-    kin = Kinematics.of(mesh)
-    mech = Mechanics(kin, material)
-    top = _boundary_nodes(mesh, "top_plate")
-    plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top, friction=friction)
-    top_dofs = np.concatenate([2 * top, 2 * top + 1])
-    path = boundary_path(mesh, "cavity")
-
-    def dirichlet(u):
-        return top_dofs, np.concatenate([np.zeros(len(top)), np.full(len(top), -u)])
-
+    mech, plane, top, path = cup.mech, cup.plane, cup.top, cup.path
     steps: list[_StepOutputs] = []
 
     def on_step(s: StepResult) -> None:
@@ -192,13 +176,46 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
             progress(s.t / u_max, f"step {len(steps) - 1}: u = {s.t * 1e3:.4g} mm of {u_max * 1e3:.4g} mm, "
                                   f"{s.iterations} Newton iterations")
 
-    stats = follow_path(mech, dirichlet, u_max, plane=plane, options=options, on_step=on_step,
-                        name="u [m]")
+    stats = follow_path(mech, cup.plate_at(0.0), u_max, plane=plane, options=options,
+                        on_step=on_step, name="u [m]")
     per_step = {f.name: np.array([getattr(st, f.name) for st in steps])
                 for f in fields(_StepOutputs) if f.name not in _PER_STEP_OBJECTS}
     return CupResponse(h1_m=h1, contact=contact, friction=friction, material=material, stats=stats, mesh=mesh,
                        **per_step, **{name: tuple(getattr(st, name) for st in steps)
                                       for name in _PER_STEP_OBJECTS})
+
+
+@dataclass(frozen=True, eq=False)
+class CupSetup:
+    """What every cup job sets up: the body, the plane (every boundary node but the plate's may
+    touch it), the top plate's nodes and the cavity path (plate edge -> rim)."""
+
+    mech: Mechanics
+    plane: RigidPlane
+    top: np.ndarray
+    path: np.ndarray
+
+    @classmethod
+    def of(cls, mesh: Mesh, material: NeoHookean, contact: str, friction: float = 0.0) -> "CupSetup":
+        """Check the contact law, Coulomb's mu and the material (ValueError) and build the setup."""
+        if contact not in CONTACT_LAWS:
+            raise ValueError(f"contact: must be one of {', '.join(CONTACT_LAWS)}, got {contact!r}")
+        if contact != "coulomb" and friction != 0.0:
+            raise ValueError(f"friction: Coulomb's coefficient applies to contact='coulomb' only, "
+                             f"got friction={friction} with contact={contact!r}")
+        if not isinstance(material, NeoHookean):
+            raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
+        kin = Kinematics.of(mesh)
+        top = _boundary_nodes(mesh, "top_plate")
+        plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top, friction=friction)
+        return cls(Mechanics(kin, material), plane, top, boundary_path(mesh, "cavity"))
+
+    def plate_at(self, u0_m: float, moving: bool = True) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
+        """The prescribed plate, u_r = 0 and u_z = -(u0 + t) (moving) or -u0 (held), as
+        `fem.solver.follow_path`'s dirichlet(t)."""
+        dofs = np.concatenate([2 * self.top, 2 * self.top + 1])
+        zeros = np.zeros(len(self.top))
+        return lambda t: (dofs, np.concatenate([zeros, np.full(len(self.top), -(u0_m + moving * t))]))
 
 
 def _joined(a: SolverStats, b: SolverStats) -> SolverStats:

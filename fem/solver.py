@@ -231,7 +231,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         W1 = m1.energy(u1)
         defect = W0 + _work(dirichlet, f_ext, t, t1, u0, u1, r0, r1) - W1
         if m1 is not m0:        # the work of the potential's own parameter, by the trapezoid
-            defect += 0.5 * (m1.energy(u0) - m0.energy(u0) + m1.energy(u1) - m0.energy(u1))
+            defect += 0.5 * (m1.energy(u0) - W0 + W1 - m0.energy(u1))
         conservative = _conservative(plane)
         if conservative and _jumped_too_far(indefinite, defect, W0, W1, t1 - t, jumps, options,
                                             t_max):

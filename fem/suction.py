@@ -27,13 +27,10 @@ import numpy as np
 from skfem import Mesh
 
 from .cavity import CavitySurface, PressurizedMechanics
-from .contact import CONTACT_LAWS, PressureProfile, RigidPlane
-from .cup import _boundary_nodes, _joined, _measure, cup_height
-from .forms import Mechanics
+from .contact import PressureProfile
+from .cup import CupSetup, _joined, _measure, cup_height
 from .integrity import check_state
-from .kinematics import Kinematics
 from .material import NeoHookean
-from .mesh import boundary_path
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
 __all__ = ["SuctionGrid", "suction_grid"]
@@ -72,56 +69,42 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
     u = np.asarray(u_m, float)
     dp = np.asarray(dp_Pa, float)
     _check_axes(u, dp, h1, material)
-    if contact not in CONTACT_LAWS:
-        raise ValueError(f"contact: must be one of {', '.join(CONTACT_LAWS)}, got {contact!r}")
+    cup = CupSetup.of(mesh, material, contact, friction)
     options = SolverOptions(**solver_opts)
-    kin = Kinematics.of(mesh)
-    body = Mechanics(kin, material)
-    top = _boundary_nodes(mesh, "top_plate")
-    plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top, friction=friction)
-    top_dofs = np.concatenate([2 * top, 2 * top + 1])
-    path = boundary_path(mesh, "cavity")
-    cavity = CavitySurface.of(mesh, wetting_m)
-
-    def plate_at(u0: float, moving: bool) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
-        """The plate at u0 (+ t while pressing)."""
-        return lambda t: (top_dofs, np.concatenate([np.zeros(len(top)),
-                                                    np.full(len(top), -(u0 + moving * t))]))
-
     # a dp interval is one load step unless it needs cutting: the grid itself is the sampling
     ramp_options = replace(options, initial_step=1.0, max_step=1.0)
+    cavity = CavitySurface.of(mesh, wetting_m)
 
-    def segment(mech, dirichlet, t_max, start, where) -> tuple[StepResult, SolverStats]:
+    def segment(mech, dirichlet, t_max, start, u_plate, where) -> tuple[StepResult, SolverStats]:
+        """The converged state at the end of one path (pressing, or a dp interval at u_plate)."""
         last: list[StepResult] = []
         try:
-            stats = follow_path(mech, dirichlet, t_max, plane=plane, start=start,
+            stats = follow_path(mech, dirichlet, t_max, plane=cup.plane, start=start,
                                 options=ramp_options if isinstance(mech, PressurizedMechanics) else options,
                                 on_step=last.append)
         except RuntimeError as err:
             err.args = (f"{where}: {err}",)
             raise
         end = last[-1]
-        check_state(mesh, end.u, u_i_now[0], 0, u_i_now[0])     # contact kept between the nodes
+        check_state(mesh, end.u, u_plate, 0, u_plate)     # contact kept between the nodes
         return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0), stats
 
-    u_i_now = [0.0]         # the plate displacement of the running segment, for messages
     outputs = np.empty((u.size, dp.size), dtype=object)
     total: SolverStats | None = None
     pressed, u_prev = None, 0.0
     for i, u_i in enumerate(u):
-        u_i_now[0] = u_i
-        pressed, stats = segment(body, plate_at(u_prev, True), u_i - u_prev, pressed,
+        pressed, stats = segment(cup.mech, cup.plate_at(u_prev), u_i - u_prev, pressed, u_i,
                                  f"pressing to u = {u_i * 1e3:.4g} mm")
         total = stats if total is None else _joined(total, stats)
         u_prev, state = u_i, pressed
-        outputs[i, 0] = _outputs(state, body, plane, top, path, cavity)
+        outputs[i, 0] = _outputs(state, cup.mech, cup, cavity)
         for j in range(1, dp.size):
             lo, hi = dp[j - 1], dp[j]
-            mech = PressurizedMechanics(body, cavity, hi, schedule=lambda t, lo=lo, hi=hi: lo + t * (hi - lo))
-            state, stats = segment(mech, plate_at(u_i, False), 1.0, state,
+            mech = PressurizedMechanics(cup.mech, cavity, hi, schedule=lambda t, lo=lo, hi=hi: lo + t * (hi - lo))
+            state, stats = segment(mech, cup.plate_at(u_i, moving=False), 1.0, state, u_i,
                                    f"u = {u_i * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {hi / 1e3:.4g} kPa")
             total = _joined(total, stats)
-            outputs[i, j] = _outputs(state, mech.at(1.0), plane, top, path, cavity)
+            outputs[i, j] = _outputs(state, mech.at(1.0), cup, cavity)
             if progress:
                 progress((i * (dp.size - 1) + j) / (u.size * (dp.size - 1)),
                          f"u = {u_i * 1e3:.4g} mm, dp = {hi / 1e3:.4g} kPa")
@@ -134,13 +117,13 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
         profiles=tuple(tuple(o[7] for o in row) for row in outputs), stats=total)
 
 
-def _outputs(state: StepResult, mech, plane, top, path, cavity) -> tuple:
+def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:
     """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile) of a converged state. F1 = -F0, the plate's
     reaction, which with suction includes the roof's share dp pi r_0^2; N is the plane's
     reaction less the suction dp pi (r_cut^2 - r_k^2) that the load puts on the flat contact
     zone beyond the seal (there the interface is outside the cavity), so F1 + N = dp pi r_k^2
     (`fem.cavity`). The profile is the plane's reaction per area (the gap at p_b)."""
-    m = _measure(state, mech, plane, top, path)
+    m = _measure(state, mech, cup.plane, cup.top, cup.path)
     x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])
     dp = getattr(mech, "dp_Pa", 0.0)
     r_k = cavity.seal_radius(x)
