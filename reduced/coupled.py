@@ -25,9 +25,12 @@ the seal to the zone's outer edge (``interface="linear"``; "p_b" keeps the table
 whole dp off: the two bounds).
 
 The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a dp
-grid of `samples` points. A stiffness factor kappa scales the modulus exactly (a neo-Hookean body
-with frictionless contact: forces and pressures scale with E at fixed dp / E): F1(u, dp) =
-kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa). Relaxation is not modelled here.
+grid of `samples` points. A stiffness factor kappa makes the cup kappa times stiffer, as the
+paper's kappa multiplies F0 (Fig. 1stiffnessFactor): a neo-Hookean body in frictionless contact
+with modulus kappa E answers dp exactly as the table's body answers dp / kappa, so F1(u, dp) =
+kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa) and the contact pressures scale
+likewise, while u_c(p/E) keeps the table's E (the same rubber at the interface, as in the paper
+route). Relaxation is not modelled here.
 """
 
 from __future__ import annotations
@@ -89,8 +92,8 @@ class CoupledLifetime:
 
 @dataclass(frozen=True, eq=False)
 class CoupledCavity:
-    """The coupled reduced model (module docstring). u_c: critical gap [m] of p/E; E_Pa: the
-    modulus in p/E (default: the table's times kappa)."""
+    """The coupled reduced model (module docstring). u_c: critical gap [m] as a function of p/E,
+    with E the table's modulus."""
 
     table: SuctionTable
     u_c: Callable[[float], float]
@@ -158,7 +161,7 @@ class CoupledCavity:
     def _node_conductance(self) -> np.ndarray:
         """Ndot / dp [1/(s Pa)] at every node (u_i, dp_j) through its profile with p_b = p_a - dp_j;
         at dp = 0 its limit, from a 1 Pa difference (nan beyond p_a)."""
-        E = self.kappa * self.table.E_Pa
+        E = self.table.E_Pa
         out = np.full((self._u.size, self._dp.size), np.nan)
         for i in range(self._u.size):
             for j, dp in enumerate(self._dp):
