@@ -124,8 +124,13 @@ class CoupledCavity:
 
     @cached_property
     def _dp(self) -> np.ndarray:
-        """The table's dp axis in the model's units (kappa dp_tab), cut at p_a (p_b >= 0)."""
+        """The table's dp axis for the kappa-times-stiffer cup (kappa dp_tab)."""
         return self.kappa * self.table.dp_Pa
+
+    @cached_property
+    def _dp_top(self) -> float:
+        """The largest dp a state can have: the table's, at most p_a (p_b >= 0)."""
+        return float(min(self._dp[-1], self.p_a_Pa))
 
     def F1(self, u: float, dp: float) -> float:
         """Pull on the handle [N] at (u, dp)."""
@@ -213,12 +218,17 @@ class CoupledCavity:
 
     def content(self, F1: float, dp: float) -> tuple[float, float]:
         """(u, N) of the state on the F1 branch at dp."""
+        u, V = self._on_branch(F1, dp)
+        return u, (self.p_a_Pa - dp) * V / self.gas.kT_J
+
+    def _on_branch(self, F1: float, dp: float) -> tuple[float, float]:
+        """(u, V) of the state on the F1 branch at dp."""
         u = self.u_at(F1, dp)
-        return u, (self.p_a_Pa - dp) * self.V(u, dp) / self.gas.kT_J
+        return u, self.V(u, dp)
 
     def _dp_range(self, F1: float) -> tuple[float, float]:
         """The dp interval of the branch inside the table: u from u_min (low dp) to u_max."""
-        top = min(self._dp[-1], self.p_a_Pa)
+        top = self._dp_top
         if F1 > self.F1(self._u[0], top):
             return math.nan, math.nan
         lo = 0.0 if F1 <= self.F1(self._u[0], 0.0) else brentq(
@@ -232,7 +242,7 @@ class CoupledCavity:
         if not self._u[0] <= u_start_m <= self._u[-1]:
             raise ValueError(f"u_start: must lie in the table's u range [{1e3 * self._u[0]:.4g}, "
                              f"{1e3 * self._u[-1]:.4g}] mm, got {1e3 * u_start_m:.4g} mm")
-        top = min(self._dp[-1], self.p_a_Pa)
+        top = self._dp_top
         if self.F1(u_start_m, top) < 0:
             raise ValueError(f"u_start: the table's dp <= {top / 1e3:.4g} kPa cannot hold the cup "
                              f"released at u = {1e3 * u_start_m:.4g} mm")
@@ -247,7 +257,7 @@ class CoupledCavity:
         def holds(F1: float) -> bool:
             lo, _ = self._dp_range(F1)
             return bool(np.isfinite(lo)) and N0 <= self.content(F1, lo)[1]
-        lo, hi = 0.0, self.F1(self._u[0], min(self._dp[-1], self.p_a_Pa))
+        lo, hi = 0.0, self.F1(self._u[0], self._dp_top)
         if holds(hi):
             return hi
         for _ in range(60):
@@ -272,14 +282,14 @@ class CoupledCavity:
                              f"{1e3 * self._u[-1]:.4g} mm; extend the table")
         dp0 = brentq(lambda d: self.content(F1, d)[1] - N0, lo, hi, xtol=1e-10 * max(hi, 1.0))
         dps = np.linspace(dp0, lo, self.samples)
-        u, N = np.array([self.content(F1, d) for d in dps]).T
+        u, V = np.array([self._on_branch(F1, d) for d in dps]).T
+        N = (self.p_a_Pa - dps) * V / self.gas.kT_J
         rising = np.diff(N) > 0
         end, reason = self.samples, "table_edge"
         if not np.all(rising):
             end, reason = int(np.argmin(rising)) + 1, "fold"
-        dps, u, N = dps[:end], u[:end], N[:end]
+        dps, u, N, V = dps[:end], u[:end], N[:end], V[:end]
         q = np.array([self.Ndot(a, b) for a, b in zip(u, dps)])
-        V = np.array([self.V(a, b) for a, b in zip(u, dps)])
         if np.any(q <= 0):
             k = int(np.argmax(q <= 0))
             return CoupledLifetime(F1, math.inf, "sealed", f"the interface seals at u = "
