@@ -12,8 +12,10 @@ from reduced.coupled import CoupledCavity
 from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
 from reduced.cup import CUP_A
 from reduced.gas import Gas
+from reduced.profile_leak import ContactProfile
 from reduced.suction_table import SuctionTable
 from validation.cli import main
+from validation.coupled.table import fem_beta
 
 
 def _run(capsys, *argv):
@@ -93,3 +95,16 @@ def test_suction_bad_input(capsys, tmp_path, extra, field):
 def test_suction_refuses_a_csv_output(capsys, tmp_path):
     code, _, err = _run(capsys, "suction", "--out", str(tmp_path / "t.csv"))
     assert code == 2 and "out" in err and not (tmp_path / "t.csv").exists()
+
+
+def test_fem_beta_reads_back_a_known_strip_load():
+    """fem_beta on a table whose contact force grows by b dp 2 pi r_k l over a uniform strip of
+    width l (force-quartile width exact for a uniform strip) returns b at every node."""
+    r_k, l, b, F0 = 0.015, 2e-3, 0.7, 3.0
+    u, dp = np.array([1e-3, 2e-3]), np.array([0.0, 1e4, 5e4])
+    N = F0 + b * dp * 2 * np.pi * r_k * l
+    F1 = np.tile(dp * np.pi * r_k**2 - N, (2, 1))
+    strip = ContactProfile(np.linspace(r_k, r_k + l, 41), np.full(41, 1e5))
+    table = SuctionTable(u, dp, F1, np.full((2, 3), 1e-6), np.full((2, 3), r_k),
+                         np.full((2, 3), r_k + l), ((strip,) * 3,) * 2, E_Pa=4e6)
+    assert np.allclose(fem_beta(table), b, rtol=1e-9)

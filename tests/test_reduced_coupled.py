@@ -106,3 +106,4 @@ def test_interface_gas_bounds_the_lifetime(model):
                              radial="strip").lifetime(10.0, u_start).lifetime_s
             for i in ("p_a", "linear", "p_b")}
     assert life["p_a"] < life["linear"] < life["p_b"]
+

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from fem.suction import SuctionGrid
-from reduced.profile_leak import ContactProfile
+from reduced.stiffness_curve import profiles_from_lists
 from reduced.suction_table import SuctionTable
 
 __all__ = ["suction_table", "fem_beta"]
@@ -15,7 +15,8 @@ __all__ = ["suction_table", "fem_beta"]
 
 def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -> SuctionTable:
     """The hand-off table of an FEM grid: F1, V, r_k, r_cut and the lumped nodal contact
-    pressures (radii strictly increasing, duplicates at a node shared by two facets dropped)."""
+    pressures, converted as the stiffness sidecar's are (`profiles_from_lists`: a node shared by
+    two facets merged, fewer than two points or no pressure is None)."""
     m = grid.material
     prov = {"source": "fem.suction", "contact": grid.contact, "E_Pa": m.E_Pa, "nu": m.nu,
             "formulation": m.formulation, "h1_mm": 1e3 * grid.h1_m,
@@ -24,17 +25,10 @@ def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -
             **(provenance or {})}
     return SuctionTable(u_m=grid.u_m, dp_Pa=grid.dp_Pa, F1_N=grid.F1_N, V_m3=grid.V_m3,
                         seal_r_m=grid.seal_r_m, cut_r_m=grid.cut_r_m,
-                        profiles=tuple(tuple(_profile(p) for p in row) for row in grid.profiles),
+                        profiles=tuple(profiles_from_lists([1e3 * p.r_m for p in row],
+                                                           [1e-3 * p.p_Pa for p in row])
+                                       for row in grid.profiles),
                         E_Pa=m.E_Pa, provenance=prov)
-
-
-def _profile(p) -> ContactProfile | None:
-    r, pr = np.asarray(p.r_m), np.asarray(p.p_Pa)
-    keep = np.concatenate([[True], np.diff(r) > 0]) if r.size else np.zeros(0, bool)
-    r, pr = r[keep], pr[keep]
-    if r.size < 2 or not np.any(pr > 0):
-        return None
-    return ContactProfile(r, np.maximum(pr, 0.0))
 
 
 def fem_beta(table: SuctionTable) -> np.ndarray:
