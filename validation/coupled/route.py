@@ -26,7 +26,8 @@ class _TableDesign:
 
 
 def coupled_model(args: argparse.Namespace):
-    """(CoupledCavity, u_start [m], cup description) from the options; ValueError on bad input."""
+    """(CoupledCavity, u_start [m], the `CupChoice`, the cup's description for the outputs) from
+    the options; ValueError on bad input."""
     from reduced.coupled import CoupledCavity
     from reduced.gas import Gas
     from reduced.suction_table import SuctionTable
