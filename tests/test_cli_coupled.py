@@ -69,7 +69,7 @@ def test_coupled_route_matches_the_library(capsys, table_path, tmp_path):
     (["lifetime", "--route", "coupled", "--suction-table", "nowhere.json"], "--suction-table"),
     (["lifetime", "--suction-table", "TABLE", "--force", "5"], "--suction-table"),
     (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--kappa", "-1"], "--kappa"),
-    (["example", "--route", "coupled"], "--route"),
+    (["example", "--route", "coupled", "--suction-table", "nowhere.json"], "--suction-table"),
 ])
 def test_coupled_route_bad_input(capsys, table_path, tmp_path, argv, field):
     argv = [str(table_path) if a == "TABLE" else a for a in argv]

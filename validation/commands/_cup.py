@@ -75,12 +75,19 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = 
                    help="eq (5)'s strip width at r1 in mm (with --l0-mm)")
 
 
-def route_model(args: argparse.Namespace) -> tuple[str, str]:
+def route_model(args: argparse.Namespace, coupled: bool = False) -> tuple[str, str]:
     """(geometry, seal) of the `LeakageModel` the route and cup-law options ask for; fills
-    ``args.cup_laws`` with the route's default."""
+    ``args.cup_laws`` with the route's default. `coupled`: the command runs the coupled route
+    itself (its geometry is the suction table's: --cup-laws does not apply)."""
     seal = ROUTES[args.route]
     if seal == "coupled":
-        raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
+        if not coupled:
+            raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
+        if args.cup_laws is not None:
+            raise ValueError("--cup-laws: the coupled route takes r and V from the FEM suction table; "
+                             "drop --cup-laws")
+        args.cup_laws = "curve"
+        return args.cup_laws, seal
     if args.cup_laws is None:
         args.cup_laws = "curve" if seal == "profile" else "cone"
     if seal == "profile" and args.cup_laws != "curve":

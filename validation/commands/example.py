@@ -3,20 +3,28 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
 
 1. FEM (fem.cup.compress_cup): cup A of Table 1 / Sec. 5.5 (alpha 33 deg, wall 2.5 -> 0.3 mm at
    r = 5 -> 20 mm), compressible neo-Hookean E = 4 MPa, nu = 0.49, pressed onto the plane to 0.9 h1
-   at the default mesh level (medium), sticking contact by default (Appendix A's no-slip assumption;
-   `cupcheck validate` shows the frictionless curve is ~6x softer at small u).
+   at the default mesh level (medium), frictionless contact by default (the paper measured its F0
+   on soap-lubricated glass, Sec. 5.5; sticking is Appendix A's no-slip bound).
 2. Rough contact: u_c(p/E) of the calibrated sandblasted PMMA, 1.89 um rms (`pmma-1.89`, Persson
    theory, EMT, nu = 0.5), the surface of the paper's Figs. for cup A.
 3. Reduced model (Sec. 3-4) in reference conventions (no relaxation, E = 4 MPa in p/E, air at
-   293.15 K, p_a = 1e5 Pa) with F0(h) from step 1 and r, V, l from the cone laws (3)-(5) with
-   Table 1's l0, l1 (--cup-laws curve takes them from the FEM instead). Another design
-   (--geometry FILE) runs the same chain on its own geometry (`validation.design`).
+   293.15 K, p_a = 1e5 Pa), by the chosen route:
+   - paper (default): F0(h) from step 1, r, V, l from the cone laws (3)-(5) with Table 1's l0, l1
+     (--cup-laws curve takes them from the FEM instead), the leak through eq (6)'s uniform strip;
+   - profile: F0, r_c, V from the FEM curve, the leak through its contact-pressure profiles;
+   - coupled: the FEM cup under the cavity's suction on a (u, dp) grid (`cupcheck suction`,
+     built here and cached in --cache-dir, or read from --suction-table): F1, V and the profile of
+     every state from the FEM, replacing eqs (3)-(7) and beta (`reduced.coupled`). Building the
+     table takes ~3 min (coarse) to ~8 min (medium) once per design and law.
+   Another design (--geometry FILE) runs the same chain on its own geometry (`validation.design`).
 
 Writes to DIR, atomically:
 
-  lifetime_vs_force.csv   cup, force_N, lifetime_s, reason, ballistic_share, r_final_mm, p_b_final_Pa
+  lifetime_vs_force.csv   cup, route, force_N, lifetime_s, reason, then ballistic_share, r_final_mm
+                          (paper, profile) or u_final_mm (coupled), and p_b_final_Pa
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
+  suction_table.json      coupled route: the FEM suction table the lifetimes used
 """
 
 from __future__ import annotations
@@ -46,6 +54,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fidelity", default=None, choices=("coarse", "medium", "fine"),
                    help="FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
                         "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)")
+    c = p.add_argument_group("coupled route")
+    c.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
+                   help="the design's table from `cupcheck suction` (default: built at --fidelity "
+                        "with --contact and cached)")
+    c.add_argument("--cache-dir", type=Path, default=Path(".cupcheck-cache/suction"), metavar="DIR",
+                   help="where built suction tables are kept (default .cupcheck-cache/suction)")
+    c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
     src = p.add_mutually_exclusive_group()
     src.add_argument("--surface", default=None, metavar="NAME",
                      help="calibrated surface preset for u_c(p/E) (default: pmma-1.89)")
@@ -99,12 +114,53 @@ def write_table(results, path: Path, cup: str, route: str) -> None:
     from validation.output import write_table as write_csv
 
     s = [r.summary() for r in results]
+    own = ("u_final_mm",) if route == "coupled" else ("ballistic_share", "r_final_mm")
     write_csv(path, {"cup": cup, "route": route, "force_N": [r.force_N for r in results],
                      "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in s],
                      "reason": [r.reason for r in results],
-                     "ballistic_share": [x["ballistic_share"] for x in s],
-                     "r_final_mm": [x["r_final_mm"] for x in s],
-                     "p_b_final_Pa": [x["p_b_final_Pa"] for x in s]}, stage="example lifetimes")
+                     **{key: [_blank(x[key]) for x in s] for key in (*own, "p_b_final_Pa")}},
+              stage="example lifetimes")
+
+
+def _blank(value):
+    """A final state's value, or an empty field where the cup held no state (over_force)."""
+    return "" if value is None else value
+
+
+def coupled_lifetimes(args: argparse.Namespace, geometry, uc, choice, tmp: Path):
+    """The coupled route's lifetimes [CoupledLifetime] and largest holdable force [N]: the design's
+    suction table (read, or built and cached), copied to the output."""
+    from reduced.coupled import CoupledCavity
+    from reduced.suction_table import SuctionTable
+    from validation.coupled.build import suction_table_for
+    from validation.output import terminal_progress
+
+    if args.suction_table is not None:
+        table = SuctionTable.from_json(args.suction_table)
+    else:
+        table = suction_table_for(geometry, fidelity=args.fidelity, contact=args.contact,
+                                  cache_dir=None if args.no_cache else args.cache_dir,
+                                  progress=terminal_progress("suction"))
+    table.to_json(tmp / "suction_table.json")
+    u_start = 1e-3 * table.provenance["h1_mm"] - choice.cup.h_start_m
+    model = CoupledCavity(table, uc)
+    results = [model.lifetime(F, u_start) for F in FORCES_N]
+    return results, model.largest_holdable_force(u_start)
+
+
+def _check_suction_table(args: argparse.Namespace, geometry) -> None:
+    """--suction-table: only with the coupled route, an existing table of this very design."""
+    if args.suction_table is None:
+        return
+    if args.route != "coupled":
+        raise ValueError("--suction-table: applies to --route coupled only")
+    from reduced.suction_table import SuctionTable
+    if not Path(args.suction_table).is_file():
+        raise ValueError(f"--suction-table: no such file '{args.suction_table}'")
+    recorded = SuctionTable.from_json(args.suction_table).provenance.get("geometry")
+    if recorded != geometry.describe():
+        raise ValueError(f"--suction-table: '{args.suction_table}' was built for another design than "
+                         f"{geometry.name}; build it with `cupcheck suction` on the same --cup/--geometry")
 
 
 def plot(series: dict, curve, cup, path: Path, title: str) -> None:
@@ -144,8 +200,9 @@ def run(args: argparse.Namespace) -> int:
 
     t0 = time.perf_counter()
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
-    cup_laws, seal = route_model(args)
+    cup_laws, seal = route_model(args, coupled=True)
     geometry, uc, uc_label = _inputs(args)
+    _check_suction_table(args, geometry)
     from fem.solver import ConvergenceError
     from validation.commands._failure import solver_failure
 
@@ -159,8 +216,11 @@ def run(args: argparse.Namespace) -> int:
         curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
         handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
         base = reference_model(choice.cup, uc)
-        model = replace(base, stiffness=curve, geometry=cup_laws, seal=seal, label="FEM-fed")
-        results = lifetime_sweep(model, FORCES_N, progress=terminal_progress("lifetime"), refine=4)
+        if seal == "coupled":
+            results, holdable = coupled_lifetimes(args, geometry, uc, choice, tmp)
+        else:
+            model = replace(base, stiffness=curve, geometry=cup_laws, seal=seal, label="FEM-fed")
+            results = lifetime_sweep(model, FORCES_N, progress=terminal_progress("lifetime"), refine=4)
         series = {f"FEM-fed, {args.route} route": results}
         if args.route != "paper":        # the same FEM F0 through the paper's strip, for comparison
             series["FEM F0, paper route (strip, eqs 3-7)"] = lifetime_sweep(
@@ -171,18 +231,28 @@ def run(args: argparse.Namespace) -> int:
              f"{choice.label}, FEM {args.contact} ({args.fidelity}), {args.route} route, {uc_label}")
     wall = time.perf_counter() - t0
     slope = float(curve.force(curve.h1_m - 1e-3))
-    crossed = ("the FEM's contact-pressure profiles" if seal == "profile" else
-               "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})" if cup_laws == "cone" else ""))
+    crossed = {"profile": "the FEM's contact-pressure profiles",
+               "coupled": "the contact-pressure profile of each (u, dp) state of the FEM suction table "
+                          f"(largest holdable force {holdable:.4g} N)" if seal == "coupled" else "",
+               "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
+                                                            if cup_laws == "cone" else "")}[seal]
     print(f"{choice.label}: FEM {args.contact} stiffness ({args.fidelity}, {response.stats.steps} steps), "
           f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
-          f"{'FEM curve' if cup_laws == 'curve' else 'cone laws (3)-(4)'}; {args.route} route: the leak "
+          f"{_rv_source(seal, cup_laws)}; {args.route} route: the leak "
           f"crosses {crossed}")
     names = list(series)
     print(f"  {'F1 (N)':>7} " + " ".join(f"{n.split(',')[0] + ', ' + n.split(', ')[1].split(' ')[0]:>24}"
                                          for n in names) + "  end")
     for i, r in enumerate(results):
         print(f"  {r.force_N:7g} " + " ".join(f"{series[n][i].lifetime_s:24.4g}" for n in names) + f"  {r.reason}")
-    print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv "
-          f"in {wall:.1f} s")
+    extra = ", suction_table.json" if seal == "coupled" else ""
+    print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
+          f"{extra} in {wall:.1f} s")
     return 0
+
+
+def _rv_source(seal: str, cup_laws: str) -> str:
+    if seal == "coupled":
+        return "FEM suction table"
+    return "FEM curve" if cup_laws == "curve" else "cone laws (3)-(4)"

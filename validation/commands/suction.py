@@ -25,13 +25,7 @@ from validation.commands._cup import add_cup_arguments
 NAME = "suction"
 HELP = "FEM response to the cavity suction on a (u, dp) grid, for lifetime --route coupled (JSON)"
 
-#: default plate displacements as fractions of h1, and pressure differences [kPa]; each dp interval
-#: costs about one Newton solve. benchmarks/bench_coupled.py measures the grid's error in the
-#: lifetime: halving either spacing moves cup A's lifetimes by <= 0.9 %.
-_U_COARSE = (0.001, 0.0025, 0.005, 0.0075, 0.01, 0.0175, 0.025, 0.0375, 0.05, 0.075, 0.1, 0.125,
-             0.15, 0.175, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8)
-U_FRACTIONS = tuple(sorted(set(_U_COARSE) | {0.5 * (a + b) for a, b in zip(_U_COARSE, _U_COARSE[1:])}))
-DP_KPA = tuple(float(x) for x in range(0, 101))
+from validation.coupled.build import DEFAULT_GRID
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -48,7 +42,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     r.add_argument("--u-mm", type=float, nargs="+", default=None, dest="u_mm", metavar="U",
                    help="plate displacements [mm], increasing, in (0, h1] (default: 53 values "
                         "from 0.001 to 0.8 h1, graded towards 0)")
-    r.add_argument("--dp-kPa", type=float, nargs="+", default=list(DP_KPA), dest="dp_kPa", metavar="DP",
+    r.add_argument("--dp-kPa", type=float, nargs="+", default=list(DEFAULT_GRID.dp_kPa), dest="dp_kPa",
+                   metavar="DP",
                    help="pressure differences p_a - p_b [kPa], from 0, increasing, at most 1000 "
                         "(default 0, 1, ..., 100)")
     r.add_argument("--out", type=Path, required=True, metavar="JSON",
@@ -100,7 +95,7 @@ def _prepare(args: argparse.Namespace) -> dict:
     check_design(geometry, args.allow_unusual_design, source=geo.name)
     mesh = cup_mesh(geo, args.fidelity)
     h1 = cup_height(mesh)
-    u = np.array(U_FRACTIONS) * h1 if args.u_mm is None else 1e-3 * np.array(args.u_mm, float)
+    u = DEFAULT_GRID.u_m(h1) if args.u_mm is None else 1e-3 * np.array(args.u_mm, float)
     if not (np.all(np.isfinite(u)) and np.all(np.diff(u) > 0) and u[0] > 0 and u[-1] <= h1 * (1 + 1e-9)):
         raise ValueError(f"u_mm: plate displacements must increase within (0, h1] = (0, "
                          f"{1e3 * h1:.6g}] mm, got {args.u_mm}")

@@ -1,0 +1,81 @@
+"""The FEM suction table of a design, built once and kept: the input of the coupled route.
+
+`SuctionGridSpec` names the (u, dp) grid: the default one (`DEFAULT_GRID`, 53 u values graded towards
+u = 0 up to 0.8 h1, dp = 0, 1, ..., 100 kPa; halving either spacing moves cup A's lifetimes by
+<= 0.9 %, benchmarks/bench_coupled.py) and a coarse one for quick checks (`QUICK_GRID`).
+`suction_table_for` runs `fem.suction.suction_grid` on a design and converts it to the reduced
+model's `SuctionTable`; with a cache directory the table goes through `joblib.Memory`, keyed by the
+design, the law, the grid and a hash of the `fem`, `reduced` and `validation.coupled` sources, so a
+second call computes nothing and a code change recomputes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "QUICK_GRID", "suction_table_for"]
+
+_U_COARSE = (0.001, 0.0025, 0.005, 0.0075, 0.01, 0.0175, 0.025, 0.0375, 0.05, 0.075, 0.1, 0.125,
+             0.15, 0.175, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8)
+
+
+@dataclass(frozen=True)
+class SuctionGridSpec:
+    """Plate displacements as fractions of the cup's height h1 and pressure differences [kPa]."""
+
+    u_fractions: tuple[float, ...]
+    dp_kPa: tuple[float, ...]
+
+    def u_m(self, h1_m: float) -> np.ndarray:
+        return np.minimum(np.array(self.u_fractions) * h1_m, h1_m)
+
+    @property
+    def dp_Pa(self) -> np.ndarray:
+        return 1e3 * np.array(self.dp_kPa)
+
+    def describe(self) -> str:
+        return f"{len(self.u_fractions)} u x {len(self.dp_kPa)} dp"
+
+
+DEFAULT_GRID = SuctionGridSpec(
+    tuple(sorted(set(_U_COARSE) | {0.5 * (a + b) for a, b in zip(_U_COARSE, _U_COARSE[1:])})),
+    tuple(float(x) for x in range(0, 101)))
+QUICK_GRID = SuctionGridSpec(_U_COARSE, tuple(float(x) for x in range(0, 101, 5)))
+
+
+def suction_table_for(geometry, *, fidelity: str = "coarse", contact: str = "frictionless",
+                      friction: float = 0.0, E_Pa: float = 4e6, nu: float = 0.49,
+                      grid: SuctionGridSpec = DEFAULT_GRID, cache_dir: str | Path | None = None,
+                      progress: Callable[[float, str], None] | None = None):
+    """The `SuctionTable` of a design (`fem.geometry.CupGeometry` or a preset name 'A', 'B') at a
+    mesh level, contact law and grid (module docstring); `progress(fraction, message)` while the
+    FEM runs. Raises `fem.solver.ConvergenceError` where a state does not converge."""
+    from fem.geometry import cup_geometry
+    from validation.scenes.pipeline import package_version
+
+    if isinstance(geometry, str):
+        geometry = cup_geometry(geometry)
+    build = _build
+    if cache_dir is not None:
+        from joblib import Memory
+        build = Memory(str(cache_dir), verbose=0).cache(_build, ignore=["progress"])
+    code = package_version("fem") + package_version("reduced") + package_version("validation/coupled")
+    return build(geometry, fidelity, contact, friction, E_Pa, nu, grid, code, progress=progress)
+
+
+def _build(geometry, fidelity, contact, friction, E_Pa, nu, grid, code, progress=None):
+    from fem.cup import cup_height
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+    from fem.suction import suction_grid
+    from validation.coupled.table import suction_table
+
+    mesh = cup_mesh(geometry, fidelity)
+    result = suction_grid(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), grid.u_m(cup_height(mesh)), grid.dp_Pa,
+                          contact=contact, friction=friction, progress=progress)
+    return suction_table(result, {"geometry": geometry.describe(), "fidelity": fidelity,
+                                  "grid": grid.describe()})
