@@ -61,7 +61,7 @@ def test_sections_share_runs_and_subsets_plan_less():
 @pytest.fixture(scope="module")
 def quick_report(tmp_path_factory):
     out = tmp_path_factory.mktemp("v") / "report"
-    code = main(["validate", "--quick", "--out", str(out)])
+    code = main(["validate", "--quick", "--out", str(out), "--cache-dir", str(out.parent / "cache")])
     # the report is written either way; the exit status says whether any check FAILed
     summary = json.loads((out / "summary.json").read_text())
     assert code == (1 if summary["extremes_outcomes"].get("FAIL", 0) else 0)
@@ -258,6 +258,21 @@ def test_quick_report_paper_numbers(quick_report):
     # every gap names its reason; every route of the quick report is there
     assert all(table.loc[table["agrees"] == "no", "reason"].str.len() > 20)
     assert {"appendix-a", "fem-frictionless"} <= set(table["route"])
+    # the coupled route's 10 N lifetime is the library's on the report's own (cached) suction table
+    from reduced.coupled import CoupledCavity
+    from reduced.cup import CUP_A
+    from reduced.gas import Gas
+    from validation.coupled.build import QUICK_GRID, suction_table_for
+    from validation.crosscheck.context import pmma_uc_table
+
+    coupled = table[table["route"].str.startswith("coupled")].set_index("claim")
+    cached = suction_table_for("A", fidelity="coarse", grid=QUICK_GRID,
+                               cache_dir=quick_report.parent / "cache" / "suction",
+                               progress=lambda f, m: pytest.fail("the report's table was not cached"))
+    direct = CoupledCavity(cached, pmma_uc_table("pmma-1.89"), Gas(T_K=293.15), 1e5).lifetime(
+        10.0, 1e-3 * cached.provenance["h1_mm"] - CUP_A.h_start_m)
+    assert float(coupled.loc["lifetime at 10 N on a rough surface", "cupcheck"]) == pytest.approx(
+        direct.lifetime_s, rel=1e-6)                  # the CSV keeps 8 significant digits
     # the calibrated inputs hit their targets (the calibration's own tolerance)
     built = table[table["agrees"] == "by construction"]
     assert len(built) == 7 and all(abs(float(r) - 1) < 1e-4 for r in built["ratio"])
