@@ -132,14 +132,15 @@ def choose_contact(law: str | None, friction: float | None, given_by: str,
     if friction is None:
         return ContactChoice(design, design_by)
     if design.law != "coulomb":
-        _refuse_mu(design.law, friction, spelling, f" (from the {design_by})")
+        raise ValueError(f"{spelling.friction}: applies to {spelling.law_is.format('coulomb')} only, but "
+                         f"the {design_by} has {FILE.law_is.format(design.law)}")
     return ContactChoice(contact_law("coulomb", friction, spelling),
                          f"{design_by} (law), {given_by} (friction)")
 
 
-def _refuse_mu(law: str, friction: Any, spelling: Spelling, where: str = "") -> None:
+def _refuse_mu(law: str, friction: Any, spelling: Spelling) -> None:
     raise ValueError(f"{spelling.friction}: applies to {spelling.law_is.format('coulomb')} only, got "
-                     f"{_show(friction)} with {spelling.law_is.format(law)}{where}")
+                     f"{_show(friction)} with {spelling.law_is.format(law)}")
 
 
 def _show(value: Any) -> str:
