@@ -46,8 +46,9 @@ def add_cup_arguments(parser: argparse.ArgumentParser, role: str):
                         f"1.5 -> 0.3 mm; r0 5 mm, r1 19 mm); {role} (default: A)")
     g.add_argument("--geometry", type=design_file, default=None, metavar="FILE",
                    help="your design (.toml or .json; keys cup, r0_mm, r1_mm, alpha_deg, "
-                        "thickness_convention, thickness = {r_mm = [...], d_mm = [...]}), "
-                        "starting from --cup")
+                        "thickness_convention, thickness = {r_mm = [...], d_mm = [...]}, and "
+                        "optionally contact = {law = ..., friction = MU}, the FEM's contact law "
+                        "unless --contact is given), starting from --cup")
     g.add_argument("--allow-unusual-design", action="store_true",
                    help="accept a cone angle outside 5..80 deg or a wall more than 400x longer "
                         "than thick (refused by default: the FEM meshes cannot resolve them)")
