@@ -101,7 +101,7 @@ def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
         _check_height(design, curve, curve_label)
     params, l_source = _parameters(design, curve, r_start_mm, l0_mm, l1_mm, laws)
     return CupChoice(cup=params, design=dict(design), label=_label(design), source=source, l_source=l_source,
-                     notes=tuple(notes), contact=None if curve is None else curve.contact)
+                     notes=tuple(notes), contact=getattr(curve, "contact", None))
 
 
 def explicit_design(cup: str | None, geometry_file: str | Path | None) -> dict[str, Any]:
@@ -122,7 +122,7 @@ def _explicit(cup: str | None, geometry_file: str | Path | None) -> tuple[dict[s
 def _check_contact(curve: StiffnessCurve | None, file_contact: Mapping[str, Any] | None,
                    curve_label: str, explicit_label: str) -> None:
     """Refuse a design file whose [contact] law or mu differs from the one the curve was computed with."""
-    recorded = None if curve is None else curve.contact
+    recorded = getattr(curve, "contact", None)   # a curve-like record without it (the suction table's) names none
     if recorded is None or file_contact is None:
         return
     same = (recorded["law"] == file_contact["law"]
