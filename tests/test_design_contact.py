@@ -182,3 +182,14 @@ def test_a_scene_takes_its_design_files_law_unless_it_names_one(tmp_path):
                            base=tmp_path)
     plain = scene_from_mapping({"outputs": out})
     assert plain["contact"]["law"] == "frictionless" and plain.contact_source == "default"
+
+
+def test_a_scene_run_records_the_design_files_law_with_its_curve(capsys, tmp_path):
+    _design(tmp_path, COULOMB_TOML)
+    (tmp_path / "s.toml").write_text('[cup]\ngeometry = "d.toml"\n[[outputs]]\nkind = "curve"\n')
+    code, _, err = _run(capsys, "run", tmp_path / "s.toml", "--out", tmp_path / "out", "--no-cache")
+    assert code == 0, err
+    curve = StiffnessCurve.from_csv(tmp_path / "out" / "curve.csv")
+    assert curve.contact == {"law": "coulomb", "friction": 0.3, "source": "geometry file d.toml"}
+    manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
+    assert manifest["scene"]["contact"] == {"law": "coulomb", "friction": 0.3, "source": "geometry file d.toml"}

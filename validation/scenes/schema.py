@@ -215,8 +215,10 @@ def _design_contact(tables: dict[str, dict[str, Any]], given: Any, source: str) 
     """Without a contact.law in the scene, take the design file's [contact] law (and its mu, unless
     the scene gives contact.friction) into ``tables["contact"]``; return who chose the law."""
     scene = f"scene file {source}"
-    if not isinstance(given, Mapping) or "law" in given or not tables["cup"]["geometry"]:
-        return scene if isinstance(given, Mapping) and "law" in given else "default"
+    if "law" in given:                     # `given` is a table: `_table` checked it
+        return scene
+    if not tables["cup"]["geometry"]:
+        return "default"
     from fem.geometry import load_design
     from fem.interface import FILE, choose_contact
 
