@@ -22,6 +22,10 @@ r = 5 mm to 0.3 mm at r = 20 mm. The paper specifies the thickness at r = 20 mm,
 r1 = 19 mm: the line through those two points is evaluated on [r0, r1], which gives a rim
 thickness of 0.447 mm (A) and 0.38 mm (B).
 
+Design files (`load_design`, TOML or JSON; keys in mm and degrees) describe the wall and may add a
+``[contact]`` table, the interface with the plane (`fem.interface.ContactLaw`): a `Design` holds
+the two apart, and `load_geometry` returns the wall alone.
+
 SI units inside (metres, degrees only for the cone angle, as its field name says).
 """
 
