@@ -66,7 +66,8 @@ from typing import Any, Literal
 import numpy as np
 from skfem import Mesh
 
-from .contact import CONTACT_LAWS, PressureProfile, RigidPlane
+from .contact import PressureProfile, RigidPlane
+from .interface import ContactLaw
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
 from .postprocess import (BIOT_STRETCH, enclosed_volume, half_maximum_width, inner_contact_radius,
                           median_force_width, quartile_width, smallest_stretch, weighted_width)
@@ -146,7 +147,8 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     and return its `CupResponse`.
 
     contact: the law at the plane (`fem.contact`): frictionless, sticking, or coulomb with
-    Coulomb's coefficient `friction` (mu >= 0).
+    Coulomb's coefficient `friction` (mu in [0, 100]; `fem.interface.ContactLaw` checks both; a
+    design file's law is `fem.geometry.load_design(path).contact`).
     admissible_only: end the path with `fem.integrity.StateRejected` at the first converged state
     that violates contact between the nodes or crosses itself (module docstring); False follows
     the solver's path regardless (for studies of the solver itself).
@@ -197,12 +199,9 @@ class CupSetup:
 
     @classmethod
     def of(cls, mesh: Mesh, material: NeoHookean, contact: str, friction: float = 0.0) -> "CupSetup":
-        """Check the contact law, Coulomb's mu and the material (ValueError) and build the setup."""
-        if contact not in CONTACT_LAWS:
-            raise ValueError(f"contact: must be one of {', '.join(CONTACT_LAWS)}, got {contact!r}")
-        if contact != "coulomb" and friction != 0.0:
-            raise ValueError(f"friction: Coulomb's coefficient applies to contact='coulomb' only, "
-                             f"got friction={friction} with contact={contact!r}")
+        """Check the contact law, Coulomb's mu (`fem.interface.ContactLaw`) and the material
+        (ValueError) and build the setup."""
+        ContactLaw(contact, friction)
         if not isinstance(material, NeoHookean):
             raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
         kin = Kinematics.of(mesh)

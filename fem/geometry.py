@@ -22,6 +22,10 @@ r = 5 mm to 0.3 mm at r = 20 mm. The paper specifies the thickness at r = 20 mm,
 r1 = 19 mm: the line through those two points is evaluated on [r0, r1], which gives a rim
 thickness of 0.447 mm (A) and 0.38 mm (B).
 
+Design files (`load_design`, TOML or JSON; keys in mm and degrees) describe the wall and may add a
+``[contact]`` table, the interface with the plane (`fem.interface.ContactLaw`): a `Design` holds
+the two apart, and `load_geometry` returns the wall alone.
+
 SI units inside (metres, degrees only for the cone angle, as its field name says).
 """
 
@@ -37,9 +41,12 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .interface import ContactLaw, contact_from_mapping
+
 __all__ = [
     "CupGeometry", "LinearThickness", "TabulatedThickness", "ThicknessProfile",
-    "cup_geometry", "load_geometry", "geometry_from_mapping", "PRESETS",
+    "cup_geometry", "load_geometry", "geometry_from_mapping", "PRESETS", "Design", "load_design",
+    "design_from_mapping",
     "polygon_self_intersects",
 ]
 
@@ -254,8 +261,35 @@ def cup_geometry(cup: str = "A", **overrides: Any) -> CupGeometry:
     return CupGeometry(**{**base, **overrides})
 
 
-# ------------------------------------------------------------- geometry files
-_FILE_KEYS = ("cup", "name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention", "thickness")
+# ------------------------------------------------------------- design files
+_FILE_KEYS = ("cup", "name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention", "thickness", "contact")
+
+
+@dataclass(frozen=True)
+class Design:
+    """What a design file holds: the wall's shape and, if the file says, its interface with the
+    plane (the ``[contact]`` table, `fem.interface`); the two stay apart."""
+
+    geometry: CupGeometry
+    contact: ContactLaw | None = None      # None: the file names no contact law
+
+    def describe(self) -> dict[str, Any]:
+        """Plain data: the geometry's record and the contact table (None without one)."""
+        return {"geometry": self.geometry.describe(),
+                "contact": None if self.contact is None else self.contact.describe()}
+
+
+def design_from_mapping(data: Mapping[str, Any], source: str = "geometry", cup: str = "A") -> Design:
+    """A `Design` from plain data (the parsed design file; keys in mm and degrees).
+
+    Geometry keys as in `geometry_from_mapping`; ``contact``, optional, a table ``{law = ...,
+    friction = MU}`` (`fem.interface.contact_from_mapping`: law frictionless, sticking or coulomb;
+    friction, Coulomb's mu in [0, 100], with coulomb only, which needs it).
+    """
+    shape = {k: v for k, v in data.items() if k != "contact"}
+    geometry = geometry_from_mapping(shape, source=source, cup=cup)
+    contact = contact_from_mapping(data["contact"], source) if "contact" in data else None
+    return Design(geometry, contact)
 
 
 def geometry_from_mapping(data: Mapping[str, Any], source: str = "geometry",
@@ -266,7 +300,10 @@ def geometry_from_mapping(data: Mapping[str, Any], source: str = "geometry",
     `cup`), ``name``, ``r0_mm``, ``r1_mm``, ``alpha_deg``, ``thickness_convention``
     ("normal"|"vertical") and ``thickness``, a table ``{"r_mm": [...], "d_mm": [...]}`` (two
     points: the line through them, extrapolated; more: piecewise-linear, covering [r0, r1]).
+    A ``contact`` table is checked (`design_from_mapping`) and not part of the shape.
     """
+    if "contact" in data:
+        return design_from_mapping(data, source=source, cup=cup).geometry
     unknown = set(data) - set(_FILE_KEYS)
     if unknown:
         raise ValueError(f"{source}: unknown key(s) {sorted(unknown)}; allowed: {', '.join(_FILE_KEYS)}")
@@ -285,7 +322,12 @@ def geometry_from_mapping(data: Mapping[str, Any], source: str = "geometry",
 
 
 def load_geometry(path: str | Path, cup: str = "A") -> CupGeometry:
-    """Read a geometry file (``.json`` or ``.toml``; keys as in `geometry_from_mapping`).
+    """The wall of a design file (`load_design`; its ``[contact]`` table is checked, not returned)."""
+    return load_design(path, cup=cup).geometry
+
+
+def load_design(path: str | Path, cup: str = "A") -> Design:
+    """Read a design file (``.json`` or ``.toml``; keys as in `design_from_mapping`).
 
     Example (TOML)::
 
@@ -295,6 +337,9 @@ def load_geometry(path: str | Path, cup: str = "A") -> CupGeometry:
         [thickness]                    # 2 points: a line (extrapolated); more: a table
         r_mm = [5, 12, 19]
         d_mm = [2.5, 1.2, 0.45]
+        [contact]                      # optional: the interface with the plane
+        law = "coulomb"                # frictionless | sticking | coulomb
+        friction = 0.5                 # Coulomb's mu in [0, 100], with coulomb only
     """
     path = Path(path)
     if not path.is_file():
@@ -314,7 +359,7 @@ def load_geometry(path: str | Path, cup: str = "A") -> CupGeometry:
         raise ValueError(f"geometry: cannot parse '{path}': {exc}".replace("\n", " ")) from None
     if not isinstance(data, Mapping):
         raise ValueError(f"geometry: '{path}' must hold a table of keys")
-    return geometry_from_mapping(data, source=path.name, cup=cup)
+    return design_from_mapping(data, source=path.name, cup=cup)
 
 
 def _profile_from_mapping(value: Any, source: str) -> ThicknessProfile:

@@ -15,6 +15,8 @@ column names (readable by pandas.read_csv and numpy.genfromtxt as they are)::
 Its provenance travels in a JSON sidecar of the same name (``curve.json``, key ``provenance``),
 among it the cup design the curve was computed for (``geometry``: r0_mm, r1_mm, alpha_deg,
 h1_mm, the thickness profile), which `design` returns; a lifetime takes the cup from there.
+An FEM curve also records its interface with the plane (``contact``, ``friction``,
+``contact_source``), which `contact` returns.
 Optionally the curve carries the contact-pressure profile p(r) of every sample (`profiles`, for
 the leak through the profile, `reduced.profile_leak`); the sidecar holds them as the FEM writes
 them, ``steps.pressure_r_mm[i]`` and ``steps.pressure_kPa[i]``, and `read_profiles_csv` reads a
@@ -129,6 +131,19 @@ class StiffnessCurve:
         if isinstance(geometry, Mapping) and all(k in geometry for k in DESIGN_KEYS):
             return dict(geometry)
         return None
+
+    @property
+    def contact(self) -> dict[str, Any] | None:
+        """The interface the curve was computed with, recorded in the provenance: ``law``
+        (frictionless, sticking, coulomb), ``friction`` (Coulomb's mu, 0 for the other laws) and
+        ``source`` (who chose the law: "command line", "geometry file my_cup.toml", ...; None
+        where the curve does not say), or None when the curve names no law (a measured curve,
+        Appendix A)."""
+        law = self.provenance.get("contact")
+        if not isinstance(law, str):
+            return None
+        return {"law": law, "friction": float(self.provenance.get("friction", 0.0)),
+                "source": self.provenance.get("contact_source")}
 
     def has(self, name: str) -> bool:
         """True if the optional column `name` ('r_c_m', 'l_m' or 'V_m3') is present."""

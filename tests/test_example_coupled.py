@@ -70,6 +70,7 @@ def test_coupled_example_lifetimes_are_the_librarys(coupled_example, table_file)
     (["--route", "paper"], "--suction-table: applies to --route coupled only"),
     (["--route", "coupled", "--cup", "B"], "was built for another design"),
     (["--route", "coupled", "--cup-laws", "cone"], "--cup-laws: the coupled route"),
+    (["--route", "coupled", "--contact", "sticking"], "was built with frictionless contact"),
 ])
 def test_coupled_example_bad_input(capsys, tmp_path, table_file, extra, message):
     out = tmp_path / "never"

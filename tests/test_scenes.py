@@ -34,7 +34,7 @@ SHIPPED = sorted(p for p in (ROOT / "scenes").glob("*.toml") if not p.name.start
     ({"outputs": [{"kind": "squeeze", "u_mm": 3, "frames": 1}]}, "outputs[0].frames: expected a whole number in [2, 60], got 1"),
     ({"outputs": [{"kind": "squeeze", "u_mm": 3, "frames": 2.5}]}, "outputs[0].frames: expected a whole number in [2, 60]"),
     ({"contact": {"law": "sticking", "friction": 0.3}, "outputs": [{"kind": "curve"}]},
-     "contact.friction: applies to law = \"coulomb\" only, got law = 'sticking'"),
+     "contact.friction: applies to law = \"coulomb\" only, got 0.3 with law = \"sticking\""),
     ({"contact": {"law": "coulomb"}, "outputs": [{"kind": "curve"}]},
      "contact.friction: law = \"coulomb\" needs friction = MU, in [0, 100]"),
     ({"contact": {"law": "coulomb", "friction": 101}, "outputs": [{"kind": "curve"}]},

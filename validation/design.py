@@ -5,7 +5,8 @@ An FEM stiffness curve records the design it was computed for (`StiffnessCurve.d
 alpha, h1, the thickness profile). A lifetime takes the cup from there; an explicit ``--cup`` or
 ``--geometry FILE`` must describe the same cup, or the run is refused with both named. A curve
 that names no design (a measured CSV, a user's mesh) takes the explicit cup, else cup A with a
-note saying so.
+note saying so. The curve also records its interface with the plane (`StiffnessCurve.contact`);
+a ``--geometry FILE`` whose ``[contact]`` table names another law or mu is refused the same way.
 
 For a Table 1 cup (A, B) the reduced model keeps the paper's r_start = 12 mm, l0, l1 and
 beta = 0.8. Any other design keeps beta = 0.8 (Table 1's value for both cups), starts at the middle
@@ -43,6 +44,7 @@ class CupChoice:
     source: str                # "stiffness curve", "geometry file", "preset" or "default preset"
     l_source: str              # where eq (5)'s l0, l1 come from
     notes: tuple[str, ...] = ()
+    contact: dict[str, Any] | None = None    # the curve's interface (`StiffnessCurve.contact`)
 
     def describe(self) -> dict[str, Any]:
         """JSON-ready description (mm, degrees) for every lifetime output."""
@@ -50,7 +52,8 @@ class CupChoice:
         return {"label": self.label, "name": c.name, "source": self.source,
                 "r0_mm": c.r0_m / _MM, "r1_mm": c.r1_m / _MM, "alpha_deg": c.alpha_deg,
                 "h1_mm": c.h1_m / _MM, "r_start_mm": c.r_start_m / _MM, "l0_mm": c.l0_m / _MM,
-                "l1_mm": c.l1_m / _MM, "beta": c.beta, "l_source": self.l_source}
+                "l1_mm": c.l1_m / _MM, "beta": c.beta, "l_source": self.l_source,
+                "contact": self.contact}
 
 
 def preset_design(name: str) -> dict[str, Any]:
@@ -76,7 +79,7 @@ def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
 
     laws: 'cone' (eq 5's l0, l1 are needed) or 'curve' (r, V, l come from the curve: a custom
     design's l0, l1 are then not used and never refuse the run)."""
-    explicit = explicit_design(cup, geometry_file) if (cup or geometry_file) else None
+    explicit, file_contact = _explicit(cup, geometry_file) if (cup or geometry_file) else (None, None)
     explicit_label = f"--geometry {geometry_file}" if geometry_file is not None else f"--cup {cup}"
     recorded = curve.design if curve is not None else None
     notes: list[str] = []
@@ -84,6 +87,7 @@ def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
         raise ValueError(f"cup: {curve_label} was computed for {_label(recorded)}, but "
                          f"{explicit_label} is {_label(explicit)}; drop the option or use that "
                          f"cup's curve")
+    _check_contact(curve, file_contact, curve_label, explicit_label)
     if recorded is not None:
         design, source = recorded, "stiffness curve"
     elif explicit is not None:
@@ -97,16 +101,40 @@ def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
         _check_height(design, curve, curve_label)
     params, l_source = _parameters(design, curve, r_start_mm, l0_mm, l1_mm, laws)
     return CupChoice(cup=params, design=dict(design), label=_label(design), source=source, l_source=l_source,
-                     notes=tuple(notes))
+                     notes=tuple(notes), contact=getattr(curve, "contact", None))
 
 
 def explicit_design(cup: str | None, geometry_file: str | Path | None) -> dict[str, Any]:
     """The design record of a geometry file (starting from preset `cup`) or of preset `cup`
     (cup A when neither is given)."""
+    return _explicit(cup, geometry_file)[0]
+
+
+def _explicit(cup: str | None, geometry_file: str | Path | None) -> tuple[dict[str, Any], dict[str, Any] | None]:
+    """(the design record, the file's [contact] table as plain data or None) of `explicit_design`."""
     if geometry_file is not None:
-        from fem.geometry import load_geometry
-        return load_geometry(geometry_file, cup=cup or "A").describe()
-    return preset_design(cup or "A")
+        from fem.geometry import load_design
+        design = load_design(geometry_file, cup=cup or "A")
+        return design.geometry.describe(), None if design.contact is None else design.contact.describe()
+    return preset_design(cup or "A"), None
+
+
+def _check_contact(curve: StiffnessCurve | None, file_contact: Mapping[str, Any] | None,
+                   curve_label: str, explicit_label: str) -> None:
+    """Refuse a design file whose [contact] law or mu differs from the one the curve was computed with."""
+    recorded = getattr(curve, "contact", None)   # a curve-like record without it (the suction table's) names none
+    if recorded is None or file_contact is None:
+        return
+    same = (recorded["law"] == file_contact["law"]
+            and math.isclose(recorded["friction"], file_contact.get("friction", 0.0), rel_tol=_SAME, abs_tol=1e-12))
+    if not same:
+        raise ValueError(f"contact: {curve_label} was computed with {_contact_label(recorded)} contact, but "
+                         f"{explicit_label} says {_contact_label(file_contact)}; drop the option or use "
+                         f"that design's curve")
+
+
+def _contact_label(contact: Mapping[str, Any]) -> str:
+    return f"coulomb (mu = {contact['friction']:g})" if contact["law"] == "coulomb" else str(contact["law"])
 
 
 def _preset_of(design: Mapping[str, Any]) -> str | None:

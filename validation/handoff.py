@@ -5,7 +5,8 @@ force-quartile width of the sealing strip, `fem.cup`), so that `cupcheck lifetim
 reads it as it reads a measured curve. Everything else a run knows goes to the sidecar
 ``<out>.json`` (every key names its unit; lengths in mm like the CSV):
 
-* ``provenance``: geometry, material, contact, fidelity, mesh, the definition of l, versions;
+* ``provenance``: geometry, material, contact (``contact``, ``friction`` for coulomb, and
+  ``contact_source``: where the law came from), fidelity, mesh, the definition of l, versions;
 * ``h1_mm``; ``solver``: the path's `fem.solver.SolverStats` (steps, newton_iterations, cutbacks,
   wall_time_s, dofs, unstable_steps, dissipated_J), ``largest_penetration_mm``,
   ``largest_F0_mismatch_N`` (max |F0 - 2 pi int p r dr|) and ``folding_u_mm`` (or null);
@@ -32,27 +33,36 @@ from fem.cup import CupResponse
 from reduced.stiffness_curve import StiffnessCurve, profiles_from_lists
 from validation.output import software_versions
 
-__all__ = ["stiffness_curve", "provenance", "sidecar", "write_sidecar", "software_versions"]
+__all__ = ["stiffness_curve", "provenance", "contact_provenance", "sidecar", "write_sidecar", "software_versions"]
 
 
 
 def provenance(response: CupResponse, *, geometry: Mapping[str, Any], mesh: Mapping[str, Any],
-               fidelity: str | None) -> dict[str, Any]:
-    """Where an FEM stiffness curve comes from: geometry, material, contact, mesh, versions."""
+               fidelity: str | None, contact_source: str | None = None) -> dict[str, Any]:
+    """Where an FEM stiffness curve comes from: geometry, material, contact (the law, Coulomb's
+    ``friction``, and ``contact_source``: who chose the law, e.g. "command line", "geometry file
+    my_cup.toml", "default", "scene file s.toml"; omitted where the caller does not say), mesh,
+    versions."""
     m = response.material
     return {
         "source": "fem",
         "geometry": dict(geometry),
         "material": {"law": "compressible neo-Hookean", "E_Pa": m.E_Pa, "nu": m.nu,
                      "formulation": m.formulation},
-        "contact": response.contact,
-        **({"friction": response.friction} if response.contact == "coulomb" else {}),
+        **contact_provenance(response.contact, response.friction, contact_source),
         "fidelity": fidelity,
         "mesh": dict(mesh),
         "l_definition": "force-quartile width 2 (r_75 - r_25) of the radial line force int p dr "
                         "over the innermost contact zone (0: no strip the mesh resolves)",
         "versions": software_versions(),
     }
+
+
+def contact_provenance(law: str, friction: float, source: str | None = None) -> dict[str, Any]:
+    """The provenance's contact keys (stiffness sidecar, suction table): ``contact`` (the law),
+    ``friction`` (Coulomb's mu, with coulomb only) and ``contact_source`` (if known)."""
+    return {"contact": law, **({"friction": float(friction)} if law == "coulomb" else {}),
+            **({"contact_source": source} if source is not None else {})}
 
 
 class CurveArrays(Protocol):

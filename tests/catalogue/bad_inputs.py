@@ -75,9 +75,12 @@ for opt, value, expected in [
 ]:
     case("CLI option", STIFF + [opt, value], expected)
 case("CLI option", STIFF + ["--contact", "coulomb"], "friction: --contact coulomb needs --friction MU, in [0, 100]")
-case("CLI option", STIFF + ["--contact", "coulomb", "--friction", "-0.2"], "friction: Coulomb's coefficient must be in [0, 100]")
-case("CLI option", STIFF + ["--contact", "coulomb", "--friction", "nan"], "friction: Coulomb's coefficient must be in [0, 100]")
+case("CLI option", STIFF + ["--contact", "coulomb", "--friction", "-0.2"], "friction: Coulomb's friction coefficient must be in [0, 100]")
+case("CLI option", STIFF + ["--contact", "coulomb", "--friction", "nan"], "friction: Coulomb's friction coefficient must be in [0, 100]")
 case("CLI option", STIFF + ["--friction", "0.3"], "friction: applies to --contact coulomb only")
+for command in (["example", "--out", "{d}/out"], ["suction", "--out", "{d}/out/s.json"]):
+    case("CLI option", command + ["--contact", "coulomb"], "friction: --contact coulomb needs --friction MU, in [0, 100]")
+    case("CLI option", command + ["--contact", "sticking", "--friction", "0.5"], "friction: applies to --contact coulomb only")
 case("CLI option", ["stiffness", "--out", "{d}/c.txt"], "out: the stiffness curve must be a .csv file")
 case("CLI option", STIFF + ["--fields-out", "{d}/f.png"], "fields_out: must end in .vtu or .vtk")
 case("CLI option", UC + ["--surface", "pmma-1.89", "--E-MPa", "0"], "E")
@@ -178,8 +181,35 @@ for label, text, expected in [
     ("steep tube", "alpha_deg = 85\n", "alpha_deg = 85 is outside 5 .. 80 deg"),
     ("slender wall", "r1_mm = 50\nalpha_deg = 45\n[thickness]\nr_mm = [5, 50]\nd_mm = [0.1, 0.1]\n", "slenderness"),
     ("thickness convention", "thickness_convention = \"oblique\"\n", "thickness_convention: must be one of normal, vertical"),
+    # the [contact] table (fem.interface): the interface with the plane
+    ("negative friction", "[contact]\nlaw = \"coulomb\"\nfriction = -0.3\n",
+     "g.toml: contact.friction: Coulomb's friction coefficient must be in [0, 100], got -0.3"),
+    ("friction too large", "[contact]\nlaw = \"coulomb\"\nfriction = 150\n",
+     "g.toml: contact.friction: Coulomb's friction coefficient must be in [0, 100], got 150"),
+    ("friction with sticking", "[contact]\nlaw = \"sticking\"\nfriction = 0.5\n",
+     "g.toml: contact.friction: applies to law = \"coulomb\" only, got 0.5 with law = \"sticking\""),
+    ("coulomb without friction", "[contact]\nlaw = \"coulomb\"\n",
+     "g.toml: contact.friction: law = \"coulomb\" needs friction = MU, in [0, 100]"),
+    ("unknown contact law", "[contact]\nlaw = \"glued\"\n",
+     "g.toml: contact.law: must be one of frictionless, sticking, coulomb, got 'glued'"),
+    ("unknown contact key", "[contact]\nlaw = \"coulomb\"\nmu = 0.3\n",
+     "g.toml: contact.mu: unknown key; allowed: law, friction"),
+    ("friction not a number", "[contact]\nlaw = \"coulomb\"\nfriction = \"0.3\"\n",
+     "g.toml: contact.friction: Coulomb's friction coefficient must be a number in [0, 100], got '0.3'"),
+    ("contact law missing", "[contact]\nfriction = 0.3\n", "g.toml: contact.law: missing"),
+    ("contact not a table", "contact = \"coulomb\"\n", "g.toml: contact must be a table with the keys law, friction"),
 ]:
     case(f"geometry file: {label}", GEO, expected, **{"g.toml": text})
+# the command line's --friction alone changes the mu of a coulomb file, and is refused with another law
+case("geometry file: friction for a sticking design", GEO + ["--friction", "0.3"],
+     "friction: applies to --contact coulomb only, but the geometry file g.toml has law = \"sticking\"",
+     **{"g.toml": "[contact]\nlaw = \"sticking\"\n"})
+for command in (["example", "--geometry", "{d}/g.toml", "--out", "{d}/out"],
+                ["suction", "--geometry", "{d}/g.toml", "--out", "{d}/out/s.json"],
+                ["lifetime", "--geometry", "{d}/g.toml", "--out", "{d}/out"]):
+    case("geometry file: negative friction", command,
+         "g.toml: contact.friction: Coulomb's friction coefficient must be in [0, 100], got -1",
+         **{"g.toml": "[contact]\nlaw = \"coulomb\"\nfriction = -1\n"})
 
 # ------------------------------------------------------------------ meshes
 MESH = ["stiffness", "--mesh", "{d}/m.msh", "--out", "{d}/out/c.csv"]

@@ -1,14 +1,22 @@
-"""The cup options, one meaning in every command: which cup (`--cup`, `--geometry FILE`) and, for
-the lifetime, where r(h), V(h), l(h) come from (`--cup-laws`) and the reduced model's start.
+"""The cup options, one meaning in every command: which cup (`--cup`, `--geometry FILE`), for the
+FEM the contact law (`--contact`, `--friction`) and, for the lifetime, where r(h), V(h), l(h) come
+from (`--cup-laws`) and the reduced model's start.
 
 `--cup` takes A or B in any case; `--geometry` is always a design file (.toml or .json, the keys of
-`fem.geometry.load_geometry`). Shared by `stiffness`, `lifetime` and `example`.
+`fem.geometry.load_design`, with an optional [contact] table). Shared by `stiffness`, `lifetime`,
+`example` and `suction`. `--contact`/`--friction` given on the command line win over the design
+file's [contact] table, which wins over frictionless (`contact_choice`).
 """
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:                          # building the parser imports no fem
+    from fem.geometry import Design
+    from fem.interface import ContactChoice
 
 from reduced.cup import CUPS
 
@@ -38,8 +46,9 @@ def add_cup_arguments(parser: argparse.ArgumentParser, role: str):
                         f"1.5 -> 0.3 mm; r0 5 mm, r1 19 mm); {role} (default: A)")
     g.add_argument("--geometry", type=design_file, default=None, metavar="FILE",
                    help="your design (.toml or .json; keys cup, r0_mm, r1_mm, alpha_deg, "
-                        "thickness_convention, thickness = {r_mm = [...], d_mm = [...]}), "
-                        "starting from --cup")
+                        "thickness_convention, thickness = {r_mm = [...], d_mm = [...]}, and "
+                        "optionally contact = {law = ..., friction = MU}, the FEM's contact law "
+                        "unless --contact is given), starting from --cup")
     g.add_argument("--allow-unusual-design", action="store_true",
                    help="accept a cone angle outside 5..80 deg or a wall more than 400x longer "
                         "than thick (refused by default: the FEM meshes cannot resolve them)")
@@ -94,3 +103,40 @@ def route_model(args: argparse.Namespace, coupled: bool = False) -> tuple[str, s
         raise ValueError("--cup-laws: the profile route takes r and V from the FEM curve whose "
                          "profiles it crosses; drop --cup-laws cone")
     return args.cup_laws, seal
+
+
+#: `fem.interface.CONTACT_LAWS`, spelled out so that building the parser imports no fem (a test pins them equal)
+CONTACT_CHOICES = ("frictionless", "sticking", "coulomb")
+
+
+def add_contact_arguments(group: argparse._ArgumentGroup, default: str) -> None:
+    """--contact and --friction (None when not given: the design file's [contact] table, else
+    frictionless); `default` says why frictionless is the default for this command."""
+    group.add_argument("--contact", choices=CONTACT_CHOICES, default=None,
+                       help="contact with the plane: frictionless, sticking (a touching point stops "
+                            "sliding), or coulomb (stick while |t| <= mu p, slide otherwise; give "
+                            "--friction) (default: the --geometry file's [contact] law, else "
+                            f"frictionless: {default})")
+    group.add_argument("--friction", type=float, default=None, metavar="MU",
+                       help="Coulomb's friction coefficient mu, in [0, 100] (with --contact coulomb, "
+                            "or alone to change the mu of a coulomb design file)")
+
+
+def contact_choice(args: argparse.Namespace, design: Design | None = None) -> ContactChoice:
+    """The FEM's contact law and where it came from (`fem.interface.choose_contact`): --contact,
+    --friction over the design file's (``args.geometry``) [contact] table over frictionless."""
+    from fem.interface import Spelling, choose_contact
+
+    cli = Spelling("contact", "friction", "--contact {}", "--friction MU")
+    file_label = f"geometry file {Path(args.geometry).name}" if args.geometry is not None else "design"
+    return choose_contact(args.contact, args.friction, "command line",
+                          None if design is None else design.contact, file_label, cli)
+
+
+def load_cup_design(args: argparse.Namespace) -> Design:
+    """The design of --geometry FILE (on top of --cup), or the --cup preset (cup A) without a file."""
+    from fem.geometry import Design, cup_geometry, load_design
+
+    if args.geometry is not None:
+        return load_design(args.geometry, cup=args.cup or "A")
+    return Design(cup_geometry(args.cup or "A"))

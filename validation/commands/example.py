@@ -3,8 +3,9 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
 
 1. FEM (fem.cup.compress_cup): cup A of Table 1 / Sec. 5.5 (alpha 33 deg, wall 2.5 -> 0.3 mm at
    r = 5 -> 20 mm), compressible neo-Hookean E = 4 MPa, nu = 0.49, pressed onto the plane to 0.9 h1
-   at the default mesh level (medium), frictionless contact by default (the paper measured its F0
-   on soap-lubricated glass, Sec. 5.5; sticking is Appendix A's no-slip bound).
+   at the default mesh level (medium), frictionless contact by default (the paper's soap-lubricated
+   measurements; --contact sticking is Appendix A's no-slip bound, --contact coulomb --friction MU
+   lies between; a --geometry file's [contact] table sets the law unless --contact is given).
 2. Rough contact: u_c(p/E) of the calibrated sandblasted PMMA, 1.89 um rms (`pmma-1.89`, Persson
    theory, EMT, nu = 0.5), the surface of the paper's Figs. for cup A.
 3. Reduced model (Sec. 3-4) in reference conventions (no relaxation, E = 4 MPa in p/E, air at
@@ -33,8 +34,13 @@ import argparse
 import math
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from validation.commands._cup import add_cup_arguments, add_cup_law_arguments, route_model
+from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
+                                      contact_choice, load_cup_design, route_model)
+
+if TYPE_CHECKING:
+    from fem.interface import ContactChoice
 
 NAME = "example"
 HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"
@@ -46,11 +52,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (written atomically)")
     add_cup_arguments(p, "the FEM runs on it and the lifetimes use it")
     add_cup_law_arguments(p, default_route="paper")
-    p.add_argument("--contact", default="frictionless", choices=("frictionless", "sticking"),
-                   help="FEM contact with the substrate (default: frictionless, as in the paper: its "
-                        "F0 was measured on soap-lubricated glass and its lifetimes on soap-cleaned "
-                        "surfaces, Sec. 5.3-5.5; sticking is Appendix A's no-slip bound, whose "
-                        "contact-pressure profile is singular at the stick edges and not mesh-converged)")
+    add_contact_arguments(p.add_argument_group("FEM contact"),
+                          "as in the paper: its F0 was measured on soap-lubricated glass and its "
+                          "lifetimes on soap-cleaned surfaces, Sec. 5.3-5.5; sticking is Appendix A's "
+                          "no-slip bound, whose contact-pressure profile is singular at the stick "
+                          "edges and not mesh-converged")
     p.add_argument("--fidelity", default=None, choices=("coarse", "medium", "fine"),
                    help="FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
                         "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)")
@@ -69,14 +75,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _inputs(args: argparse.Namespace):
-    """Every check before the solve: (the FEM geometry, u_c table, its label)."""
+    """Every check before the solve: (the FEM geometry, u_c table, its label); the FEM's contact
+    law (`contact_choice`) goes to ``args.contact_choice``."""
     import os
 
-    from fem.geometry import cup_geometry, load_geometry
     from validation.guards import check_design, check_uc_table
 
-    geometry = load_geometry(args.geometry, cup=args.cup or "A") if args.geometry is not None \
-        else cup_geometry(args.cup or "A")
+    design = load_cup_design(args)
+    args.contact_choice = contact_choice(args, design)
+    geometry = design.geometry
     check_design(geometry.describe(), args.allow_unusual_design, source=geometry.name)
     if args.uc_table is not None:
         if not os.path.isfile(args.uc_table):
@@ -91,9 +98,10 @@ def _inputs(args: argparse.Namespace):
     return geometry, uc_table(preset(name).spectrum(), 0.5), name
 
 
-def fem_stiffness(geometry, contact: str, fidelity: str, progress=None):
+def fem_stiffness(geometry, contact: ContactChoice, fidelity: str, progress=None):
     """(CupResponse, StiffnessCurve) of a cup geometry (`fem.geometry.CupGeometry` or a preset
-    name): the FEM step of the main job."""
+    name) with the contact law `contact` (`fem.interface.ContactChoice`: the law, and where it
+    came from, which the provenance records): the FEM step of the main job."""
     from fem.cup import compress_cup
     from fem.geometry import cup_geometry
     from fem.material import NeoHookean
@@ -103,10 +111,11 @@ def fem_stiffness(geometry, contact: str, fidelity: str, progress=None):
     if isinstance(geometry, str):
         geometry = cup_geometry(geometry)
     mesh = cup_mesh(geometry, fidelity)
-    response = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact=contact,
-                            u_max_m=0.9 * geometry.h1_m, progress=progress)
+    response = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact=contact.contact.law,
+                            friction=contact.contact.friction, u_max_m=0.9 * geometry.h1_m, progress=progress)
     prov = handoff.provenance(response, geometry=geometry.describe(),
-                              mesh={"fidelity": fidelity, **vars(mesh_spec(fidelity))}, fidelity=fidelity)
+                              mesh={"fidelity": fidelity, **vars(mesh_spec(fidelity))}, fidelity=fidelity,
+                              contact_source=contact.source)
     return response, handoff.stiffness_curve(response, prov)
 
 
@@ -138,7 +147,8 @@ def coupled_lifetimes(args: argparse.Namespace, geometry, uc, choice, tmp: Path)
     if args.suction_table is not None:
         table = SuctionTable.from_json(args.suction_table)
     else:
-        table = suction_table_for(geometry, fidelity=args.fidelity, contact=args.contact,
+        law = args.contact_choice.contact
+        table = suction_table_for(geometry, fidelity=args.fidelity, contact=law.law, friction=law.friction,
                                   cache_dir=None if args.no_cache else args.cache_dir,
                                   progress=terminal_progress("suction"))
     table.to_json(tmp / "suction_table.json")
@@ -157,10 +167,16 @@ def _check_suction_table(args: argparse.Namespace, geometry) -> None:
     from reduced.suction_table import SuctionTable
     if not Path(args.suction_table).is_file():
         raise ValueError(f"--suction-table: no such file '{args.suction_table}'")
-    recorded = SuctionTable.from_json(args.suction_table).provenance.get("geometry")
-    if recorded != geometry.describe():
+    prov = SuctionTable.from_json(args.suction_table).provenance
+    if prov.get("geometry") != geometry.describe():
         raise ValueError(f"--suction-table: '{args.suction_table}' was built for another design than "
                          f"{geometry.name}; build it with `cupcheck suction` on the same --cup/--geometry")
+    law = args.contact_choice.contact
+    built = (prov.get("contact"), float(prov.get("friction", 0.0)))
+    if built != (law.law, law.friction):
+        raise ValueError(f"--suction-table: '{args.suction_table}' was built with {built[0]} contact"
+                         f"{f' mu = {built[1]:g}' if built[0] == 'coulomb' else ''}, the example runs "
+                         f"{law.label()}; give the same --contact (and --friction)")
 
 
 def plot(series: dict, curve, cup, path: Path, title: str) -> None:
@@ -208,7 +224,7 @@ def run(args: argparse.Namespace) -> int:
 
     with atomic_directory(args.out) as tmp:
         try:
-            response, curve = fem_stiffness(geometry, args.contact, args.fidelity, terminal_progress("FEM"))
+            response, curve = fem_stiffness(geometry, args.contact_choice, args.fidelity, terminal_progress("FEM"))
         except ConvergenceError as exc:
             raise solver_failure(exc, Path(f"{Path(args.out)}.failure.json")) from None
         choice = resolve_cup(curve, r_start_mm=args.r_start_mm, l0_mm=args.l0_mm, l1_mm=args.l1_mm,
@@ -228,7 +244,7 @@ def run(args: argparse.Namespace) -> int:
         series["Appendix A-fed, paper route (d0 2 mm)"] = lifetime_sweep(base, FORCES_N, refine=1)
         write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, args.route)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
-             f"{choice.label}, FEM {args.contact} ({args.fidelity}), {args.route} route, {uc_label}")
+             f"{choice.label}, FEM {args.contact_choice.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
     wall = time.perf_counter() - t0
     slope = float(curve.force(curve.h1_m - 1e-3))
     crossed = {"profile": "the FEM's contact-pressure profiles",
@@ -236,7 +252,8 @@ def run(args: argparse.Namespace) -> int:
                           f"(largest holdable force {holdable:.4g} N)" if seal == "coupled" else "",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
                                                             if cup_laws == "cone" else "")}[seal]
-    print(f"{choice.label}: FEM {args.contact} stiffness ({args.fidelity}, {response.stats.steps} steps), "
+    print(f"{choice.label}: FEM {args.contact_choice.contact.label()} stiffness (from the "
+          f"{args.contact_choice.source}; {args.fidelity}, {response.stats.steps} steps), "
           f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
           f"{_rv_source(seal, cup_laws)}; {args.route} route: the leak "

@@ -28,7 +28,7 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from validation.commands._cup import add_cup_arguments
+from validation.commands._cup import add_contact_arguments, add_cup_arguments, contact_choice, load_cup_design
 
 NAME = "stiffness"
 HELP = "FEM stiffness curve F0(h), r_c, l, V of cup A, B or your own design (CSV + JSON sidecar)"
@@ -57,13 +57,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     m.add_argument("--formulation", choices=("displacement", "mixed"), default="displacement",
                    help="displacement (default; nu <= 0.495, it locks above) or mixed u-p (nearly "
                         "incompressible, nu up to 0.4999)")
-    m.add_argument("--contact", choices=("frictionless", "sticking", "coulomb"), default="frictionless",
-                   help="contact with the plane: frictionless, sticking (a touching point stops "
-                        "sliding), or coulomb (stick while |t| <= mu p, slide otherwise; give "
-                        "--friction) (default frictionless: the soap-lubricated glass on which the "
-                        "paper measured F0, Sec. 5.5)")
-    m.add_argument("--friction", type=float, default=None, metavar="MU",
-                   help="Coulomb's friction coefficient mu, in [0, 100] (with --contact coulomb)")
+    add_contact_arguments(m, "the soap-lubricated glass on which the paper measured F0, Sec. 5.5")
     r = parser.add_argument_group("run")
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default=None,
                    help="mesh level of a generated mesh (default medium: F0 within 1 %% of the "
@@ -90,13 +84,14 @@ def run(args: argparse.Namespace) -> int:
     from validation.commands._failure import solver_failure
 
     try:
-        response = compress_cup(job["mesh"], job["material"], contact=args.contact,
-                                friction=job["friction"], u_max_m=job["u_max_m"],
+        law = job["contact"].contact
+        response = compress_cup(job["mesh"], job["material"], contact=law.law,
+                                friction=law.friction, u_max_m=job["u_max_m"],
                                 progress=terminal_progress("stiffness"))
     except ConvergenceError as exc:
         raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
     prov = handoff.provenance(response, geometry=job["geometry"], mesh=job["mesh_info"],
-                              fidelity=job["fidelity"])
+                              fidelity=job["fidelity"], contact_source=job["contact"].source)
     curve = handoff.stiffness_curve(response, prov)
     with atomic_file(job["sidecar"]) as tmp_json, atomic_file(args.out) as tmp_csv:
         curve.to_csv(tmp_csv, sidecar=False)
@@ -106,7 +101,8 @@ def run(args: argparse.Namespace) -> int:
                 every_step = tmp_fields.suffix.lower() == ".xdmf"
                 response.write_fields(tmp_fields, step=None if every_step else -1)
     s = response.stats
-    print(f"cupcheck stiffness: wrote {args.out} and {job['sidecar'].name}: {s.steps} steps, "
+    print(f"cupcheck stiffness: wrote {args.out} and {job['sidecar'].name}: {job['contact'].contact.label()} "
+          f"contact (from the {job['contact'].source}), {s.steps} steps, "
           f"{s.newton_iterations} Newton iterations, {s.dofs} dofs, {s.wall_time_s:.1f} s; "
           f"F0 = {response.F0_N[-1]:.4g} N at u = {1e3 * response.u_m[-1]:.4g} mm")
     if response.folding_u_m is not None:
@@ -119,7 +115,6 @@ def run(args: argparse.Namespace) -> int:
 def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     """Validate every input and build the mesh and material (cheap); raise ValueError."""
     from fem.cup import cup_height
-    from fem.geometry import cup_geometry, load_geometry
     from fem.material import NeoHookean
     from fem.mesh import DEFAULT_FIDELITY, FIDELITIES, cup_mesh, read_mesh
 
@@ -142,21 +137,22 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         raise ValueError(f"nu: with the displacement formulation Poisson's ratio must be <= "
                          f"{LOCKING_NU} (above, its elements lock and stiffen F0); use "
                          f"--formulation mixed for nu up to 0.4999, got {args.nu:g}")
-    friction = _friction(args.contact, args.friction)
     fidelity = args.fidelity or DEFAULT_FIDELITY
     if args.mesh is not None:
         given = [o for o, v in (("--geometry", args.geometry), ("--fidelity", args.fidelity), ("--cup", args.cup),
                                 ("--thickness-convention", args.thickness_convention)) if v is not None]
         if given:
             raise ValueError(f"mesh: a mesh file fixes the geometry and the mesh; drop {', '.join(given)}")
+        contact = contact_choice(args)
         mesh = read_mesh(args.mesh, unit=args.mesh_unit)
         geometry = {"name": f"mesh file {Path(args.mesh).name}"}
         mesh_info = {"file": str(args.mesh), "unit": args.mesh_unit,
                      "sha256": hashlib.sha256(Path(args.mesh).read_bytes()).hexdigest()}
         fidelity = None
     else:
-        geo = load_geometry(args.geometry, cup=args.cup or "A") if args.geometry is not None \
-            else cup_geometry(args.cup or "A")
+        design = load_cup_design(args)
+        contact = contact_choice(args, design)
+        geo = design.geometry
         if args.thickness_convention is not None:
             geo = replace(geo, thickness_convention=args.thickness_convention)
         geometry = geo.describe()
@@ -176,21 +172,7 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         u_max = min(u_max, h1)
     return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
             "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json"),
-            "friction": friction}
-
-
-def _friction(contact: str, friction: float | None) -> float:
-    """Coulomb's mu for --contact coulomb (required there, refused with the other laws)."""
-    if contact != "coulomb":
-        if friction is not None:
-            raise ValueError(f"friction: applies to --contact coulomb only, got --friction "
-                             f"{friction:g} with --contact {contact}")
-        return 0.0
-    if friction is None:
-        raise ValueError("friction: --contact coulomb needs --friction MU, in [0, 100]")
-    if not (0.0 <= friction <= 100.0):
-        raise ValueError(f"friction: Coulomb's coefficient must be in [0, 100], got {friction:g}")
-    return float(friction)
+            "contact": contact}
 
 
 def _writable(path: Path, name: str, what: str = "") -> None:

@@ -7,6 +7,9 @@ on the handle F1, the cavity volume, the seal radius and the contact-pressure pr
 `cupcheck lifetime --route coupled --suction-table FILE` reads. Every input is checked before the
 solve (one line, exit 2); a solve that fails exits 1; no file is left behind either way.
 
+The contact law is --contact (with --friction for coulomb), else the --geometry file's [contact]
+table, else frictionless; the table's provenance records it and where it came from.
+
 examples:
   cupcheck suction --cup A --out out/cupA_suction.json
   cupcheck suction --cup B --fidelity coarse --dp-kPa 0 25 50 75 100 --out cupB.json
@@ -20,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from validation.commands._cup import add_cup_arguments
+from validation.commands._cup import add_contact_arguments, add_cup_arguments, contact_choice, load_cup_design
 
 NAME = "suction"
 HELP = "FEM response to the cavity suction on a (u, dp) grid, for lifetime --route coupled (JSON)"
@@ -33,9 +36,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     m = parser.add_argument_group("material and contact")
     m.add_argument("--E-MPa", type=float, default=4.0, dest="E_MPa", help="Young's modulus E [MPa] (default 4)")
     m.add_argument("--nu", type=float, default=0.49, help="Poisson's ratio [-], at most 0.495 (default 0.49)")
-    m.add_argument("--contact", choices=("frictionless", "sticking"), default="frictionless",
-                   help="contact with the plane (default frictionless: path independent, so the "
-                        "order press-then-suck does not matter; sticking is the response to that order)")
+    add_contact_arguments(m, "path independent, so the order press-then-suck does not matter; "
+                             "sticking and coulomb give the response to that order")
     r = parser.add_argument_group("grid and run")
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default="medium",
                    help="mesh level (default medium)")
@@ -56,14 +58,17 @@ def run(args: argparse.Namespace) -> int:
     from fem.suction import suction_grid
     from validation.commands._failure import solver_failure
     from validation.coupled.table import suction_table
+    from validation.handoff import contact_provenance
     from validation.output import atomic_file, terminal_progress
 
     try:
-        grid = suction_grid(job["mesh"], job["material"], job["u_m"], job["dp_Pa"],
-                            contact=args.contact, progress=terminal_progress("suction"))
+        law = job["contact"].contact
+        grid = suction_grid(job["mesh"], job["material"], job["u_m"], job["dp_Pa"], contact=law.law,
+                            friction=law.friction, progress=terminal_progress("suction"))
     except ConvergenceError as exc:
         raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
-    table = suction_table(grid, {"geometry": job["geometry"], "fidelity": args.fidelity})
+    table = suction_table(grid, {"geometry": job["geometry"], "fidelity": args.fidelity,
+                                 **contact_provenance(law.law, law.friction, job["contact"].source)})
     with atomic_file(args.out) as tmp:
         table.to_json(tmp)
     s = grid.stats
@@ -76,7 +81,6 @@ def run(args: argparse.Namespace) -> int:
 def _prepare(args: argparse.Namespace) -> dict:
     """Validate every input and build the mesh and material (cheap); raise ValueError."""
     from fem.cup import cup_height
-    from fem.geometry import cup_geometry, load_geometry
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
     from validation.commands.stiffness import LOCKING_NU, _writable
@@ -89,8 +93,9 @@ def _prepare(args: argparse.Namespace) -> dict:
     if not (0.0 <= args.nu <= LOCKING_NU):
         raise ValueError(f"nu: Poisson's ratio must be in [0, {LOCKING_NU}], got {args.nu:g}")
     material = NeoHookean(E_Pa=check_modulus(args.E_MPa) * 1e6, nu=args.nu)
-    geo = load_geometry(args.geometry, cup=args.cup or "A") if args.geometry is not None \
-        else cup_geometry(args.cup or "A")
+    design = load_cup_design(args)
+    contact = contact_choice(args, design)
+    geo = design.geometry
     geometry = geo.describe()
     check_design(geometry, args.allow_unusual_design, source=geo.name)
     mesh = cup_mesh(geo, args.fidelity)
@@ -105,7 +110,7 @@ def _prepare(args: argparse.Namespace) -> dict:
         raise ValueError(f"dp_kPa: pressure differences must start at 0 and increase, at most "
                          f"1000 kPa, at least two, got {args.dp_kPa}")
     return {"mesh": mesh, "material": material, "u_m": np.minimum(u, h1), "dp_Pa": 1e3 * dp,
-            "geometry": geometry}
+            "geometry": geometry, "contact": contact}
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -73,9 +73,10 @@ def _build(geometry, fidelity, contact, friction, E_Pa, nu, grid, code, progress
     from fem.mesh import cup_mesh
     from fem.suction import suction_grid
     from validation.coupled.table import suction_table
+    from validation.handoff import contact_provenance
 
     mesh = cup_mesh(geometry, fidelity)
     result = suction_grid(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), grid.u_m(cup_height(mesh)), grid.dp_Pa,
                           contact=contact, friction=friction, progress=progress)
     return suction_table(result, {"geometry": geometry.describe(), "fidelity": fidelity,
-                                  "grid": grid.describe()})
+                                  "grid": grid.describe(), **contact_provenance(contact, friction)})

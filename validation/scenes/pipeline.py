@@ -72,14 +72,16 @@ def _fem_path(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: 
         u_max_m=u_max_m, progress=progress)
 
 
-def _fem_curve(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str, path=None):
-    """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`, not part of the key)."""
+def _fem_curve(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str, path=None,
+               contact_source: str | None = None):
+    """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`, not part of the key);
+    its provenance says who chose the contact law (`Scene.contact_source`)."""
     COMPUTED["fem_curve"] += 1
     from validation import handoff
 
     response = path()
     prov = handoff.provenance(response, geometry=_geometry(cup).describe(), mesh={"fidelity": fidelity},
-                              fidelity=fidelity)
+                              fidelity=fidelity, contact_source=contact_source)
     return handoff.stiffness_curve(response, prov)
 
 
@@ -179,7 +181,8 @@ class Products:
         s, u_max_m = self.scene, self._u_max_m(None)
         return self._get("curve", lambda: self._cached(_fem_curve, ignore=["path"])(
             s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m,
-            package_version("fem") + package_version("validation"), path=lambda: self.fem_path(None)))
+            package_version("fem") + package_version("validation"), path=lambda: self.fem_path(None),
+            contact_source=s.contact_source))
 
     def _appendix_a(self):
         from reduced.appendix_a import appendix_a_curve

@@ -3,7 +3,8 @@
     [cup]            preset = "A" | geometry = "my_cup.toml"        (one of them)
     [material]       E_MPa = 4.0, nu = 0.49, relaxation = "none" | "default"
     [contact]        law = "frictionless" | "sticking" | "coulomb", friction = MU (Coulomb's mu in
-                     [0, 100], with law = "coulomb" only, which needs it)
+                     [0, 100], with law = "coulomb" only, which needs it); without a law, the design
+                     file's [contact] table (cup.geometry) if it has one, else frictionless
     [surface]        preset = "pmma-1.89" | uc_table = "uc.csv"     (one of them)
     [fluid]          kind = "air" | "water"
     [loads]          F1_N = [5, 10, 20], r_start_mm = 12 (optional), kappa = 1.0
@@ -30,7 +31,9 @@ coarse level, the paper's route, pmma-1.89, air, F1 = 5, 10, 20, 40, 80 N (the m
 scenes/main.toml, sets the medium level and F1 = 5, 10, ..., 80 N). Unknown keys, wrong
 types and contradictions are ValueErrors naming the key path (``outputs[2].kind: expected one of
 ...``): one line and exit status 2 on the command line, before anything is computed or written.
-Paths in the scene are relative to the scene file.
+Paths in the scene are relative to the scene file. The contact law and mu are checked by
+`fem.interface` (imported only for a scene that names mu, coulomb or a design file: a scene of the
+reduced model alone imports no fem); `Scene.contact_source` says where the law came from.
 """
 
 from __future__ import annotations
@@ -52,7 +55,6 @@ MAX_FRAMES = 60
 FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parameter", "r_pb_vs_time",
            "p_Ndot_vs_time")
 SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset", "contact.friction")
-MAX_FRICTION = 100.0
 _TABLES: dict[str, dict[str, Any]] = {
     "cup": {"preset": "A", "geometry": None},
     "material": {"E_MPa": 4.0, "nu": 0.49, "relaxation": "none"},
@@ -76,21 +78,24 @@ class Scene:
     outputs: tuple[dict[str, Any], ...]
     source: str = "scene"
     sweep: dict[str, Any] | None = None
+    contact_source: str = "default"     # who chose the contact law: the scene, the design file, default
 
     def variant(self, value: Any) -> "Scene":
         """The scene with the swept parameter set to `value` (and no sweep)."""
         table, key = self.sweep["key"].split(".")
         tables = {k: dict(v) for k, v in self.tables.items()}
         tables[table][key] = value
-        return Scene(tables=tables, outputs=self.outputs, source=self.source)
+        source = self.contact_source if key != "friction" else f"{self.contact_source} (law), sweep (friction)"
+        return Scene(tables=tables, outputs=self.outputs, source=self.source, contact_source=source)
 
     def __getitem__(self, table: str) -> dict[str, Any]:
         return self.tables[table]
 
     def resolved(self) -> dict[str, Any]:
         """Plain data for the manifest: every table with its defaults, and the outputs."""
-        return {**{k: dict(v) for k, v in self.tables.items()}, "sweep": self.sweep,
-                "outputs": [dict(o) for o in self.outputs]}
+        tables = {k: dict(v) for k, v in self.tables.items()}
+        tables["contact"]["source"] = self.contact_source
+        return {**tables, "sweep": self.sweep, "outputs": [dict(o) for o in self.outputs]}
 
     def needs_fem(self) -> bool:
         """Whether any requested output needs the FEM (a stiffness curve from it)."""
@@ -117,6 +122,7 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
         raise ValueError(f"{unknown[0]}: unknown table; allowed: {', '.join([*_TABLES, 'sweep', 'outputs'])}")
     tables = {name: _table(name, data.get(name, {}), defaults) for name, defaults in _TABLES.items()}
     _paths(tables, Path(base))
+    contact_source = _design_contact(tables, data.get("contact", {}), source)
     _cross_checks(tables, data.get("sweep"))
     outputs = data.get("outputs")
     if not isinstance(outputs, list) or not outputs:
@@ -132,7 +138,7 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
     if sweep is not None and any(o["kind"] in ("curve", "trajectories", *STATE_KINDS)
                                  or o["figure"] in ("r_pb_vs_time", "p_Ndot_vs_time") for o in parsed):
         raise ValueError("sweep: a swept scene writes lifetimes and figures; drop the curve, trajectories and 3D outputs")
-    return Scene(tables=tables, outputs=parsed, source=source, sweep=sweep)
+    return Scene(tables=tables, outputs=parsed, source=source, sweep=sweep, contact_source=contact_source)
 
 
 def _sweep(table: Any, tables: dict[str, dict[str, Any]]) -> dict[str, Any]:
@@ -200,21 +206,38 @@ def _paths(tables: dict[str, dict[str, Any]], base: Path) -> None:
 
 
 def _friction(value: Any, where: str) -> float:
-    value = _number(value, where, positive=False)
-    if not 0.0 <= value <= MAX_FRICTION:
-        raise ValueError(f"{where}: Coulomb's friction coefficient must be in [0, {MAX_FRICTION:g}], got {value:g}")
-    return value
+    """Coulomb's mu, checked by `fem.interface` (the one check of every input's mu)."""
+    from fem.interface import Spelling, contact_law
+    return contact_law("coulomb", value, Spelling(friction=where)).friction
+
+
+def _design_contact(tables: dict[str, dict[str, Any]], given: Any, source: str) -> str:
+    """Without a contact.law in the scene, take the design file's [contact] law (and its mu, unless
+    the scene gives contact.friction) into ``tables["contact"]``; return who chose the law."""
+    scene = f"scene file {source}"
+    if "law" in given:                     # `given` is a table: `_table` checked it
+        return scene
+    if not tables["cup"]["geometry"]:
+        return "default"
+    from fem.geometry import load_design
+    from fem.interface import FILE, choose_contact
+
+    path = Path(tables["cup"]["geometry"])
+    design = load_design(path, cup=tables["cup"]["preset"]).contact
+    if design is None:
+        return "default"
+    choice = choose_contact(None, given.get("friction"), scene, design, f"geometry file {path.name}", FILE)
+    law = choice.contact
+    tables["contact"].update(law=law.law, friction=law.friction if law.law == "coulomb" else None)
+    return choice.source
 
 
 def _cross_checks(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
     contact = tables["contact"]
     swept = isinstance(sweep, Mapping) and sweep.get("key") == "contact.friction"
-    if contact["friction"] is not None:
-        if contact["law"] != "coulomb":
-            raise ValueError(f"contact.friction: applies to law = \"coulomb\" only, got law = {contact['law']!r}")
-        contact["friction"] = _friction(contact["friction"], "contact.friction")
-    elif contact["law"] == "coulomb" and not swept:
-        raise ValueError(f"contact.friction: law = \"coulomb\" needs friction = MU, in [0, {MAX_FRICTION:g}]")
+    if contact["friction"] is not None or (contact["law"] == "coulomb" and not swept):
+        from fem.interface import FILE, contact_law       # only here: a reduced-model scene imports no fem
+        contact["friction"] = contact_law(contact["law"], contact["friction"], FILE).friction
     if contact["law"] == "coulomb" and tables["stiffness"]["source"] != "fem":
         raise ValueError("contact.law: Coulomb friction is a FEM contact law; it needs stiffness.source = \"fem\"")
     if tables["cup"]["geometry"] is not None and tables["stiffness"]["source"] != "fem":
