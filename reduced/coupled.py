@@ -35,19 +35,18 @@ route). Relaxation is not modelled here.
 
 from __future__ import annotations
 
-import bisect
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 from scipy.optimize import brentq
 
 from reduced.gas import AIR, Gas
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
 from reduced.suction_table import SuctionTable
+from reduced.table_surface import TableSurface
 
 __all__ = ["CoupledCavity", "CoupledLifetime", "INTERFACES"]
 
@@ -154,13 +153,13 @@ class CoupledCavity:
         return float(np.max(g[np.isfinite(g)]))
 
     @cached_property
-    def _surfaces(self) -> dict[str, "_Surface"]:
+    def _surfaces(self) -> dict[str, TableSurface]:
         g = self._node_conductance          # inf: no contact (1e3 x the largest); nan: p_b < 0
         top, floor = 1e3 * self._largest_conductance, 1e-30 * self._largest_conductance
         rates = np.log(np.clip(np.where(np.isnan(g), floor, g), floor, top))
-        return {"F1": _Surface(self._u, self._dp, self.table.F1_N, self.along_u),
-                "V": _Surface(self._u, self._dp, self.table.V_m3, self.along_u),
-                "Ndot": _Surface(self._u, self._dp, rates, self.along_u)}
+        return {"F1": TableSurface(self._u, self._dp, self.table.F1_N, self.along_u),
+                "V": TableSurface(self._u, self._dp, self.table.V_m3, self.along_u),
+                "Ndot": TableSurface(self._u, self._dp, rates, self.along_u)}
 
     @cached_property
     def _node_conductance(self) -> np.ndarray:
@@ -301,33 +300,3 @@ class CoupledCavity:
         return CoupledLifetime(F1, float(t[-1]), reason, f"detached at t = {t[-1]:.4g} s: {where}", N0,
                                t, u, dps, N, q, V, p_a_Pa=self.p_a_Pa)
 
-
-def _cell(x: np.ndarray, y: np.ndarray, a: float, b: float) -> tuple[int, int, float, float]:
-    """Cell (i, j) and local coordinates of (a, b) on the grid x by y (clamped to it)."""
-    i = min(max(bisect.bisect_right(x, a) - 1, 0), x.size - 2)
-    j = min(max(bisect.bisect_right(y, b) - 1, 0), y.size - 2)
-    return i, j, (a - x[i]) / (x[i + 1] - x[i]), (b - y[j]) / (y[j + 1] - y[j])
-
-
-class _Surface:
-    """z(u, dp) on the table's grid: monotone cubic (PCHIP, Fritsch-Carlson slopes) or linear along
-    u, linear along dp. PCHIP keeps each column's monotonicity (the branch stays unique) and is
-    third order where the data are smooth; the grid refinement in benchmarks/bench_coupled.py
-    measures both."""
-
-    def __init__(self, u: np.ndarray, dp: np.ndarray, z: np.ndarray, along_u: str):
-        self.u, self.dp, self.z = u, dp, np.asarray(z, dtype=float)
-        self.slope = (PchipInterpolator(u, self.z, axis=0).derivative()(u) if along_u == "pchip"
-                      else None)
-
-    def __call__(self, a: float, b: float) -> float:
-        i, j, s, t = _cell(self.u, self.dp, a, b)
-        z0, z1 = self.z[i, j:j + 2], self.z[i + 1, j:j + 2]
-        if self.slope is None:
-            col = (1 - s) * z0 + s * z1
-        else:
-            h = self.u[i + 1] - self.u[i]
-            h00, h10, h01, h11 = (2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2,
-                                  s**3 - s**2)
-            col = h00 * z0 + h10 * h * self.slope[i, j:j + 2] + h01 * z1 + h11 * h * self.slope[i + 1, j:j + 2]
-        return float((1 - t) * col[0] + t * col[1])
