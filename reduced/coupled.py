@@ -37,15 +37,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
 from scipy.optimize import brentq
 
+from reduced.coupled_relax import RelaxedParts, relaxed_lifetime, relaxed_parts
 from reduced.gas import AIR, Gas
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
 from reduced.suction_table import SuctionTable
+from reduced.viscoelastic import RelaxationModulus
 from reduced.table_surface import TableSurface
 
 __all__ = ["CoupledCavity", "CoupledLifetime", "INTERFACES"]
@@ -69,6 +71,9 @@ class CoupledLifetime:
     N_dot_per_s: np.ndarray
     V_m3: np.ndarray
     p_a_Pa: float = 1e5
+    phi_s: np.ndarray | None = None     # with relaxation: the contact time of eq (10)
+    kappa: np.ndarray | None = None     # with relaxation: the stiffness factor kappa(phi)
+    steps: int = 0                      # with relaxation: accepted integration steps
 
     @property
     def p_b_Pa(self) -> np.ndarray:
@@ -81,18 +86,26 @@ class CoupledLifetime:
                 "reason": self.reason, "sealed": self.reason == "sealed", "N0": self.N0,
                 "u_final_mm": 1e3 * float(self.u_m[-1]) if self.u_m.size else None,
                 "p_b_final_Pa": float(self.p_b_Pa[-1]) if self.dp_Pa.size else None,
+                **({} if self.phi_s is None else
+                   {"phi_final_s": float(self.phi_s[-1]) if self.phi_s.size else None,
+                    "kappa_final": float(self.kappa[-1]) if self.kappa.size else None,
+                    "steps": self.steps}),
                 "message": self.message}
 
     def trajectory_columns(self) -> dict[str, np.ndarray]:
         """Trajectory arrays under CSV column names that carry their units."""
         return {"t_s": self.t_s, "u_mm": 1e3 * self.u_m, "p_b_Pa": self.p_b_Pa, "N": self.N,
-                "N_dot_per_s": self.N_dot_per_s, "V_mm3": 1e9 * self.V_m3}
+                "N_dot_per_s": self.N_dot_per_s, "V_mm3": 1e9 * self.V_m3,
+                **({} if self.phi_s is None else {"phi_s": self.phi_s, "kappa": self.kappa})}
 
 
 @dataclass(frozen=True, eq=False)
 class CoupledCavity:
     """The coupled reduced model (module docstring). u_c: critical gap [m] as a function of p/E,
-    with E the table's modulus."""
+    with E the table's modulus (with relaxation E_eff(phi), `reduced.coupled_relax`).
+    relaxation: E_eff(t), or None (kappa fixed); phi0_s: with relaxation, the contact time [s] of
+    the stiffness measurement the table stands for (`reduced.viscoelastic.measurement_contact_time`,
+    13 s for cup A)."""
 
     table: SuctionTable
     u_c: Callable[[float], float]
@@ -103,6 +116,8 @@ class CoupledCavity:
     radial: str = "annulus"
     samples: int = 801
     along_u: str = "pchip"
+    relaxation: RelaxationModulus | None = None
+    phi0_s: float | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.kappa) and self.kappa > 0):
@@ -115,6 +130,18 @@ class CoupledCavity:
             raise ValueError(f"along_u: expected 'pchip' or 'linear', got {self.along_u!r}")
         if not (isinstance(self.samples, int) and self.samples >= 11):
             raise ValueError(f"samples: need an integer >= 11, got {self.samples}")
+        if self.phi0_s is not None and not (math.isfinite(self.phi0_s) and self.phi0_s > 0):
+            raise ValueError(f"phi0_s: measurement contact time must be finite and > 0 s, got {self.phi0_s}")
+        if self.relaxation is None and self.phi0_s is not None:
+            raise ValueError("phi0_s: the measurement contact time is used only with relaxation; "
+                             "give relaxation or drop phi0_s")
+        if self.relaxation is not None and self.phi0_s is None:
+            raise ValueError("phi0_s: with relaxation give the contact time of the stiffness "
+                             "measurement in s (> 0), e.g. reduced.viscoelastic.measurement_contact_time(cup)")
+
+    @cached_property
+    def _relaxed(self) -> RelaxedParts:
+        return relaxed_parts(self)
 
     # -------------------------------------------------------------- the table, interpolated
     @property
@@ -133,18 +160,18 @@ class CoupledCavity:
 
     def F1(self, u: float, dp: float) -> float:
         """Pull on the handle [N] at (u, dp)."""
-        return self.kappa * self._surfaces["F1"](u, dp)
+        return self.kappa * self._mechanics["F1"](u, dp)
 
     def V(self, u: float, dp: float) -> float:
         """Cavity volume [m^3] at (u, dp)."""
-        return self._surfaces["V"](u, dp)
+        return self._mechanics["V"](u, dp)
 
     def Ndot(self, u: float, dp: float) -> float:
         """Molecules per second leaking in at (u, dp): dp times the conductance Ndot / dp,
         interpolated in ln (it varies exponentially with the contact pressure; dividing by dp
         removes the zero of the driving force at dp = 0). A sealed node enters as 1e-30 of the
         largest conductance, and a conductance below 1e-20 of it is a seal (0)."""
-        g = float(np.exp(self._surfaces["Ndot"](u, dp)))
+        g = float(np.exp(self._rate_surface(u, dp)))
         return dp * g if g > 1e-20 * self._largest_conductance else 0.0
 
     @cached_property
@@ -153,13 +180,16 @@ class CoupledCavity:
         return float(np.max(g[np.isfinite(g)]))
 
     @cached_property
-    def _surfaces(self) -> dict[str, TableSurface]:
+    def _mechanics(self) -> dict[str, TableSurface]:
+        return {"F1": TableSurface(self._u, self._dp, self.table.F1_N, self.along_u),
+                "V": TableSurface(self._u, self._dp, self.table.V_m3, self.along_u)}
+
+    @cached_property
+    def _rate_surface(self) -> TableSurface:
         g = self._node_conductance          # inf: no contact (1e3 x the largest); nan: p_b < 0
         top, floor = 1e3 * self._largest_conductance, 1e-30 * self._largest_conductance
         rates = np.log(np.clip(np.where(np.isnan(g), floor, g), floor, top))
-        return {"F1": TableSurface(self._u, self._dp, self.table.F1_N, self.along_u),
-                "V": TableSurface(self._u, self._dp, self.table.V_m3, self.along_u),
-                "Ndot": TableSurface(self._u, self._dp, rates, self.along_u)}
+        return TableSurface(self._u, self._dp, rates, self.along_u)
 
     @cached_property
     def _node_conductance(self) -> np.ndarray:
@@ -178,27 +208,15 @@ class CoupledCavity:
                 drive = max(dp, 1.0)
                 gaps = ring_gaps(prof, self.u_c, E)
                 if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
-                    out[i, j] = np.inf           # open): no resistance, see _surfaces
+                    out[i, j] = np.inf           # open): no resistance, see _rate_surface
                     continue
                 out[i, j] = profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - drive, prof.r_m, gaps,
                                               self.radial) / drive
         return out
 
     def _solid_profile(self, i: int, j: int) -> ContactProfile | None:
-        """The solid contact pressure at node (i, j): kappa p_tab less the interface gas's rise
-        over p_b across the zone [r_k, r_cut] (module docstring)."""
-        prof = self.table.profiles[i][j]
-        if prof is None:
-            return None
-        dp = self._dp[j]
-        r, p = prof.r_m, self.kappa * prof.p_Pa
-        rk, rcut = self.table.seal_r_m[i, j], self.table.cut_r_m[i, j]
-        tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too
-        zone = (r >= rk - tol) & (r <= rcut + tol)
-        rise = {"p_b": 0.0, "p_a": 1.0}.get(self.interface)
-        if rise is None:
-            rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
-        return ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
+        """The solid contact pressure at node (i, j) of the kappa-times-stiffer cup (`solid_profile`)."""
+        return solid_profile(self.table, i, j, self.kappa, self._dp[j], self.interface)
 
     # -------------------------------------------------------------- the branch at fixed F1
     def u_at(self, F1: float, dp: float) -> float:
@@ -250,7 +268,11 @@ class CoupledCavity:
 
     def largest_holdable_force(self, u_start_m: float) -> float:
         """The largest F1 [N] the cup released at u_start holds at t = 0: the branch at that F1
-        just reaches the start content at its low-dp end (bisection on F1)."""
+        just reaches the start content at its low-dp end (bisection on F1). With relaxation: the
+        cup at t = 0, kappa(phi = 0)."""
+        if self.relaxation is not None:
+            k0 = self._relaxed.kappa(0.0)[0]
+            return replace(self, kappa=k0, relaxation=None, phi0_s=None).largest_holdable_force(u_start_m)
         _, N0 = self.start(u_start_m)
 
         def holds(F1: float) -> bool:
@@ -264,11 +286,18 @@ class CoupledCavity:
             lo, hi = (mid, hi) if holds(mid) else (lo, mid)
         return lo
 
-    def lifetime(self, force_N: float, u_start_m: float) -> CoupledLifetime:
-        """Lifetime of the cup released at u_start and pulled by F1 = force_N (module docstring)."""
+    def lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
+                 rtol: float = 1e-6) -> CoupledLifetime:
+        """Lifetime of the cup released at u_start and pulled by F1 = force_N (module docstring).
+        With relaxation it is integrated in time (`reduced.coupled_relax`) up to t_max_s with the
+        relative tolerance rtol; without, t_max_s and rtol are not used (a quadrature)."""
         F1 = float(force_N)
         if not (math.isfinite(F1) and F1 > 0):
             raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
+        if self.relaxation is not None:
+            if not (t_max_s > 0 and 0 < rtol < 1e-2):
+                raise ValueError(f"t_max_s, rtol: need t_max_s > 0 and 0 < rtol < 0.01, got {t_max_s}, {rtol}")
+            return relaxed_lifetime(self, F1, u_start_m, t_max_s, rtol)
         _, N0 = self.start(u_start_m)
         lo, hi = self._dp_range(F1)
         empty = np.zeros(0)
@@ -300,3 +329,20 @@ class CoupledCavity:
         return CoupledLifetime(F1, float(t[-1]), reason, f"detached at t = {t[-1]:.4g} s: {where}", N0,
                                t, u, dps, N, q, V, p_a_Pa=self.p_a_Pa)
 
+
+def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,
+                  interface: str) -> ContactProfile | None:
+    """The solid contact pressure at node (i, j): scale p_tab less the interface gas's rise over
+    p_b across the zone [r_k, r_cut] at the pressure difference dp (module docstring); None where
+    the table has no profile."""
+    prof = table.profiles[i][j]
+    if prof is None:
+        return None
+    r, p = prof.r_m, scale * prof.p_Pa
+    rk, rcut = table.seal_r_m[i, j], table.cut_r_m[i, j]
+    tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too
+    zone = (r >= rk - tol) & (r <= rcut + tol)
+    rise = {"p_b": 0.0, "p_a": 1.0}.get(interface)
+    if rise is None:
+        rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
+    return ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))

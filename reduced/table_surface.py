@@ -10,6 +10,7 @@ partial derivatives of the same interpolant (dz/du continuous, dz/ddp constant o
 from __future__ import annotations
 
 import bisect
+from functools import cached_property
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
@@ -45,18 +46,23 @@ class TableSurface:
         return float((1 - t) * col[0] + t * col[1])
 
     def value_and_slopes(self, a: float, b: float) -> tuple[float, float, float]:
-        """(z, dz/du, dz/ddp) at (a, b)."""
+        """(z, dz/du, dz/ddp) at (a, b) (on Python floats: it is called in the inner loops)."""
         i, j, s, t = cell(self.u, self.dp, a, b)
-        z0, z1 = self.z[i, j:j + 2], self.z[i + 1, j:j + 2]
-        h = self.u[i + 1] - self.u[i]
+        z, h = self._lists[0], self._lists[2][i]
+        z00, z01, z10, z11 = z[i][j], z[i][j + 1], z[i + 1][j], z[i + 1][j + 1]
         if self.slope is None:
-            col, dcol = (1 - s) * z0 + s * z1, (z1 - z0) / h
+            c0, c1 = z00 + s * (z10 - z00), z01 + s * (z11 - z01)
+            d0, d1 = (z10 - z00) / h, (z11 - z01) / h
         else:
-            m0, m1 = h * self.slope[i, j:j + 2], h * self.slope[i + 1, j:j + 2]
-            col = ((2 * s**3 - 3 * s**2 + 1) * z0 + (s**3 - 2 * s**2 + s) * m0
-                   + (-2 * s**3 + 3 * s**2) * z1 + (s**3 - s**2) * m1)
-            dcol = ((6 * s**2 - 6 * s) * (z0 - z1) + (3 * s**2 - 4 * s + 1) * m0
-                    + (3 * s**2 - 2 * s) * m1) / h
-        w = self.dp[j + 1] - self.dp[j]
-        return (float((1 - t) * col[0] + t * col[1]), float((1 - t) * dcol[0] + t * dcol[1]),
-                float((col[1] - col[0]) / w))
+            m = self._lists[1]
+            m00, m01, m10, m11 = h * m[i][j], h * m[i][j + 1], h * m[i + 1][j], h * m[i + 1][j + 1]
+            h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+            g0, g10, g11 = (6 * s**2 - 6 * s) / h, (3 * s**2 - 4 * s + 1) / h, (3 * s**2 - 2 * s) / h
+            c0, c1 = h00 * z00 + h10 * m00 + h01 * z10 + h11 * m10, h00 * z01 + h10 * m01 + h01 * z11 + h11 * m11
+            d0, d1 = g0 * (z00 - z10) + g10 * m00 + g11 * m10, g0 * (z01 - z11) + g10 * m01 + g11 * m11
+        return (1 - t) * c0 + t * c1, (1 - t) * d0 + t * d1, (c1 - c0) / (self.dp[j + 1] - self.dp[j])
+
+    @cached_property
+    def _lists(self) -> tuple[list, list | None, list]:
+        return (self.z.tolist(), None if self.slope is None else self.slope.tolist(),
+                np.diff(self.u).tolist())
