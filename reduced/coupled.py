@@ -30,7 +30,9 @@ paper's kappa multiplies F0 (Fig. 1stiffnessFactor): a neo-Hookean body in frict
 with modulus kappa E answers dp exactly as the table's body answers dp / kappa, so F1(u, dp) =
 kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa) and the contact pressures scale
 likewise, while u_c(p/E) keeps the table's E (the same rubber at the interface, as in the paper
-route). Relaxation is not modelled here.
+route). With a relaxation modulus (`relaxation`, `phi0_s`) kappa follows the contact time,
+kappa(phi) = kappa E_eff(phi) / E_eff(phi0) with eq (10), the interface sees E_eff(phi) as on the
+paper route, and (N, phi) is integrated in time: `reduced.coupled_relax`.
 """
 
 from __future__ import annotations
@@ -48,7 +50,7 @@ from reduced.gas import AIR, Gas
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
 from reduced.suction_table import SuctionTable
 from reduced.viscoelastic import RelaxationModulus
-from reduced.table_surface import TableSurface
+from reduced.table_surface import TableSurface, solid_profile
 
 __all__ = ["CoupledCavity", "CoupledLifetime", "INTERFACES"]
 
@@ -329,20 +331,3 @@ class CoupledCavity:
         return CoupledLifetime(F1, float(t[-1]), reason, f"detached at t = {t[-1]:.4g} s: {where}", N0,
                                t, u, dps, N, q, V, p_a_Pa=self.p_a_Pa)
 
-
-def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,
-                  interface: str) -> ContactProfile | None:
-    """The solid contact pressure at node (i, j): scale p_tab less the interface gas's rise over
-    p_b across the zone [r_k, r_cut] at the pressure difference dp (module docstring); None where
-    the table has no profile."""
-    prof = table.profiles[i][j]
-    if prof is None:
-        return None
-    r, p = prof.r_m, scale * prof.p_Pa
-    rk, rcut = table.seal_r_m[i, j], table.cut_r_m[i, j]
-    tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too
-    zone = (r >= rk - tol) & (r <= rcut + tol)
-    rise = {"p_b": 0.0, "p_a": 1.0}.get(interface)
-    if rise is None:
-        rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
-    return ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))

@@ -48,7 +48,7 @@ from scipy.optimize import brentq
 
 from reduced.ode import dopri5
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
-from reduced.table_surface import TableSurface, cell
+from reduced.table_surface import TableSurface, cell, solid_profile
 
 if TYPE_CHECKING:
     from reduced.coupled import CoupledCavity, CoupledLifetime
@@ -95,7 +95,6 @@ class _NodeRates:
     interpolation in p_b = p_a - kappa s_j over [max(0, p_a - kappa_hi s_j), p_a]."""
 
     def __init__(self, cc: CoupledCavity, E_ref: float, kappa_hi: float):
-        from reduced.coupled import solid_profile
         t, pa = cc.table, cc.p_a_Pa
         self.u, self.s, self.pa, self.along_u = t.u_m, t.dp_Pa, pa, cc.along_u
         nu, ns = t.F1_N.shape
@@ -105,24 +104,32 @@ class _NodeRates:
         self.fixed = np.full((nu, ns), np.nan)      # +inf: no contact; -inf: sealed; dp = 0: its limit
         for i in range(nu):
             for j in range(ns):
-                prof = solid_profile(t, i, j, 1.0, self.s[j], cc.interface)
-                if prof is None:
-                    raise ValueError(f"suction table: no contact profile at u = {1e3 * t.u_m[i]:.4g} mm, "
-                                     f"dp = {self.s[j] / 1e3:.4g} kPa (the cavity is open)")
-                gaps = ring_gaps(prof, cc.u_c, E_ref, scale=cc.kappa)
-                if np.all(np.isinf(gaps)) or np.any(gaps <= 0):
-                    self.fixed[i, j] = math.inf if np.all(np.isinf(gaps)) else -math.inf
-                    continue
-                leak = lambda pb: profile_leak_rate(cc.gas, pa, pb, prof.r_m, gaps, cc.radial)  # noqa: E731
-                if j == 0:
-                    self.fixed[i, j] = math.log(leak(pa - 1.0))      # the dp -> 0 limit, as unrelaxed
-                    continue
-                pb = 0.5 * (self.lo[j] + pa) + 0.5 * (pa - self.lo[j]) * x
-                self.coef[i, j] = chebyshev.chebfit(x, [math.log(leak(b) / (pa - b)) for b in pb],
-                                                    _CHEBYSHEV - 1)
+                self.fixed[i, j], self.coef[i, j] = self._fit(cc, i, j, E_ref, x)
         at_ref = np.concatenate([self._raw(cc.kappa, j) for j in range(ns)])
         self.top = float(np.max(at_ref[np.isfinite(at_ref)]))
         self._last: tuple = (None, None, None)
+
+    def _fit(self, cc: CoupledCavity, i: int, j: int, E_ref: float, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """(fixed value or nan, Chebyshev coefficients) of node (i, j): gaps from the solid profile
+        at s_j (kappa-free), the leak at the p_b of the Chebyshev points x."""
+        none = np.zeros(_CHEBYSHEV)
+        pa, s = self.pa, self.s[j]
+        prof = solid_profile(cc.table, i, j, 1.0, s, cc.interface)
+        if prof is None:
+            raise ValueError(f"suction table: no contact profile at u = {1e3 * self.u[i]:.4g} mm, "
+                             f"dp = {s / 1e3:.4g} kPa (the cavity is open)")
+        gaps = ring_gaps(prof, cc.u_c, E_ref, scale=cc.kappa)
+        if np.all(np.isinf(gaps)):
+            return math.inf, none                        # no contact: no resistance
+        if np.any(gaps <= 0):
+            return -math.inf, none                       # sealed
+
+        def leak(pb: float) -> float:
+            return profile_leak_rate(cc.gas, pa, pb, prof.r_m, gaps, cc.radial)
+        if j == 0:
+            return math.log(leak(pa - 1.0)), none        # the dp -> 0 limit, as unrelaxed
+        pb = 0.5 * (self.lo[j] + pa) + 0.5 * (pa - self.lo[j]) * x
+        return math.nan, chebyshev.chebfit(x, [math.log(leak(b) / (pa - b)) for b in pb], _CHEBYSHEV - 1)
 
     @property
     def largest(self) -> float:
@@ -399,71 +406,89 @@ class _Dynamics:
 def relaxed_lifetime(cc: CoupledCavity, F1: float, u_start: float, t_max: float,
                      rtol: float) -> CoupledLifetime:
     """Lifetime of the relaxing cup released at u_start and pulled by F1 (module docstring)."""
-    from reduced.coupled import CoupledLifetime
-    parts = cc._relaxed
-    k0, dk0 = parts.kappa(0.0)
-    frozen = replace(cc, kappa=k0, relaxation=None, phi0_s=None)      # the cup at t = 0
-    _, N0 = frozen.start(u_start)
-    lo, hi = frozen._dp_range(F1)
-    empty = np.zeros(0)
+    run = _Run(cc, F1)
+    k0, dk0 = run.parts.kappa(0.0)
+    P0 = run.start(u_start, k0)
+    if P0 is None:
+        return run.result(0.0, "over_force", f"F1 = {F1:g} N exceeds what the cup holds with its "
+                          f"start content: it detaches at once", [])
+    first = run.dyn.rates(P0, k0, dk0, 0.0)
+    if first.N_dot <= 0.0:
+        return run.result(math.inf, "sealed", f"the interface is sealed at t = 0 (u = {1e3 * P0.u:.4g} "
+                          f"mm, dp = {k0 * P0.s / 1e3:.4g} kPa)", [run.row(0.0, run.N0, 0.0, first)])
+    sol = run.integrate(first, k0, t_max, rtol)
+    rows = run.trajectory(sol, P0)
+    t_end = float(sol.t[-1])
+    if sol.event is None:
+        return run.result(math.inf, "horizon", f"still attached at t_max = {t_max:g} s", rows, sol.steps)
+    where = (f"u reached the table's smallest u = {1e3 * cc.table.u_m[0]:.4g} mm" if sol.event == 0 else
+             "the branch folds (D = 0: no state holds more gas, or rdot diverges in eq 10)")
+    return run.result(t_end, ("table_edge", "fold")[sol.event], f"detached at t = {t_end:.4g} s: {where}",
+                      rows, sol.steps)
 
-    def result(life: float, reason: str, msg: str, rows: list) -> CoupledLifetime:
-        a = np.array(rows, dtype=float).reshape(-1, 8).T
-        return CoupledLifetime(F1, life, reason, msg, N0, *a[:6], p_a_Pa=cc.p_a_Pa, phi_s=a[6],
-                               kappa=a[7], steps=steps)
 
-    steps = 0
-    if not np.isfinite(lo) or N0 > frozen.content(F1, lo)[1]:
-        return result(0.0, "over_force", f"F1 = {F1:g} N exceeds what the cup holds with its start "
-                      f"content: it detaches at once", [])
-    if N0 < frozen.content(F1, hi)[1]:
-        raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
-                         f"{1e3 * cc.table.u_m[-1]:.4g} mm; extend the table")
-    branch = _Branch(cc, F1, parts.surfaces)
-    branch.last_s = brentq(lambda d: frozen.content(F1, d)[1] - N0, lo, hi, xtol=1e-10 * max(hi, 1.0)) / k0
-    P0, end = branch.solve(N0, k0)
-    if end is not None:
-        return result(0.0, "over_force", f"F1 = {F1:g} N: the branch ends ({end}) before it holds the "
-                      f"start content: it detaches at once", [])
-    start = (P0.u, P0.s)
-    dyn = _Dynamics(cc, parts, branch)
-    first = dyn.rates(P0, k0, dk0, 0.0)
+class _Run:
+    """One relaxed lifetime: the start, the integration of (N - N0, phi) and the trajectory."""
 
+    def __init__(self, cc: CoupledCavity, F1: float):
+        self.cc, self.F1, self.parts = cc, F1, cc._relaxed
+        self.branch = _Branch(cc, F1, self.parts.surfaces)
+        self.dyn = _Dynamics(cc, self.parts, self.branch)
+        self.N0 = math.nan
+
+    def start(self, u_start: float, k0: float) -> _Point | None:
+        """The state at t = 0 (N0 fixed at F1 = 0 and kappa(0), Sec. 3), None for an over-force."""
+        cc, F1 = self.cc, self.F1
+        frozen = replace(cc, kappa=k0, relaxation=None, phi0_s=None)      # the cup at t = 0
+        _, self.N0 = frozen.start(u_start)
+        lo, hi = frozen._dp_range(F1)
+        if not np.isfinite(lo) or self.N0 > frozen.content(F1, lo)[1]:
+            return None
+        if self.N0 < frozen.content(F1, hi)[1]:
+            raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
+                             f"{1e3 * cc.table.u_m[-1]:.4g} mm; extend the table")
+        dp0 = brentq(lambda d: frozen.content(F1, d)[1] - self.N0, lo, hi, xtol=1e-10 * max(hi, 1.0))
+        self.branch.last_s = dp0 / k0
+        P0, end = self.branch.solve(self.N0, k0)
+        return P0 if end is None else None
+
+    def integrate(self, first: _Rates, k0: float, t_max: float, rtol: float):
+        """dopri5 on y = (N - N0, phi) (beyond the branch's end: its end values) with the edge and
+        fold events."""
+        N0, kappa, dyn, D0 = self.N0, self.parts.kappa, self.dyn, abs(first.D)
+        Q_scale = self.branch.edge(k0).N - N0             # the leak to the table's edge at t = 0
+
+        def rhs(t: float, y: list) -> list:
+            R = dyn(N0 + y[0], max(y[1], 0.0))
+            return [R.N_dot, R.phi_dot]
+
+        def edge_event(t: float, y: list) -> float:
+            return N0 + y[0] - self.branch.edge(kappa(max(y[1], 0.0))[0]).N
+
+        def fold_event(t: float, y: list) -> float:
+            return _DYNAMIC_FOLD - abs(dyn(N0 + y[0], max(y[1], 0.0)).D) / D0
+
+        return dopri5(rhs, 0.0, [0.0, 0.0], t_max, rtol, [rtol * Q_scale, 1e-6],
+                      events=[edge_event, fold_event], h0=1e-3 * Q_scale / first.N_dot)
+
+    def trajectory(self, sol, P0: _Point) -> list[tuple]:
+        """The rows at the accepted steps, each solved on the branch from the start on."""
+        self.branch.last_u, self.branch.last_s = P0.u, P0.s
+        rows = []
+        for t, (q, phi) in zip(sol.t, sol.y):
+            phi, N = max(phi, 0.0), self.N0 + q
+            if t == sol.t[-1] and sol.event == 0:      # the event is N = N_edge(kappa): its time interpolated
+                N = self.branch.edge(self.parts.kappa(phi)[0]).N
+            rows.append(self.row(t, N, phi, self.dyn(N, phi)))
+        return rows
+
+    @staticmethod
     def row(t: float, N: float, phi: float, R: _Rates) -> tuple:
         P = R.point
         return (t, P.u, R.kappa * P.s, N, R.N_dot, P.V[0], phi, R.kappa)
 
-    if first.N_dot <= 0.0:
-        return result(math.inf, "sealed", f"the interface is sealed at t = 0 (u = {1e3 * P0.u:.4g} mm, "
-                      f"dp = {k0 * P0.s / 1e3:.4g} kPa)", [row(0.0, N0, 0.0, first)])
-    D0 = abs(first.D)
-    Q_scale = branch.edge(k0).N - N0                  # the leak to the table's edge at t = 0
-
-    def rhs(t: float, y: list) -> list:             # y = (N - N0, phi); beyond the end: its values
-        R = dyn(N0 + y[0], max(y[1], 0.0))
-        return [R.N_dot, R.phi_dot]
-
-    def edge_event(t: float, y: list) -> float:
-        return N0 + y[0] - branch.edge(parts.kappa(max(y[1], 0.0))[0]).N
-
-    def fold_event(t: float, y: list) -> float:
-        return _DYNAMIC_FOLD - abs(dyn(N0 + y[0], max(y[1], 0.0)).D) / D0
-
-    sol = dopri5(rhs, 0.0, [0.0, 0.0], t_max, rtol, [rtol * Q_scale, 1e-6],
-                 events=[edge_event, fold_event], h0=1e-3 * Q_scale / first.N_dot)
-    steps = sol.steps
-    branch.last_u, branch.last_s = start
-    rows = []
-    for t, (q, phi) in zip(sol.t, sol.y):
-        phi = max(phi, 0.0)
-        N = N0 + q
-        if t == sol.t[-1] and sol.event == 0:      # the event is N = N_edge(kappa); its time interpolated
-            N = branch.edge(parts.kappa(phi)[0]).N
-        rows.append(row(t, N, phi, dyn(N, phi)))
-    t_end = float(sol.t[-1])
-    if sol.event is None:
-        return result(math.inf, "horizon", f"still attached at t_max = {t_max:g} s", rows)
-    reason = ("table_edge", "fold")[sol.event]
-    where = (f"u reached the table's smallest u = {1e3 * cc.table.u_m[0]:.4g} mm" if sol.event == 0 else
-             "the branch folds (D = 0: no state holds more gas, or rdot diverges in eq 10)")
-    return result(t_end, reason, f"detached at t = {t_end:.4g} s: {where}", rows)
+    def result(self, life: float, reason: str, msg: str, rows: list, steps: int = 0) -> CoupledLifetime:
+        from reduced.coupled import CoupledLifetime
+        a = np.array(rows, dtype=float).reshape(-1, 8).T
+        return CoupledLifetime(self.F1, life, reason, msg, self.N0, *a[:6], p_a_Pa=self.cc.p_a_Pa,
+                               phi_s=a[6], kappa=a[7], steps=steps)

@@ -5,6 +5,7 @@ PCHIP (Fritsch-Carlson slopes) keeps each column's monotonicity (the branch stay
 third order where the data are smooth; linear along dp keeps monotone rows monotone. The grid
 refinement in benchmarks/bench_coupled.py measures both. `value_and_slopes` also returns the two
 partial derivatives of the same interpolant (dz/du continuous, dz/ddp constant on each cell).
+`solid_profile`: the contact pressure a node's leak goes through.
 """
 
 from __future__ import annotations
@@ -15,7 +16,10 @@ from functools import cached_property
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-__all__ = ["TableSurface", "cell"]
+from reduced.profile_leak import ContactProfile
+from reduced.suction_table import SuctionTable
+
+__all__ = ["TableSurface", "cell", "solid_profile"]
 
 
 def cell(x: np.ndarray, y: np.ndarray, a: float, b: float) -> tuple[int, int, float, float]:
@@ -66,3 +70,21 @@ class TableSurface:
     def _lists(self) -> tuple[list, list | None, list]:
         return (self.z.tolist(), None if self.slope is None else self.slope.tolist(),
                 np.diff(self.u).tolist())
+
+
+def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,
+                  interface: str) -> ContactProfile | None:
+    """The solid contact pressure at node (i, j): scale p_tab less the interface gas's rise over
+    p_b across the zone [r_k, r_cut] at the pressure difference dp (`reduced.coupled`); None where
+    the table has no profile."""
+    prof = table.profiles[i][j]
+    if prof is None:
+        return None
+    r, p = prof.r_m, scale * prof.p_Pa
+    rk, rcut = table.seal_r_m[i, j], table.cut_r_m[i, j]
+    tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too
+    zone = (r >= rk - tol) & (r <= rcut + tol)
+    rise = {"p_b": 0.0, "p_a": 1.0}.get(interface)
+    if rise is None:
+        rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
+    return ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
