@@ -63,7 +63,7 @@ class CoupledLifetime:
 
     force_N: float
     lifetime_s: float
-    reason: str              # "table_edge", "fold", "sealed", "over_force"
+    reason: str              # "table_edge", "fold", "sealed", "over_force" (relaxed: also "horizon")
     message: str
     N0: float
     t_s: np.ndarray
