@@ -30,24 +30,27 @@ paper's kappa multiplies F0 (Fig. 1stiffnessFactor): a neo-Hookean body in frict
 with modulus kappa E answers dp exactly as the table's body answers dp / kappa, so F1(u, dp) =
 kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa) and the contact pressures scale
 likewise, while u_c(p/E) keeps the table's E (the same rubber at the interface, as in the paper
-route). Relaxation is not modelled here.
+route). With a relaxation modulus (`relaxation`, `phi0_s`) kappa follows the contact time,
+kappa(phi) = kappa E_eff(phi) / E_eff(phi0) with eq (10), the interface sees E_eff(phi) as on the
+paper route, and (N, phi) is integrated in time: `reduced.coupled_relax`.
 """
 
 from __future__ import annotations
 
-import bisect
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 from scipy.optimize import brentq
 
+from reduced.coupled_relax import RelaxedParts, relaxed_lifetime, relaxed_parts
 from reduced.gas import AIR, Gas
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
 from reduced.suction_table import SuctionTable
+from reduced.viscoelastic import RelaxationModulus
+from reduced.table_surface import TableSurface, solid_profile
 
 __all__ = ["CoupledCavity", "CoupledLifetime", "INTERFACES"]
 
@@ -60,7 +63,7 @@ class CoupledLifetime:
 
     force_N: float
     lifetime_s: float
-    reason: str              # "table_edge", "fold", "sealed", "over_force"
+    reason: str              # "table_edge", "fold", "sealed", "over_force" (relaxed: also "horizon")
     message: str
     N0: float
     t_s: np.ndarray
@@ -70,6 +73,9 @@ class CoupledLifetime:
     N_dot_per_s: np.ndarray
     V_m3: np.ndarray
     p_a_Pa: float = 1e5
+    phi_s: np.ndarray | None = None     # with relaxation: the contact time of eq (10)
+    kappa: np.ndarray | None = None     # with relaxation: the stiffness factor kappa(phi)
+    steps: int = 0                      # with relaxation: accepted integration steps
 
     @property
     def p_b_Pa(self) -> np.ndarray:
@@ -82,18 +88,26 @@ class CoupledLifetime:
                 "reason": self.reason, "sealed": self.reason == "sealed", "N0": self.N0,
                 "u_final_mm": 1e3 * float(self.u_m[-1]) if self.u_m.size else None,
                 "p_b_final_Pa": float(self.p_b_Pa[-1]) if self.dp_Pa.size else None,
+                **({} if self.phi_s is None else
+                   {"phi_final_s": float(self.phi_s[-1]) if self.phi_s.size else None,
+                    "kappa_final": float(self.kappa[-1]) if self.kappa.size else None,
+                    "steps": self.steps}),
                 "message": self.message}
 
     def trajectory_columns(self) -> dict[str, np.ndarray]:
         """Trajectory arrays under CSV column names that carry their units."""
         return {"t_s": self.t_s, "u_mm": 1e3 * self.u_m, "p_b_Pa": self.p_b_Pa, "N": self.N,
-                "N_dot_per_s": self.N_dot_per_s, "V_mm3": 1e9 * self.V_m3}
+                "N_dot_per_s": self.N_dot_per_s, "V_mm3": 1e9 * self.V_m3,
+                **({} if self.phi_s is None else {"phi_s": self.phi_s, "kappa": self.kappa})}
 
 
 @dataclass(frozen=True, eq=False)
 class CoupledCavity:
     """The coupled reduced model (module docstring). u_c: critical gap [m] as a function of p/E,
-    with E the table's modulus."""
+    with E the table's modulus (with relaxation E_eff(phi), `reduced.coupled_relax`).
+    relaxation: E_eff(t), or None (kappa fixed); phi0_s: with relaxation, the contact time [s] of
+    the stiffness measurement the table stands for (`reduced.viscoelastic.measurement_contact_time`,
+    13 s for cup A)."""
 
     table: SuctionTable
     u_c: Callable[[float], float]
@@ -104,6 +118,8 @@ class CoupledCavity:
     radial: str = "annulus"
     samples: int = 801
     along_u: str = "pchip"
+    relaxation: RelaxationModulus | None = None
+    phi0_s: float | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.kappa) and self.kappa > 0):
@@ -116,6 +132,18 @@ class CoupledCavity:
             raise ValueError(f"along_u: expected 'pchip' or 'linear', got {self.along_u!r}")
         if not (isinstance(self.samples, int) and self.samples >= 11):
             raise ValueError(f"samples: need an integer >= 11, got {self.samples}")
+        if self.phi0_s is not None and not (math.isfinite(self.phi0_s) and self.phi0_s > 0):
+            raise ValueError(f"phi0_s: measurement contact time must be finite and > 0 s, got {self.phi0_s}")
+        if self.relaxation is None and self.phi0_s is not None:
+            raise ValueError("phi0_s: the measurement contact time is used only with relaxation; "
+                             "give relaxation or drop phi0_s")
+        if self.relaxation is not None and self.phi0_s is None:
+            raise ValueError("phi0_s: with relaxation give the contact time of the stiffness "
+                             "measurement in s (> 0), e.g. reduced.viscoelastic.measurement_contact_time(cup)")
+
+    @cached_property
+    def _relaxed(self) -> RelaxedParts:
+        return relaxed_parts(self)
 
     # -------------------------------------------------------------- the table, interpolated
     @property
@@ -134,18 +162,18 @@ class CoupledCavity:
 
     def F1(self, u: float, dp: float) -> float:
         """Pull on the handle [N] at (u, dp)."""
-        return self.kappa * self._surfaces["F1"](u, dp)
+        return self.kappa * self._mechanics["F1"](u, dp)
 
     def V(self, u: float, dp: float) -> float:
         """Cavity volume [m^3] at (u, dp)."""
-        return self._surfaces["V"](u, dp)
+        return self._mechanics["V"](u, dp)
 
     def Ndot(self, u: float, dp: float) -> float:
         """Molecules per second leaking in at (u, dp): dp times the conductance Ndot / dp,
         interpolated in ln (it varies exponentially with the contact pressure; dividing by dp
         removes the zero of the driving force at dp = 0). A sealed node enters as 1e-30 of the
         largest conductance, and a conductance below 1e-20 of it is a seal (0)."""
-        g = float(np.exp(self._surfaces["Ndot"](u, dp)))
+        g = float(np.exp(self._rate_surface(u, dp)))
         return dp * g if g > 1e-20 * self._largest_conductance else 0.0
 
     @cached_property
@@ -154,13 +182,16 @@ class CoupledCavity:
         return float(np.max(g[np.isfinite(g)]))
 
     @cached_property
-    def _surfaces(self) -> dict[str, "_Surface"]:
+    def _mechanics(self) -> dict[str, TableSurface]:
+        return {"F1": TableSurface(self._u, self._dp, self.table.F1_N, self.along_u),
+                "V": TableSurface(self._u, self._dp, self.table.V_m3, self.along_u)}
+
+    @cached_property
+    def _rate_surface(self) -> TableSurface:
         g = self._node_conductance          # inf: no contact (1e3 x the largest); nan: p_b < 0
         top, floor = 1e3 * self._largest_conductance, 1e-30 * self._largest_conductance
         rates = np.log(np.clip(np.where(np.isnan(g), floor, g), floor, top))
-        return {"F1": _Surface(self._u, self._dp, self.table.F1_N, self.along_u),
-                "V": _Surface(self._u, self._dp, self.table.V_m3, self.along_u),
-                "Ndot": _Surface(self._u, self._dp, rates, self.along_u)}
+        return TableSurface(self._u, self._dp, rates, self.along_u)
 
     @cached_property
     def _node_conductance(self) -> np.ndarray:
@@ -179,27 +210,15 @@ class CoupledCavity:
                 drive = max(dp, 1.0)
                 gaps = ring_gaps(prof, self.u_c, E)
                 if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
-                    out[i, j] = np.inf           # open): no resistance, see _surfaces
+                    out[i, j] = np.inf           # open): no resistance, see _rate_surface
                     continue
                 out[i, j] = profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - drive, prof.r_m, gaps,
                                               self.radial) / drive
         return out
 
     def _solid_profile(self, i: int, j: int) -> ContactProfile | None:
-        """The solid contact pressure at node (i, j): kappa p_tab less the interface gas's rise
-        over p_b across the zone [r_k, r_cut] (module docstring)."""
-        prof = self.table.profiles[i][j]
-        if prof is None:
-            return None
-        dp = self._dp[j]
-        r, p = prof.r_m, self.kappa * prof.p_Pa
-        rk, rcut = self.table.seal_r_m[i, j], self.table.cut_r_m[i, j]
-        tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too
-        zone = (r >= rk - tol) & (r <= rcut + tol)
-        rise = {"p_b": 0.0, "p_a": 1.0}.get(self.interface)
-        if rise is None:
-            rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
-        return ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
+        """The solid contact pressure at node (i, j) of the kappa-times-stiffer cup (`solid_profile`)."""
+        return solid_profile(self.table, i, j, self.kappa, self._dp[j], self.interface)
 
     # -------------------------------------------------------------- the branch at fixed F1
     def u_at(self, F1: float, dp: float) -> float:
@@ -251,7 +270,11 @@ class CoupledCavity:
 
     def largest_holdable_force(self, u_start_m: float) -> float:
         """The largest F1 [N] the cup released at u_start holds at t = 0: the branch at that F1
-        just reaches the start content at its low-dp end (bisection on F1)."""
+        just reaches the start content at its low-dp end (bisection on F1). With relaxation: the
+        cup at t = 0, kappa(phi = 0)."""
+        if self.relaxation is not None:
+            k0 = self._relaxed.kappa(0.0)[0]
+            return replace(self, kappa=k0, relaxation=None, phi0_s=None).largest_holdable_force(u_start_m)
         _, N0 = self.start(u_start_m)
 
         def holds(F1: float) -> bool:
@@ -265,11 +288,18 @@ class CoupledCavity:
             lo, hi = (mid, hi) if holds(mid) else (lo, mid)
         return lo
 
-    def lifetime(self, force_N: float, u_start_m: float) -> CoupledLifetime:
-        """Lifetime of the cup released at u_start and pulled by F1 = force_N (module docstring)."""
+    def lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
+                 rtol: float = 1e-6) -> CoupledLifetime:
+        """Lifetime of the cup released at u_start and pulled by F1 = force_N (module docstring).
+        With relaxation it is integrated in time (`reduced.coupled_relax`) up to t_max_s with the
+        relative tolerance rtol; without, t_max_s and rtol are not used (a quadrature)."""
         F1 = float(force_N)
         if not (math.isfinite(F1) and F1 > 0):
             raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
+        if self.relaxation is not None:
+            if not (t_max_s > 0 and 0 < rtol < 1e-2):
+                raise ValueError(f"t_max_s, rtol: need t_max_s > 0 and 0 < rtol < 0.01, got {t_max_s}, {rtol}")
+            return relaxed_lifetime(self, F1, u_start_m, t_max_s, rtol)
         _, N0 = self.start(u_start_m)
         lo, hi = self._dp_range(F1)
         empty = np.zeros(0)
@@ -301,33 +331,3 @@ class CoupledCavity:
         return CoupledLifetime(F1, float(t[-1]), reason, f"detached at t = {t[-1]:.4g} s: {where}", N0,
                                t, u, dps, N, q, V, p_a_Pa=self.p_a_Pa)
 
-
-def _cell(x: np.ndarray, y: np.ndarray, a: float, b: float) -> tuple[int, int, float, float]:
-    """Cell (i, j) and local coordinates of (a, b) on the grid x by y (clamped to it)."""
-    i = min(max(bisect.bisect_right(x, a) - 1, 0), x.size - 2)
-    j = min(max(bisect.bisect_right(y, b) - 1, 0), y.size - 2)
-    return i, j, (a - x[i]) / (x[i + 1] - x[i]), (b - y[j]) / (y[j + 1] - y[j])
-
-
-class _Surface:
-    """z(u, dp) on the table's grid: monotone cubic (PCHIP, Fritsch-Carlson slopes) or linear along
-    u, linear along dp. PCHIP keeps each column's monotonicity (the branch stays unique) and is
-    third order where the data are smooth; the grid refinement in benchmarks/bench_coupled.py
-    measures both."""
-
-    def __init__(self, u: np.ndarray, dp: np.ndarray, z: np.ndarray, along_u: str):
-        self.u, self.dp, self.z = u, dp, np.asarray(z, dtype=float)
-        self.slope = (PchipInterpolator(u, self.z, axis=0).derivative()(u) if along_u == "pchip"
-                      else None)
-
-    def __call__(self, a: float, b: float) -> float:
-        i, j, s, t = _cell(self.u, self.dp, a, b)
-        z0, z1 = self.z[i, j:j + 2], self.z[i + 1, j:j + 2]
-        if self.slope is None:
-            col = (1 - s) * z0 + s * z1
-        else:
-            h = self.u[i + 1] - self.u[i]
-            h00, h10, h01, h11 = (2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2,
-                                  s**3 - s**2)
-            col = h00 * z0 + h10 * h * self.slope[i, j:j + 2] + h01 * z1 + h11 * h * self.slope[i + 1, j:j + 2]
-        return float((1 - t) * col[0] + t * col[1])

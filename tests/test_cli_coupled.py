@@ -4,6 +4,7 @@ library's, and bad input is one line, exit 2, nothing written."""
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from reduced.cup import CUP_A
 from reduced.gas import Gas
 from reduced.profile_leak import ContactProfile
 from reduced.suction_table import SuctionTable
+from reduced.viscoelastic import default_relaxation, measurement_contact_time
 from validation.cli import main
 from validation.coupled.table import fem_beta
 
@@ -65,7 +67,15 @@ def test_coupled_route_matches_the_library(capsys, table_path, tmp_path):
 
 @pytest.mark.parametrize("argv, field", [
     (["lifetime", "--route", "coupled", "--force", "5"], "--suction-table"),
-    (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--relaxation", "default"], "--route"),
+    (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--fluid", "water"], "--route"),
+    (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--relaxation", "default",
+      "--phi0-s", "0"], "--phi0-s"),
+    (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--relaxation", "default",
+      "--phi0-s", "nan"], "--phi0-s"),
+    (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--phi0-s", "13"], "--phi0-s"),
+    (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--relaxation", "none.csv"], "relaxation"),
+    (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--relaxation", "default",
+      "--rtol", "0.5"], "--rtol"),
     (["lifetime", "--route", "coupled", "--suction-table", "nowhere.json"], "--suction-table"),
     (["lifetime", "--suction-table", "TABLE", "--force", "5"], "--suction-table"),
     (["lifetime", "--route", "coupled", "--suction-table", "TABLE", "--kappa", "-1"], "--kappa"),
@@ -108,3 +118,42 @@ def test_fem_beta_reads_back_a_known_strip_load():
     table = SuctionTable(u, dp, F1, np.full((2, 3), 1e-6), np.full((2, 3), r_k),
                          np.full((2, 3), r_k + l), ((strip,) * 3,) * 2, E_Pa=4e6)
     assert np.allclose(fem_beta(table), b, rtol=1e-9)
+
+
+def test_relaxed_coupled_route_matches_the_library(capsys, table_path, tmp_path):
+    """--relaxation default on the coupled route: phi0 defaults to cup A's measurement contact
+    time (13 s), the lifetimes are the library's, the trajectory carries phi and kappa."""
+    code, out, _ = _run(capsys, "lifetime", "--route", "coupled", "--suction-table", str(table_path),
+                        "--cup", "A", "--force", "2", "--relaxation", "default", "--json",
+                        "--out", str(tmp_path / "run"))
+    assert code == 0
+    row = json.loads(out)[0]
+    assert row["cup"]["phi0_s"] == pytest.approx(measurement_contact_time(CUP_A), rel=1e-12)
+    model = CoupledCavity(SuctionTable.from_json(table_path), UcTable.from_csv(ILLUSTRATIVE_UC_CSV),
+                          Gas(T_K=293.15), 1e5, relaxation=default_relaxation(),
+                          phi0_s=measurement_contact_time(CUP_A))
+    expected = model.lifetime(2.0, CUP_A.h1_m - CUP_A.h_start_m)
+    assert row["lifetime_s"] == pytest.approx(expected.lifetime_s, rel=1e-12)
+    assert row["kappa_final"] == pytest.approx(expected.kappa[-1], rel=1e-12)
+    header = (tmp_path / "run" / "trajectory_F1_2N.csv").read_text().splitlines()[0]
+    assert header.endswith("phi_s,kappa")
+
+
+def test_relaxed_node_conductance_is_the_unrelaxed_one_at_each_kappa(table_path):
+    """The relaxed model's node conductances (Chebyshev in p_b, `reduced.coupled_relax`) at a
+    frozen kappa against the unrelaxed model's, computed directly for the cup that is kappa times
+    stiffer and meets the interface with E = kappa E_eff(phi0) (the FEM profiles: many rings;
+    measured 5e-9 in ln on this table)."""
+    table = SuctionTable.from_json(table_path)
+    uc = UcTable.from_csv(ILLUSTRATIVE_UC_CSV)
+    law = default_relaxation()
+    relaxed = CoupledCavity(table, uc, Gas(T_K=293.15), 1e5, relaxation=law, phi0_s=13.0)
+    rates = relaxed._relaxed.rates
+    E_ref = float(law(13.0))
+    for kappa in (0.6, 1.0, 1.2):
+        direct = CoupledCavity(replace(table, E_Pa=kappa * E_ref), uc, Gas(T_K=293.15), 1e5, kappa=kappa)
+        g = direct._node_conductance
+        fitted = np.stack([rates.column(kappa, j) for j in range(table.dp_Pa.size)], axis=1)
+        ok = np.isfinite(g) & (g > 0)
+        assert ok.sum() > 0.5 * g.size
+        assert np.max(np.abs(fitted[ok] - np.log(g[ok]))) < 1e-7

@@ -1,7 +1,7 @@
 """The coupled cavity (reduced/coupled.py) against the paper's own route: a suction table built from
 eqs (3)-(7) (F1 = dp pi r^2 - F0, V of eq 4, a uniform strip at eq 6's pressure) must give the
 lifetimes of the paper's reduced model, to the table's interpolation error, which falls with the
-grid. And the table's JSON round trip."""
+grid, also with viscoelastic relaxation (reduced/coupled_relax.py). And the table's JSON round trip."""
 
 import math
 from dataclasses import replace
@@ -10,11 +10,13 @@ import numpy as np
 import pytest
 
 from reduced.coupled import CoupledCavity
+from reduced.coupled_relax import load_strip
 from reduced.critical_gap import illustrative_uc_table
 from reduced.cup import cup_by_name
 from reduced.lifetime import lifetime, reference_model
 from reduced.profile_leak import ContactProfile
 from reduced.suction_table import SuctionTable
+from reduced.viscoelastic import RelaxationModulus, default_relaxation, measurement_contact_time
 
 
 def paper_table(model, nu: int, ndp: int) -> SuctionTable:
@@ -107,3 +109,113 @@ def test_interface_gas_bounds_the_lifetime(model):
             for i in ("p_a", "linear", "p_b")}
     assert life["p_a"] < life["linear"] < life["p_b"]
 
+
+
+# ----------------------------------------------------------------------------- relaxation
+def _relaxed_on_paper_table(model, n: int, law, phi0_s: float, **kw) -> CoupledCavity:
+    return CoupledCavity(paper_table(model, n, n), model.u_c, model.gas, model.p_a_Pa, interface="p_b",
+                         radial="strip", relaxation=law, phi0_s=phi0_s, **kw)
+
+
+def test_flat_relaxation_is_the_quadrature(model):
+    """E_eff constant at the table's E: kappa = 1 and p/E as unrelaxed, so the time integration of
+    (N, phi) must give the quadrature t = int dN / Ndot (converged: 6401 samples change it by
+    < 1e-6 from 1601) to the ODE tolerance (rtol 1e-6; measured 5e-6 / 3.5e-5 / 6e-6 on 41 x 41,
+    the kinks of the dp-linear surfaces cost the error control a factor ~30)."""
+    flat = RelaxationModulus(np.array([1.0, 10.0]), np.array([4e6, 4e6]))
+    relaxed = _relaxed_on_paper_table(model, 41, flat, 1.0)
+    quadrature = replace(relaxed, relaxation=None, phi0_s=None, samples=6401)
+    u_start = model.cup.h1_m - model.cup.h_start_m
+    for F1 in (5.0, 20.0, 60.0):
+        r = relaxed.lifetime(F1, u_start)
+        assert r.reason == "table_edge" and np.allclose(r.kappa, 1.0, rtol=1e-12, atol=0)
+        assert r.lifetime_s == pytest.approx(quadrature.lifetime(F1, u_start).lifetime_s, rel=1e-4)
+
+
+@pytest.fixture(scope="module")
+def relaxed_refined(model):
+    """The relaxed coupled model (default law, phi0 of cup A) on paper tables of 21 and 41 points."""
+    phi0 = measurement_contact_time(model.cup)
+    return [_relaxed_on_paper_table(model, n, default_relaxation(), phi0) for n in (21, 41)]
+
+
+@pytest.mark.parametrize("F1", [5.0, 20.0, 60.0])
+def test_relaxed_paper_table_reproduces_the_relaxed_paper_route(model, relaxed_refined, F1):
+    """The paper table carries the paper's r (eq 3, the strip's inner edge) and l (eq 5, the
+    uniform strip's force-quartile width), so eq 10, kappa(phi) and u_c(p / E_eff(phi)) are the
+    paper route's; what remains is the interpolation of the table, second order in the grid as
+    unrelaxed (measured 3.1e-3 / 1.9e-3 / 1.9e-3 on 21 x 21 and 7.1e-4 / 4.5e-4 / 3.3e-4 on
+    41 x 41, the unrelaxed model's own errors on these grids being the same to 10 %)."""
+    paper = replace(model, relaxation=default_relaxation())
+    expected = lifetime(paper, F1)
+    u_start = model.cup.h1_m - model.cup.h_start_m
+    runs = [cc.lifetime(F1, u_start) for cc in relaxed_refined]
+    errors = [abs(r.lifetime_s / expected.lifetime_s - 1) for r in runs]
+    assert errors[1] < 1.5e-3
+    assert errors[1] < errors[0] / 3                      # second order: 4x per halving
+    assert runs[1].phi_s[-1] == pytest.approx(expected.phi_s[-1], rel=5e-3)
+    assert runs[1].kappa[0] == pytest.approx(default_relaxation()(0.0) / default_relaxation()(
+        measurement_contact_time(model.cup)), rel=1e-12)
+
+
+def test_softening_lengthens_the_lifetime(model):
+    """A law with E_eff(phi0) = the table's E (phi0 = 1 s: kappa(0) = 1, the start is the
+    unrelaxed one) that softens (4 -> 1.8 MPa over 3e4 s) lengthens the lifetime; its mirror image
+    (4 -> 8.9 MPa) shortens it. The sign: at fixed gas the softer cup holds F1 at a smaller dp
+    (kappa F1_tab(u, dp/kappa) = F1), so it settles deeper, away from the table's edge, and the leak's
+    drive dp is smaller; the interface does not open, kappa p / E_eff(phi) staying what it was (the
+    suction's share beta dp / E_eff even grows). The paper route shows the same sign (117 -> 152 s
+    at 5 N with this law)."""
+    u_start = model.cup.h1_m - model.cup.h_start_m
+    soft = RelaxationModulus(np.array([1.0, 3e4]), np.array([4e6, 1.8e6]))
+    stiff = RelaxationModulus(np.array([1.0, 3e4]), np.array([4e6, 4e6 * 4e6 / 1.8e6]))
+    unrelaxed = CoupledCavity(paper_table(model, 21, 21), model.u_c, model.gas, model.p_a_Pa,
+                              interface="p_b", radial="strip")
+    for F1 in (5.0, 60.0):
+        base = unrelaxed.lifetime(F1, u_start)
+        softer = replace(unrelaxed, relaxation=soft, phi0_s=1.0).lifetime(F1, u_start)
+        stiffer = replace(unrelaxed, relaxation=stiff, phi0_s=1.0).lifetime(F1, u_start)
+        assert softer.kappa[0] == stiffer.kappa[0] == 1.0
+        assert stiffer.lifetime_s < base.lifetime_s < softer.lifetime_s
+        assert softer.kappa[-1] < 1.0 < stiffer.kappa[-1]
+
+
+def test_contact_time_starts_as_the_time(model):
+    """phi(0) = 0 and dphi/dt = 1 - rdot phi / l -> 1 while phi is small (eq 10); kappa is
+    E_eff(phi) / E_eff(phi0) along the trajectory (phi falls again near the end, where the strip
+    moves fast: rdot phi / l > 1), and the CSV columns name both."""
+    law = default_relaxation()
+    cc = _relaxed_on_paper_table(model, 21, law, 13.0)
+    r = cc.lifetime(20.0, model.cup.h1_m - model.cup.h_start_m)
+    assert r.phi_s[0] == 0.0 and r.phi_s[1] == pytest.approx(r.t_s[1], rel=1e-2)
+    assert np.allclose(r.kappa, law(r.phi_s) / law(13.0), rtol=1e-12, atol=0)
+    assert {"phi_s", "kappa"} <= set(r.trajectory_columns()) and r.summary()["phi_final_s"] > 0
+
+
+@pytest.mark.parametrize("phi0, match", [(0.0, "phi0_s.*> 0"), (-3.0, "phi0_s.*> 0"),
+                                          (math.nan, "phi0_s.*> 0"), (math.inf, "phi0_s.*> 0"),
+                                          (None, "phi0_s.*measurement")])
+def test_relaxation_bad_input(model, phi0, match):
+    with pytest.raises(ValueError, match=match):
+        CoupledCavity(paper_table(model, 5, 4), model.u_c, relaxation=default_relaxation(), phi0_s=phi0)
+
+
+def test_phi0_without_relaxation_is_refused(model):
+    with pytest.raises(ValueError, match="phi0_s.*relaxation"):
+        CoupledCavity(paper_table(model, 5, 4), model.u_c, phi0_s=13.0)
+
+
+def test_load_strip_is_the_fem_quartile_strip():
+    """r, l of eq 10 against `fem.postprocess.quartile_width` (independent code): a uniform strip
+    is itself, and on ramps, peaks and a second zone the widths agree."""
+    from fem.postprocess import quartile_width
+    strip = ContactProfile(np.array([0.010, 0.0124]), np.array([3e4, 3e4]))
+    assert load_strip(strip) == pytest.approx((0.010, 0.0024), rel=1e-12)
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        r = np.cumsum(rng.uniform(1e-4, 5e-4, 12)) + 0.01
+        p = np.where(rng.uniform(size=12) < 0.25, 0.0, rng.uniform(1e3, 1e5, 12))
+        p[0] = 0.0
+        if not np.any(p > 0):
+            continue
+        assert load_strip(ContactProfile(r, p))[1] == pytest.approx(quartile_width(r, p), rel=1e-12)

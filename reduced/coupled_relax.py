@@ -1,0 +1,494 @@
+"""Viscoelastic relaxation in the coupled cavity (`reduced.coupled`): the state (N, phi), eq (10).
+
+As in the paper route (`reduced.lifetime`, Sec. 3) the cup's stiffness follows the contact-time
+state phi, kappa(phi) = kappa E_eff(phi) / E_eff(phi0) (phi0: the contact time of the stiffness
+measurement, the table's cup being the cup as measured), with
+
+    dphi/dt = 1 - rdot phi / l,   phi(0) = 0                                            (10)
+
+The FEM behind the table is elastic, so at every instant the exact E-scaling of the module
+`reduced.coupled` holds with the current kappa: in table coordinates (u, s = dp / kappa) the cup
+holds F1 = kappa F1_tab(u, s), its gas (p_a - kappa s) V_tab(u, s) = N kT, and its contact
+pressures are kappa p_tab(u, s). As in the paper route the interface sees the relaxed modulus,
+u_c(p / E_eff(phi)) (Sec. 3: "the relaxation modulus evaluated at the time given by phi"); since
+kappa p / E_eff(phi) = kappa_in p_tab / E_eff(phi0) (kappa_in: the constant factor), the gaps
+at a table node do not depend on phi, and the leak there changes with kappa only through
+p_b = p_a - kappa s. So each node's conductance ln(Ndot / dp) is a smooth function of p_b alone,
+interpolated per node by Chebyshev polynomials over the p_b the relaxation can reach, and the
+surface at the current kappa is built from the node values as in `reduced.coupled`.
+
+r and l in eq (10) are those of the strip that carries the load: the uniform strip with the
+profile's force quartiles, l = 2 (r_75 - r_25) (the force-quartile width that the FEM hands to the
+paper route as eq 5's l, `fem.postprocess.quartile_width`) and r = (3 r_25 - r_75) / 2 its inner
+edge. For the paper's uniform strip [r, r + l] these are exactly its r and l; on an FEM table they
+move continuously, whereas the seal radius r_k is a mesh node's and jumps by a node spacing when
+the contact front passes a node (the zone r_k ... r_cut is the whole flattened contact, not the
+strip). Both are taken at the nodes (scale-free, so kappa-independent) and interpolated.
+
+The state (N, phi) is integrated by Dormand-Prince (`reduced.ode.dopri5`); u and s are algebraic:
+at each evaluation the branch at the current kappa is solved for the state holding N (Newton with
+bisection, warm-started). Differentiating the two equations and eq (10) in time gives a 3 x 3
+linear system for (udot, sdot, phidot); it is singular where its determinant D = 0: with
+phi = 0 or a flat E_eff the static fold (no state holds more gas), otherwise the dynamic
+singularity where rdot diverges (as in `reduced.lifetime._run_relaxed`). End (reason): "fold"
+(|D| / |D(0)| < 1e-4), "table_edge" (u reaches the table's smallest u), "over_force" (t = 0),
+"sealed" (no leak at t = 0) or "horizon" (still holding at t_max).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.polynomial import chebyshev
+from scipy.optimize import brentq
+
+from reduced.ode import dopri5
+from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
+from reduced.table_surface import TableSurface, cell, solid_profile
+
+if TYPE_CHECKING:
+    from reduced.coupled import CoupledCavity, CoupledLifetime
+    from reduced.suction_table import SuctionTable
+
+__all__ = ["load_strip", "relaxed_lifetime"]
+
+_DYNAMIC_FOLD = 1e-4    # |D| / |D(0)| at which the branch is declared folded (static or dynamic)
+_CHEBYSHEV = 7          # p_b points per node (cup A coarse, dp <= 60 kPa: 3e-7 in ln against direct)
+_PHI_LONGEST = 1e15     # [s] the modulus is assumed not to exceed max(samples, E_eff(this)) before
+
+
+def load_strip(profile: ContactProfile) -> tuple[float, float] | None:
+    """(r, l) [m] of the uniform strip with the load quartiles of the innermost contact zone:
+    l = 2 (r_75 - r_25), r = (3 r_25 - r_75) / 2, quartiles of int p dr (trapezoid, p linear
+    between samples; the zone runs to the first zero after the first loaded sample). None if
+    the profile carries no load."""
+    r, p = profile.r_m, profile.p_Pa
+    if not np.any(p > 0):
+        return None
+    k = int(np.argmax(p > 0))
+    free = np.flatnonzero(p[k:] <= 0)
+    end = r.size if free.size == 0 else k + int(free[0]) + 1
+    r, p = r[:end], p[:end]
+    load = np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(r))])
+    q25, q75 = (_load_quantile(r, p, load, f) for f in (0.25, 0.75))
+    return 0.5 * (3.0 * q25 - q75), 2.0 * (q75 - q25)
+
+
+def _load_quantile(r: np.ndarray, p: np.ndarray, load: np.ndarray, fraction: float) -> float:
+    target = fraction * load[-1]
+    i = max(int(np.searchsorted(load, target)), 1)
+    if load[i] == target:
+        return float(r[i])
+    h, rest = r[i] - r[i - 1], target - load[i - 1]
+    a, b = 0.5 * (p[i] - p[i - 1]) / h, p[i - 1]          # int_0^x p = b x + a x^2
+    if abs(a) * h < 1e-12 * max(abs(b), 1e-300):
+        return float(r[i - 1] + rest / b)
+    return float(r[i - 1] + (-b + math.sqrt(max(b * b + 4 * a * rest, 0.0))) / (2 * a))
+
+
+class _NodeRates:
+    """ln(Ndot / dp) at every table node as a function of kappa (module docstring): Chebyshev
+    interpolation in p_b = p_a - kappa s_j over [max(0, p_a - kappa_hi s_j), p_a]."""
+
+    def __init__(self, cc: CoupledCavity, E_ref: float, kappa_hi: float):
+        t, pa = cc.table, cc.p_a_Pa
+        self.u, self.s, self.pa, self.along_u = t.u_m, t.dp_Pa, pa, cc.along_u
+        nu, ns = t.F1_N.shape
+        self.lo = np.maximum(pa - kappa_hi * self.s, 0.0)
+        x = np.cos((2 * np.arange(_CHEBYSHEV) + 1) * np.pi / (2 * _CHEBYSHEV))
+        self.coef = np.zeros((nu, ns, _CHEBYSHEV))
+        self.fixed = np.full((nu, ns), np.nan)      # +inf: no contact; -inf: sealed; dp = 0: its limit
+        for i in range(nu):
+            for j in range(ns):
+                self.fixed[i, j], self.coef[i, j] = self._fit(cc, i, j, E_ref, x)
+        at_ref = np.concatenate([self._raw(cc.kappa, j) for j in range(ns)])
+        self.top = float(np.max(at_ref[np.isfinite(at_ref)]))
+        self._last: tuple = (None, None, None)
+
+    def _fit(self, cc: CoupledCavity, i: int, j: int, E_ref: float, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """(fixed value or nan, Chebyshev coefficients) of node (i, j): gaps from the solid profile
+        at s_j (kappa-free), the leak at the p_b of the Chebyshev points x."""
+        none = np.zeros(_CHEBYSHEV)
+        pa, s = self.pa, self.s[j]
+        prof = solid_profile(cc.table, i, j, 1.0, s, cc.interface)
+        if prof is None:
+            raise ValueError(f"suction table: no contact profile at u = {1e3 * self.u[i]:.4g} mm, "
+                             f"dp = {s / 1e3:.4g} kPa (the cavity is open)")
+        gaps = ring_gaps(prof, cc.u_c, E_ref, scale=cc.kappa)
+        if np.all(np.isinf(gaps)):
+            return math.inf, none                        # no contact: no resistance
+        if np.any(gaps <= 0):
+            return -math.inf, none                       # sealed
+
+        def leak(pb: float) -> float:
+            return profile_leak_rate(cc.gas, pa, pb, prof.r_m, gaps, cc.radial)
+        if j == 0:
+            return math.log(leak(pa - 1.0)), none        # the dp -> 0 limit, as unrelaxed
+        pb = 0.5 * (self.lo[j] + pa) + 0.5 * (pa - self.lo[j]) * x
+        return math.nan, chebyshev.chebfit(x, [math.log(leak(b) / (pa - b)) for b in pb], _CHEBYSHEV - 1)
+
+    @property
+    def largest(self) -> float:
+        """ln of the scale of the conductances (sealed below 1e-20 of it, as unrelaxed)."""
+        return self.top
+
+    def _raw(self, kappa: float, j: int) -> np.ndarray:
+        """ln(Ndot / dp) at the nodes (u_i, s_j) at kappa; nan beyond p_a, +-inf open / sealed."""
+        pb = self.pa - kappa * self.s[j]
+        if pb < 0.0:
+            return np.full(self.u.size, np.nan)
+        half = 0.5 * (self.pa - self.lo[j])
+        x = min(max((pb - self.lo[j] - half) / half, -1.0), 1.0) if half > 0 else 0.0
+        z = chebyshev.chebval(x, self.coef[:, j, :].T)
+        return np.where(np.isnan(self.fixed[:, j]), z, self.fixed[:, j])
+
+    def column(self, kappa: float, j: int) -> np.ndarray:
+        """`_raw`, clipped to [1e-30, 1e3] x the scale (nan: the floor), as unrelaxed."""
+        floor, top = self.top + math.log(1e-30), self.top + math.log(1e3)
+        z = self._raw(kappa, j)
+        return np.clip(np.where(np.isnan(z), floor, z), floor, top)
+
+    def __call__(self, kappa: float, u: float, s: float) -> float:
+        """ln(Ndot / dp) at (u, s) at kappa: the surface of `reduced.coupled` on that cell."""
+        _, j, _, _ = cell(self.u, self.s, u, s)
+        if self._last[:2] != (kappa, j):
+            z = np.stack([self.column(kappa, j), self.column(kappa, j + 1)], axis=1)
+            self._last = (kappa, j, TableSurface(self.u, self.s[j:j + 2], z, self.along_u))
+        return self._last[2](u, s)
+
+
+@dataclass(frozen=True)
+class _Point:
+    """A state on the branch at one kappa (table coordinates) with what its derivatives need."""
+
+    u: float
+    s: float
+    N: float
+    dN_ds: float
+    F: tuple[float, float, float]      # F1_tab and its u, s slopes
+    V: tuple[float, float, float]
+
+
+class _Branch:
+    """The branch of pull F1 at the current kappa: the state that holds N gas (module docstring)."""
+
+    def __init__(self, cc: CoupledCavity, F1: float, surfaces: dict[str, TableSurface]):
+        self.cc, self.F1, self.S = cc, F1, surfaces
+        self.kT, self.pa = cc.gas.kT_J, cc.p_a_Pa
+        self.u_lo, self.u_hi = float(cc.table.u_m[0]), float(cc.table.u_m[-1])
+        self.s_max = float(cc.table.dp_Pa[-1])
+        self.last_u, self.last_s = self.u_hi, 0.0
+        self._edge: tuple[float | None, _Point | None] = (None, None)
+
+    def u_of(self, s: float, k: float) -> float:
+        """u with k F1_tab(u, s) = F1 (F1 falls with u); u_lo where even u_lo cannot hold F1."""
+        F = self.S["F1"]
+
+        def f(u: float) -> tuple[float, float]:
+            z, z_u, _ = F.value_and_slopes(u, s)
+            return k * z - self.F1, k * z_u
+        f_lo, f_hi = f(self.u_lo)[0], f(self.u_hi)[0]
+        slack = 1e-9 * max(abs(self.F1), 1.0)
+        if f_lo <= slack:
+            return self.u_lo
+        if f_hi > 0:
+            if f_hi <= slack:
+                return self.u_hi
+            raise ValueError(f"F1 = {self.F1:g} N presses the cup beyond the table's u = "
+                             f"{1e3 * self.u_hi:.4g} mm at dp = {k * s / 1e3:.4g} kPa; extend the table")
+        u = _newton(f, self.u_lo, self.u_hi, 1.0, self.last_u, 1e-13 * self.u_hi)
+        self.last_u = u
+        return u
+
+    def point(self, s: float, k: float) -> _Point:
+        u = self.u_of(s, k)
+        F, V = self.S["F1"].value_and_slopes(u, s), self.S["V"].value_and_slopes(u, s)
+        g = self.pa - k * s
+        det = k * F[1] * (g * V[2] - k * V[0]) - k * F[2] * g * V[1]
+        return _Point(u, s, g * V[0] / self.kT, det / (k * F[1] * self.kT), F, V)
+
+    def edge(self, k: float) -> _Point:
+        """The branch's state at the table's smallest u (the end of the data)."""
+        if self._edge[0] != k:
+            top = self.s_top(k)
+            g = lambda s: k * self.S["F1"](self.u_lo, s) - self.F1      # noqa: E731
+            s = top if g(top) <= 0 else (0.0 if g(0.0) >= 0 else brentq(g, 0.0, top, xtol=1e-12 * top))
+            self._edge = (k, self.point(s, k))
+        return self._edge[1]
+
+    def s_top(self, k: float) -> float:
+        return min(self.s_max, self.pa / k)
+
+    def solve(self, N: float, k: float) -> tuple[_Point, str | None]:
+        """(the state holding N, None), or (the branch's end, 'fold' or 'table_edge') if N lies
+        beyond it (the dynamics is continued there with the end values)."""
+        s_lo, s_hi = self.edge(k).s, self.s_top(k)
+        P = self.point(min(max(self.last_s, s_lo), s_hi), k)
+        if P.dN_ds >= 0:                                 # at or below a fold: the fold lies above
+            P = self._fold(P, self._climb(P, k, s_hi), k)
+            if P.N <= N:
+                return self._keep(P), "fold"
+        if P.N >= N:
+            lo, hi = self._up(P, N, k, s_hi)
+        else:
+            lo, hi, end = self._down(P, N, k, s_lo)
+            if end is not None:
+                return self._keep(lo), end
+        if lo.N == N:
+            return self._keep(lo), None
+
+        def f(x: float) -> tuple[float, float]:
+            Q = self.point(x, k)
+            return Q.N - N, Q.dN_ds
+        s = _newton(f, lo.s, hi.s, 1.0, lo.s + (N - lo.N) / lo.dN_ds if lo.dN_ds < 0 else lo.s,
+                    1e-14 * self.s_max)
+        return self._keep(self.point(s, k)), None
+
+    def _keep(self, P: _Point) -> _Point:
+        self.last_s, self.last_u = P.s, P.u
+        return P
+
+    def _step(self, P: _Point, N: float) -> float:
+        return max(2.0 * abs(N - P.N) / abs(P.dN_ds), 1e-6 * self.s_max) if P.dN_ds < 0 else 1e-3 * self.s_max
+
+    def _down(self, P: _Point, N: float, k: float, s_lo: float) -> tuple[_Point, _Point, str | None]:
+        """Below P (N(P) < N): (lo, hi, None) with N(lo) >= N > N(hi), or (the fold or the edge,
+        -, its name) if the branch ends before holding N."""
+        step = self._step(P, N)
+        while True:
+            Q = self.point(max(P.s - step, s_lo), k)
+            if Q.dN_ds >= 0:
+                fold = self._fold(Q, P, k)
+                return (fold, P, "fold" if fold.N < N else None)
+            if Q.N >= N:
+                return Q, P, None
+            if Q.s <= s_lo:
+                return Q, P, "table_edge"
+            P, step = Q, 2.0 * step
+
+    def _up(self, P: _Point, N: float, k: float, s_hi: float) -> tuple[_Point, _Point]:
+        """Above P (N(P) >= N): (lo, hi) with N(lo) >= N >= N(hi)."""
+        step = self._step(P, N)
+        while True:
+            Q = self.point(min(P.s + step, s_hi), k)
+            if Q.N <= N:
+                return P, Q
+            if Q.s >= s_hi:
+                raise ValueError(f"suction table: the branch at F1 = {self.F1:g} N holds more than "
+                                 f"N = {N:.6g} up to its top dp = {k * s_hi / 1e3:.4g} kPa; extend dp")
+            P, step = Q, 2.0 * step
+
+    def _climb(self, P: _Point, k: float, s_hi: float) -> _Point:
+        """The first state above P on the stable side (dN/ds < 0)."""
+        step = 1e-4 * self.s_max
+        while True:
+            Q = self.point(min(P.s + step, s_hi), k)
+            if Q.dN_ds < 0:
+                return Q
+            if Q.s >= s_hi:
+                raise ValueError(f"suction table: no stable state at F1 = {self.F1:g} N below "
+                                 f"dp = {k * s_hi / 1e3:.4g} kPa")
+            P, step = Q, 2.0 * step
+
+    def _fold(self, below: _Point, above: _Point, k: float) -> _Point:
+        """The fold dN/ds = 0 between a state `below` (dN/ds >= 0) and one `above` (< 0)."""
+        if below.dN_ds == 0:
+            return below
+        s = brentq(lambda x: self.point(x, k).dN_ds, below.s, above.s, xtol=1e-14 * self.s_max)
+        return self.point(s, k)
+
+
+def _newton(f: Callable[[float], tuple[float, float]], lo: float, hi: float, sign_lo: float,
+            x0: float, xtol: float) -> float:
+    """Root of f (value, slope) in [lo, hi], f having the sign of sign_lo at lo and the other at
+    hi: Newton steps, bisection where one leaves the bracket."""
+    x = min(max(x0, lo), hi)
+    for _ in range(200):
+        fx, dfx = f(x)
+        if fx == 0.0:
+            return x
+        if (fx > 0) == (sign_lo > 0):
+            lo = x
+        else:
+            hi = x
+        step = x - fx / dfx if dfx != 0.0 else math.nan
+        x_new = step if min(lo, hi) < step < max(lo, hi) else 0.5 * (lo + hi)
+        if abs(x_new - x) <= xtol or abs(hi - lo) <= xtol:
+            return x_new
+        x = x_new
+    raise RuntimeError(f"coupled branch: no convergence in [{lo:.6g}, {hi:.6g}]")
+
+
+@dataclass(frozen=True, eq=False)
+class RelaxedParts:
+    """What the relaxed lifetimes of one `CoupledCavity` share: kappa(phi) -> (kappa, dkappa/dphi),
+    the table's surfaces in (u, s) (F1, V and the strip's r, l) and the node conductances."""
+
+    kappa: Callable[[float], tuple[float, float]]
+    surfaces: dict[str, TableSurface]
+    rates: _NodeRates
+
+
+def relaxed_parts(cc: CoupledCavity) -> RelaxedParts:
+    """Build `RelaxedParts` (the conductances: _CHEBYSHEV leak evaluations per node)."""
+    law, t = cc.relaxation, cc.table
+    E_ref = law.modulus_and_log_slope(cc.phi0_s)[0]
+
+    def kappa(phi: float) -> tuple[float, float]:
+        E, slope = law.modulus_and_log_slope(phi)
+        k = cc.kappa * E / E_ref
+        return k, (k * slope / phi if slope != 0.0 else 0.0)
+
+    kappa_hi = cc.kappa * max(float(np.max(law.E_Pa)), law.modulus_and_log_slope(_PHI_LONGEST)[0]) / E_ref
+    strips = np.array([[_strip(t, i, j) for j in range(t.dp_Pa.size)] for i in range(t.u_m.size)])
+    surfaces = {name: TableSurface(t.u_m, t.dp_Pa, z, cc.along_u)
+                for name, z in (("F1", t.F1_N), ("V", t.V_m3), ("r", strips[..., 0]), ("l", strips[..., 1]))}
+    return RelaxedParts(kappa, surfaces, _NodeRates(cc, E_ref, kappa_hi))
+
+
+def _strip(table: SuctionTable, i: int, j: int) -> tuple[float, float]:
+    """(r, l) of eq (10) at node (i, j): `load_strip`, or where nothing presses the zone [r_k, r_cut]."""
+    strip = load_strip(table.profiles[i][j])
+    return strip if strip is not None else (table.seal_r_m[i, j], table.cut_r_m[i, j] - table.seal_r_m[i, j])
+
+
+def _det3(m: list[list[float]]) -> float:
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+@dataclass(frozen=True)
+class _Rates:
+    """Ndot, phidot and D at a state."""
+
+    point: _Point
+    kappa: float
+    N_dot: float
+    phi_dot: float
+    D: float
+
+
+class _Dynamics:
+    """dN/dt (the leak) and dphi/dt (eq 10 with rdot from the 3 x 3 system) at (N, phi)."""
+
+    def __init__(self, cc: CoupledCavity, parts: RelaxedParts, branch: _Branch):
+        self.cc, self.parts, self.br = cc, parts, branch
+        self.sealed_below = parts.rates.largest + math.log(1e-20)
+        self._last: tuple = (None, None)
+
+    def __call__(self, N: float, phi: float) -> _Rates:
+        if self._last[0] != (N, phi):
+            k, dk = self.parts.kappa(phi)
+            P, _ = self.br.solve(N, k)
+            self._last = ((N, phi), self.rates(P, k, dk, phi))
+        return self._last[1]
+
+    def rates(self, P: _Point, k: float, dk: float, phi: float) -> _Rates:
+        S, kT = self.parts.surfaces, self.cc.gas.kT_J
+        z = self.parts.rates(k, P.u, P.s)
+        N_dot = k * P.s * math.exp(z) if z > self.sealed_below else 0.0
+        r, r_u, r_s = S["r"].value_and_slopes(P.u, P.s)
+        l = S["l"](P.u, P.s)
+        a = phi / l if l > 0.0 else 0.0                # a line contact keeps its point: phi grows
+        g = self.cc.p_a_Pa - k * P.s
+        (F, F_u, F_s), (V, V_u, V_s) = P.F, P.V
+        m = [[k * F_u, k * F_s, F * dk], [g * V_u, g * V_s - k * V, -P.s * V * dk], [a * r_u, a * r_s, 1.0]]
+        D = _det3(m)
+        b = [0.0, kT * N_dot, 1.0]
+        phi_dot = _det3([[row[0], row[1], b[n]] for n, row in enumerate(m)]) / D if D != 0.0 else math.inf
+        return _Rates(P, k, N_dot, phi_dot, D)
+
+
+def relaxed_lifetime(cc: CoupledCavity, F1: float, u_start: float, t_max: float,
+                     rtol: float) -> CoupledLifetime:
+    """Lifetime of the relaxing cup released at u_start and pulled by F1 (module docstring)."""
+    run = _Run(cc, F1)
+    k0, dk0 = run.parts.kappa(0.0)
+    P0 = run.start(u_start, k0)
+    if P0 is None:
+        return run.result(0.0, "over_force", f"F1 = {F1:g} N exceeds what the cup holds with its "
+                          f"start content: it detaches at once", [])
+    first = run.dyn.rates(P0, k0, dk0, 0.0)
+    if first.N_dot <= 0.0:
+        return run.result(math.inf, "sealed", f"the interface is sealed at t = 0 (u = {1e3 * P0.u:.4g} "
+                          f"mm, dp = {k0 * P0.s / 1e3:.4g} kPa)", [run.row(0.0, run.N0, 0.0, first)])
+    sol = run.integrate(first, k0, t_max, rtol)
+    rows = run.trajectory(sol, P0)
+    t_end = float(sol.t[-1])
+    if sol.event is None:
+        return run.result(math.inf, "horizon", f"still attached at t_max = {t_max:g} s", rows, sol.steps)
+    where = (f"u reached the table's smallest u = {1e3 * cc.table.u_m[0]:.4g} mm" if sol.event == 0 else
+             "the branch folds (D = 0: no state holds more gas, or rdot diverges in eq 10)")
+    return run.result(t_end, ("table_edge", "fold")[sol.event], f"detached at t = {t_end:.4g} s: {where}",
+                      rows, sol.steps)
+
+
+class _Run:
+    """One relaxed lifetime: the start, the integration of (N - N0, phi) and the trajectory."""
+
+    def __init__(self, cc: CoupledCavity, F1: float):
+        self.cc, self.F1, self.parts = cc, F1, cc._relaxed
+        self.branch = _Branch(cc, F1, self.parts.surfaces)
+        self.dyn = _Dynamics(cc, self.parts, self.branch)
+        self.N0 = math.nan
+
+    def start(self, u_start: float, k0: float) -> _Point | None:
+        """The state at t = 0 (N0 fixed at F1 = 0 and kappa(0), Sec. 3), None for an over-force."""
+        cc, F1 = self.cc, self.F1
+        frozen = replace(cc, kappa=k0, relaxation=None, phi0_s=None)      # the cup at t = 0
+        _, self.N0 = frozen.start(u_start)
+        lo, hi = frozen._dp_range(F1)
+        if not np.isfinite(lo) or self.N0 > frozen.content(F1, lo)[1]:
+            return None
+        if self.N0 < frozen.content(F1, hi)[1]:
+            raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
+                             f"{1e3 * cc.table.u_m[-1]:.4g} mm; extend the table")
+        dp0 = brentq(lambda d: frozen.content(F1, d)[1] - self.N0, lo, hi, xtol=1e-10 * max(hi, 1.0))
+        self.branch.last_s = dp0 / k0
+        P0, end = self.branch.solve(self.N0, k0)
+        return P0 if end is None else None
+
+    def integrate(self, first: _Rates, k0: float, t_max: float, rtol: float):
+        """dopri5 on y = (N - N0, phi) (beyond the branch's end: its end values) with the edge and
+        fold events."""
+        N0, kappa, dyn, D0 = self.N0, self.parts.kappa, self.dyn, abs(first.D)
+        Q_scale = self.branch.edge(k0).N - N0             # the leak to the table's edge at t = 0
+
+        def rhs(t: float, y: list) -> list:
+            R = dyn(N0 + y[0], max(y[1], 0.0))
+            return [R.N_dot, R.phi_dot]
+
+        def edge_event(t: float, y: list) -> float:
+            return N0 + y[0] - self.branch.edge(kappa(max(y[1], 0.0))[0]).N
+
+        def fold_event(t: float, y: list) -> float:
+            return _DYNAMIC_FOLD - abs(dyn(N0 + y[0], max(y[1], 0.0)).D) / D0
+
+        return dopri5(rhs, 0.0, [0.0, 0.0], t_max, rtol, [rtol * Q_scale, 1e-6],
+                      events=[edge_event, fold_event], h0=1e-3 * Q_scale / first.N_dot)
+
+    def trajectory(self, sol, P0: _Point) -> list[tuple]:
+        """The rows at the accepted steps, each solved on the branch from the start on."""
+        self.branch.last_u, self.branch.last_s = P0.u, P0.s
+        rows = []
+        for t, (q, phi) in zip(sol.t, sol.y):
+            phi, N = max(phi, 0.0), self.N0 + q
+            if t == sol.t[-1] and sol.event == 0:      # the event is N = N_edge(kappa): its time interpolated
+                N = self.branch.edge(self.parts.kappa(phi)[0]).N
+            rows.append(self.row(t, N, phi, self.dyn(N, phi)))
+        return rows
+
+    @staticmethod
+    def row(t: float, N: float, phi: float, R: _Rates) -> tuple:
+        P = R.point
+        return (t, P.u, R.kappa * P.s, N, R.N_dot, P.V[0], phi, R.kappa)
+
+    def result(self, life: float, reason: str, msg: str, rows: list, steps: int = 0) -> CoupledLifetime:
+        from reduced.coupled import CoupledLifetime
+        a = np.array(rows, dtype=float).reshape(-1, 8).T
+        return CoupledLifetime(self.F1, life, reason, msg, self.N0, *a[:6], p_a_Pa=self.cc.p_a_Pa,
+                               phi_s=a[6], kappa=a[7], steps=steps)

@@ -1,0 +1,90 @@
+"""A quantity z(u, dp) on a suction table's grid, interpolated: monotone cubic (PCHIP) or linear
+along u, linear along dp (`reduced.coupled`'s F1, V, ln(Ndot / dp), and the strip's r and l).
+
+PCHIP (Fritsch-Carlson slopes) keeps each column's monotonicity (the branch stays unique) and is
+third order where the data are smooth; linear along dp keeps monotone rows monotone. The grid
+refinement in benchmarks/bench_coupled.py measures both. `value_and_slopes` also returns the two
+partial derivatives of the same interpolant (dz/du continuous, dz/ddp constant on each cell).
+`solid_profile`: the contact pressure a node's leak goes through.
+"""
+
+from __future__ import annotations
+
+import bisect
+from functools import cached_property
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+
+from reduced.profile_leak import ContactProfile
+from reduced.suction_table import SuctionTable
+
+__all__ = ["TableSurface", "cell", "solid_profile"]
+
+
+def cell(x: np.ndarray, y: np.ndarray, a: float, b: float) -> tuple[int, int, float, float]:
+    """Cell (i, j) and local coordinates of (a, b) on the grid x by y (clamped to it)."""
+    i = min(max(bisect.bisect_right(x, a) - 1, 0), x.size - 2)
+    j = min(max(bisect.bisect_right(y, b) - 1, 0), y.size - 2)
+    return i, j, (a - x[i]) / (x[i + 1] - x[i]), (b - y[j]) / (y[j + 1] - y[j])
+
+
+class TableSurface:
+    """z(u, dp) on the grid u by dp [len(u), len(dp)] (module docstring); along_u 'pchip' or 'linear'."""
+
+    def __init__(self, u: np.ndarray, dp: np.ndarray, z: np.ndarray, along_u: str):
+        self.u, self.dp, self.z = u, dp, np.asarray(z, dtype=float)
+        self.slope = (PchipInterpolator(u, self.z, axis=0).derivative()(u) if along_u == "pchip"
+                      else None)
+
+    def __call__(self, a: float, b: float) -> float:
+        i, j, s, t = cell(self.u, self.dp, a, b)
+        z0, z1 = self.z[i, j:j + 2], self.z[i + 1, j:j + 2]
+        if self.slope is None:
+            col = (1 - s) * z0 + s * z1
+        else:
+            h = self.u[i + 1] - self.u[i]
+            h00, h10, h01, h11 = (2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2,
+                                  s**3 - s**2)
+            col = h00 * z0 + h10 * h * self.slope[i, j:j + 2] + h01 * z1 + h11 * h * self.slope[i + 1, j:j + 2]
+        return float((1 - t) * col[0] + t * col[1])
+
+    def value_and_slopes(self, a: float, b: float) -> tuple[float, float, float]:
+        """(z, dz/du, dz/ddp) at (a, b) (on Python floats: it is called in the inner loops)."""
+        i, j, s, t = cell(self.u, self.dp, a, b)
+        z, h = self._lists[0], self._lists[2][i]
+        z00, z01, z10, z11 = z[i][j], z[i][j + 1], z[i + 1][j], z[i + 1][j + 1]
+        if self.slope is None:
+            c0, c1 = z00 + s * (z10 - z00), z01 + s * (z11 - z01)
+            d0, d1 = (z10 - z00) / h, (z11 - z01) / h
+        else:
+            m = self._lists[1]
+            m00, m01, m10, m11 = h * m[i][j], h * m[i][j + 1], h * m[i + 1][j], h * m[i + 1][j + 1]
+            h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+            g0, g10, g11 = (6 * s**2 - 6 * s) / h, (3 * s**2 - 4 * s + 1) / h, (3 * s**2 - 2 * s) / h
+            c0, c1 = h00 * z00 + h10 * m00 + h01 * z10 + h11 * m10, h00 * z01 + h10 * m01 + h01 * z11 + h11 * m11
+            d0, d1 = g0 * (z00 - z10) + g10 * m00 + g11 * m10, g0 * (z01 - z11) + g10 * m01 + g11 * m11
+        return (1 - t) * c0 + t * c1, (1 - t) * d0 + t * d1, (c1 - c0) / (self.dp[j + 1] - self.dp[j])
+
+    @cached_property
+    def _lists(self) -> tuple[list, list | None, list]:
+        return (self.z.tolist(), None if self.slope is None else self.slope.tolist(),
+                np.diff(self.u).tolist())
+
+
+def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,
+                  interface: str) -> ContactProfile | None:
+    """The solid contact pressure at node (i, j): scale p_tab less the interface gas's rise over
+    p_b across the zone [r_k, r_cut] at the pressure difference dp (`reduced.coupled`); None where
+    the table has no profile."""
+    prof = table.profiles[i][j]
+    if prof is None:
+        return None
+    r, p = prof.r_m, scale * prof.p_Pa
+    rk, rcut = table.seal_r_m[i, j], table.cut_r_m[i, j]
+    tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too
+    zone = (r >= rk - tol) & (r <= rcut + tol)
+    rise = {"p_b": 0.0, "p_a": 1.0}.get(interface)
+    if rise is None:
+        rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
+    return ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
