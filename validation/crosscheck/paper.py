@@ -111,24 +111,27 @@ def coupled_route(ctx: Context) -> Route:
         from reduced.coupled import CoupledCavity
         from reduced.gas import Gas
 
+        from reduced.viscoelastic import default_relaxation, measurement_contact_time
+
         t = table(cup)
-        return CoupledCavity(t, pmma_uc_table(surface), Gas(T_K=293.15), P_A, kappa=kappa), \
+        return CoupledCavity(t, pmma_uc_table(surface), Gas(T_K=293.15), P_A, kappa=kappa,
+                             relaxation=default_relaxation(), phi0_s=measurement_contact_time(CUPS[cup])), \
             1e-3 * t.provenance["h1_mm"] - CUPS[cup].h_start_m
 
-    def life(cup, surface, F1, kappa=1.0, fluid="air", **_):     # the branch ends: no horizon
+    def life(cup, surface, F1, kappa=1.0, fluid="air", **options):
         m, u_start = cavity(cup, surface, kappa)
-        return _CoupledResult(m.lifetime(F1, u_start), table(cup), kappa)
+        return _CoupledResult(m.lifetime(F1, u_start, **options), table(cup), kappa)
 
     def holdable(cup):
         m, u_start = cavity(cup, "pmma-1.89", 1.0)
         return m.largest_holdable_force(u_start)
 
-    return Route("coupled (fem-frictionless, no relaxation)", life, holdable, fluids=("air",))
+    return Route("coupled (fem-frictionless)", life, holdable, fluids=("air",))
 
 
 class _CoupledResult:
     """A coupled lifetime as the rows read it: r(t) is the seal radius r_k of the table, interpolated
-    at the trajectory's (u, dp / kappa); the route has no ballistic share."""
+    at the trajectory's (u, dp / kappa(t)); the route has no ballistic share."""
 
     ballistic_share = None
 
@@ -137,7 +140,8 @@ class _CoupledResult:
 
         self.lifetime_s, self.reason, self.t_s = result.lifetime_s, result.reason, result.t_s
         seal = RegularGridInterpolator((table.u_m, table.dp_Pa), table.seal_r_m)
-        self.r_m = seal(np.column_stack([result.u_m, result.dp_Pa / kappa])) if result.u_m.size else result.u_m
+        k = result.kappa if result.kappa is not None else kappa
+        self.r_m = seal(np.column_stack([result.u_m, result.dp_Pa / k])) if result.u_m.size else result.u_m
 
 
 def model(curve, cup: str, surface: str, *, fluid: str = "air", kappa: float = 1.0,
