@@ -25,7 +25,15 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.mark.parametrize("data,message", [
     ({"bsae": {}}, "bsae: unknown key; allowed: scene, base, sampling, axes"),
     ({"base": {"E_Mpa": 4}}, "base.E_Mpa: unknown key"),
-    ({"base": {"contact": "glued"}}, "base.contact: expected one of frictionless, sticking, got 'glued'"),
+    ({"base": {"contact": "glued"}}, "base.contact: expected one of frictionless, sticking, coulomb, got 'glued'"),
+    ({"base": {"contact": "coulomb"}}, 'base.friction: base.contact = "coulomb" needs base.friction'),
+    ({"base": {"contact": "sticking", "friction": 0.3}}, "base.friction: applies to base.contact = \"coulomb\" only"),
+    ({"base": {"contact": "coulomb", "friction": -1}}, "base.friction: Coulomb's friction coefficient must be in [0, 100]"),
+    ({"base": {"contact": "sticking"}, "axes": [{"name": "friction", "values": [0.1, 0.5]}]},
+     'axes[0].name: a friction axis varies Coulomb\'s mu: it needs base.contact = "coulomb"'),
+    ({"base": {"contact": "coulomb", "friction": 0.2}, "axes": [{"name": "friction", "values": [0.1, -0.5]}]},
+     "axes[0]: Coulomb's friction coefficient must be in [0, 100], got -0.5"),
+    ({"axes": [{"name": "contact", "values": ["sticking", "coulomb"]}]}, "base.friction: base.contact = \"coulomb\" needs"),
     ({"axes": [{"name": "alpha_deg", "values": [30]}, {"name": "angle", "values": [1]}]},
      "axes[1].name: expected one of alpha_deg"),
     ({"sampling": {"method": "lhs", "n": 4}, "axes": [{"name": "alpha_deg", "values": [30, 40]}]},
@@ -40,6 +48,25 @@ def test_bad_sweep_files_are_refused_with_the_key_path(data, message):
     with pytest.raises(ValueError, match=None) as exc:
         sweep_from_mapping(data)
     assert message in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_friction_axis_sweeps_coulombs_mu_between_the_limits():
+    """Coulomb designs evaluate with their own mu: the small-u stiffness rises with mu, from the
+    frictionless design's (mu = 0; the two paths take different load steps and F0(1 mm) is
+    interpolated between them, ~3e-4 apart, while their end states agree to 2e-5,
+    tests/test_fem_friction.py) towards the sticking one's."""
+    from validation.sweeps.evaluate import evaluate_design
+
+    def stiffness(contact, **extra):
+        spec = sweep_from_mapping({"base": {"contact": contact, "F1_N": [10], **extra}})
+        return evaluate_design(spec.designs()[0])[0]["small_u_stiffness_N_per_mm"]
+
+    spec = sweep_from_mapping({"base": {"contact": "coulomb", "friction": 0.0, "F1_N": [10]},
+                               "axes": [{"name": "friction", "values": [0.0, 1.0]}]})
+    k0, k1 = (evaluate_design(d)[0]["small_u_stiffness_N_per_mm"] for d in spec.designs())
+    free, stuck = stiffness("frictionless"), stiffness("sticking")
+    assert k0 == pytest.approx(free, rel=1e-3)
+    assert free < k1 < stuck
 
 
 def test_bad_sweep_file_exits_2_and_writes_nothing(tmp_path, capsys):

@@ -90,7 +90,9 @@ def _stiffness(geometry, design: dict[str, Any]):
     nu = design["nu"]
     material = NeoHookean(E_Pa=design["E_MPa"] * 1e6, nu=nu,
                           formulation="mixed" if nu > 0.495 else "displacement")
-    response = compress_cup(mesh, material, contact=design["contact"], u_max_m=0.9 * geometry.h1_m)
+    friction = design.get("friction", 0.0) if design["contact"] == "coulomb" else 0.0
+    response = compress_cup(mesh, material, contact=design["contact"], friction=friction,
+                            u_max_m=0.9 * geometry.h1_m)
     prov = handoff.provenance(response, geometry=geometry.describe(), mesh={"fidelity": design["fidelity"]},
                               fidelity=design["fidelity"])
     return response, handoff.stiffness_curve(response, prov)

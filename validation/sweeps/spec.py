@@ -7,7 +7,8 @@
     d1_mm = 0.447
     E_MPa = 4.0
     nu = 0.49
-    contact = "sticking"            # frictionless | sticking
+    contact = "sticking"            # frictionless | sticking | coulomb
+    # friction = 0.5                # Coulomb's mu in [0, 100]: with contact = "coulomb" only
     surface = "pmma-1.89"           # a calibrated preset (`cupcheck uc --list-surfaces`)
     fidelity = "coarse"             # FEM mesh level
     F1_N = [10, 40]                 # lifetimes at these pull forces: one table row per force
@@ -26,8 +27,9 @@
 
 Instead of (or under) ``[base]``, ``scene = "my_scene.toml"`` takes the base design from a scene
 file (`validation.scenes.schema`: its cup, material, contact, surface, loads and FEM fidelity);
-keys in ``[base]`` then override the scene's. Axis names are the numeric base keys (alpha_deg, r0_mm, r1_mm, d0_mm, d1_mm, E_MPa, nu, r_start_mm)
-and, on a grid, the categorical ones (contact, surface). Errors name the key path
+keys in ``[base]`` then override the scene's. Axis names are the numeric base keys (alpha_deg, r0_mm, r1_mm, d0_mm, d1_mm, E_MPa, nu, r_start_mm,
+friction: with a coulomb base) and, on a grid, the categorical ones (contact, surface; a coulomb
+value takes the base's friction). Errors name the key path
 (``axes[1].name: expected one of ...``) and are ValueErrors (exit status 2 on the command line).
 """
 
@@ -46,14 +48,17 @@ import numpy as np
 
 __all__ = ["SweepSpec", "load_sweep", "sweep_from_mapping", "NUMERIC_AXES", "design_hash"]
 
-NUMERIC_AXES = ("alpha_deg", "r0_mm", "r1_mm", "d0_mm", "d1_mm", "E_MPa", "nu", "r_start_mm", "l0_mm", "l1_mm")
+NUMERIC_AXES = ("alpha_deg", "r0_mm", "r1_mm", "d0_mm", "d1_mm", "E_MPa", "nu", "r_start_mm", "l0_mm", "l1_mm",
+                "friction")
 CATEGORICAL_AXES = ("contact", "surface")
 _BASE_DEFAULTS: dict[str, Any] = {
     "cup": "A", "alpha_deg": None, "r0_mm": None, "r1_mm": None, "d0_mm": None, "d1_mm": None,
     "E_MPa": 4.0, "nu": 0.49, "contact": "sticking", "surface": "pmma-1.89", "fidelity": "coarse",
     "r_start_mm": None, "l0_mm": None, "l1_mm": None, "F1_N": [10.0], "F0_at_u_mm": [1.0], "allow_unusual_design": False,
 }
-_CHOICES = {"contact": ("frictionless", "sticking"), "fidelity": ("coarse", "medium", "fine"),
+#: optional base keys, absent unless given (a design's hash is that of its given keys)
+_OPTIONAL = ("friction",)
+_CHOICES = {"contact": ("frictionless", "sticking", "coulomb"), "fidelity": ("coarse", "medium", "fine"),
             "cup": ("A", "B")}
 _METHODS = ("grid", "lhs", "sobol")
 
@@ -127,7 +132,32 @@ def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".") -> Sweep
         raise ValueError(f"axes: an axis appears twice ({', '.join(names)})")
     if method != "grid" and not parsed:
         raise ValueError(f"axes: {method} sampling needs at least one axis")
+    _check_contact_axes(base, parsed)
     return SweepSpec(base=base, axes=parsed, method=method, n=n if method != "grid" else 0, seed=seed)
+
+
+def _check_contact_axes(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) -> None:
+    """Every design's contact law is whole (`fem.interface.contact_law` checks it): a friction axis
+    varies a coulomb base's mu; a contact axis's coulomb value takes base.friction."""
+    from fem.interface import Spelling, contact_law
+
+    names = [a["name"] for a in axes]
+    spelling = Spelling("base.contact", "base.friction", 'base.contact = "{}"', "base.friction = MU")
+    laws = axes[names.index("contact")]["values"] if "contact" in names else [base["contact"]]
+    if "friction" in names:
+        i = names.index("friction")
+        if base["contact"] != "coulomb" or "contact" in names:
+            raise ValueError(f'axes[{i}].name: a friction axis varies Coulomb\'s mu: it needs '
+                             f'base.contact = "coulomb" and no contact axis')
+        axis = axes[i]
+        for mu in axis.get("values", [axis.get("low"), axis.get("high")]):
+            contact_law("coulomb", mu, Spelling("base.contact", f"axes[{i}]", 'base.contact = "{}"', "MU"))
+        return
+    mu = base.get("friction")
+    for law in dict.fromkeys(laws):
+        contact_law(law, mu if law == "coulomb" else None, spelling)
+    if mu is not None and "coulomb" not in laws:
+        contact_law(laws[0], mu, spelling)          # a mu without a coulomb law: refused
 
 
 def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
@@ -139,6 +169,8 @@ def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
     sc = load_scene(Path(root) / scene)
     base = {"cup": sc["cup"]["preset"], "E_MPa": sc["material"]["E_MPa"], "nu": sc["material"]["nu"],
             "contact": sc["contact"]["law"], "fidelity": sc["stiffness"]["fidelity"], "F1_N": sc["loads"]["F1_N"]}
+    if sc["contact"]["law"] == "coulomb":
+        base["friction"] = sc["contact"]["friction"]
     if sc["surface"]["preset"] and not sc["surface"]["uc_table"]:
         base["surface"] = sc["surface"]["preset"]
     if sc["loads"]["r_start_mm"] is not None:
@@ -164,7 +196,7 @@ def _keys(table: Any, allowed: tuple[str, ...], where: str) -> None:
 
 
 def _base(table: Mapping[str, Any]) -> dict[str, Any]:
-    _keys(table, tuple(_BASE_DEFAULTS), "base")
+    _keys(table, tuple(_BASE_DEFAULTS) + _OPTIONAL, "base")
     base = {**_BASE_DEFAULTS, **table}
     for key, choices in _CHOICES.items():
         if base[key] not in choices:
@@ -172,7 +204,7 @@ def _base(table: Mapping[str, Any]) -> dict[str, Any]:
     if not isinstance(base["allow_unusual_design"], bool):
         raise ValueError(f"base.allow_unusual_design: expected true or false, got {base['allow_unusual_design']!r}")
     for key in NUMERIC_AXES:
-        if base[key] is not None:
+        if base.get(key) is not None:
             base[key] = _number(base[key], f"base.{key}")
     for key in ("F1_N", "F0_at_u_mm"):
         values = base[key] if isinstance(base[key], list) else [base[key]]
