@@ -112,3 +112,168 @@ class CoupledFactor:
 
     def freeing(self, dofs: np.ndarray) -> "CoupledFactor":
         return CoupledFactor(self.base.freeing(dofs), self.K, self.coupling)
+
+
+class FrictionStep:
+    """The Newton step of one iterate for Coulomb contact (the interface of `fem.solver._Step`):
+    the quadratic model of the energy minimized on the free dofs subject to the linearized
+    frictional contact conditions, solved exactly on the contact dofs (module docstring)."""
+
+    coupled = True      # the line search may accept it by a fall of the residual
+
+    def __init__(self, plane, state, u, res, free, du_fixed, tol, factor, friction):
+        self.plane, self.old, self.u, self.free, self.tol = plane, state, u, free, tol
+        self.res0 = res + friction           # r - f_ext without the friction forces
+        self.du_fixed, self.factor, self.friction = du_fixed, factor, friction
+        self.state, self.settled = state, False
+
+    def solve(self, solver, K, shift, history, policy, lower=True) -> float:
+        plane, old = self.plane, self.old
+        nodes = np.flatnonzero(old.active)
+        rd = 2 * plane.nodes
+        base_free = self.free.copy()
+        base_free[rd[nodes]] = False
+        base_free[rd[nodes] + 1] = False
+        fac, shift = self.factor(solver, K, base_free, shift, history, policy, lower)
+        du_fixed = np.where(base_free, 0.0, self.du_fixed)
+        du_fixed[rd[nodes]] = du_fixed[rd[nodes] + 1] = 0.0
+        du0 = fac.solve(-self.res0, du_fixed)
+        g = plane.gap(self.u)
+        sub = _Condensed(plane, old, self.u, self.res0, K, fac, du0, nodes, self.tol)
+        flight = None
+        for _ in range(20):
+            sub.ssn()
+            du = sub.du()
+            if flight is None:
+                flight = du.copy()
+            out = np.ones(len(g), bool)
+            out[sub.cand] = False
+            new = np.flatnonzero(out & (g + du[rd + 1] < 0.0))
+            if len(new) == 0:
+                break
+            flight[rd[new]], flight[rd[new] + 1] = du[rd[new]], du[rd[new] + 1]
+            sub.add(new)
+        self.du, self.du0 = du, flight
+        self._sub = sub
+        self._outcome(sub)
+        return shift
+
+    def _outcome(self, sub) -> None:
+        old, n = self.old, len(self.old.active)
+        An = np.zeros(n, bool)
+        An[sub.cand] = sub.An
+        self.release = old.active & ~An
+        self.pressed = An & ~old.active
+        slip = np.zeros(n, np.int8)
+        slip[sub.cand[: len(sub.rnodes)]] = np.where(sub.An[: len(sub.rnodes)], sub.slip, 0)
+        keep = old.active & ~self.release
+        self.state = ContactState(keep, old.u_r_stick_m, np.where(keep, slip, 0).astype(np.int8))
+        self.settled = sub.converged and not self.release.any() and not self.pressed.any() \
+            and np.array_equal(self.state.slip, old.slip)
+
+    def holds(self, alpha: float) -> np.ndarray:
+        active = self.state.active.copy()
+        if alpha >= 1.0:
+            active |= self.pressed
+        return active
+
+    def reduces_residual(self, r_trial: np.ndarray, fext0: np.ndarray, alpha: float) -> bool:
+        base = r_trial - fext0
+        res = base - self.plane.friction_force(self.state, base)
+        free = self.free.copy()
+        dofs, _ = self.plane.constraints(self.state)
+        free[dofs] = False
+        old = self.res0 - self.friction
+        return bool(np.linalg.norm(res[free]) <= (1.0 - 1e-4 * alpha) * np.linalg.norm(old[self.free]))
+
+
+class _Condensed:
+    """The linearized frictional contact problem on the contact dofs C, the rest of the body
+    condensed. C: the z- and r-dofs of the nodes held at the start of the iteration (constrained
+    in the base factor: their unknowns are displacement increments) and the z-dofs of the free
+    nodes the step would push through the plane (free in it: their unknowns are the contact
+    forces). With the base step du0 and the columns Z (the response to a unit increment or a unit
+    force), du = du0 + Z y and the reactions at C are f = q + F y. Solved by a semismooth Newton
+    (primal-dual active set) method on Alart and Curnier's complementarity functions."""
+
+    def __init__(self, plane, old, u, res0, K, fac, du0, nodes, tol):
+        self.plane, self.K, self.fac, self.du0, self.tol = plane, K, fac, du0, tol
+        self.mu, self.n = plane.friction, len(u)
+        rd = 2 * plane.nodes
+        self.rnodes, self.cand = nodes, nodes.copy()
+        self.An = np.ones(len(nodes), bool)
+        self.slip = old.slip[nodes].astype(np.int8)
+        self.g_all = plane.gap(u)
+        self.d0 = u[rd[nodes]] - old.u_r_stick_m[nodes]
+        self.res0 = res0
+        self.rows = np.zeros(0, int)
+        self.Z = np.zeros((self.n, 0))
+        self.force = np.zeros(0, bool)
+        self._columns(np.concatenate([rd[nodes] + 1, rd[nodes]]), force=False)
+        self.converged = False
+
+    def _columns(self, dofs, force):
+        if len(dofs) == 0:
+            return
+        E = np.zeros((self.n, len(dofs)))
+        E[dofs, np.arange(len(dofs))] = 1.0
+        if force:
+            Z = self.fac.solve(E)
+        else:
+            Z = self.fac.solve(-(self.K @ E))
+            Z[dofs, np.arange(len(dofs))] = 1.0
+        self.Z = np.hstack([self.Z, Z])
+        self.rows = np.concatenate([self.rows, dofs])
+        self.force = np.concatenate([self.force, np.full(len(dofs), force)])
+
+    def add(self, new):
+        self._columns(2 * self.plane.nodes[new] + 1, force=True)
+        self.cand = np.concatenate([self.cand, new])
+        self.An = np.concatenate([self.An, np.ones(len(new), bool)])
+
+    def du(self):
+        return self.du0 + self.Z @ self.y
+
+    def ssn(self, maxit=30):
+        if len(self.rows) == 0:
+            self.y, self.converged = np.zeros(0), True
+            return
+        F = (self.K @ self.Z)[self.rows]
+        D = self.Z[self.rows]
+        q = (self.res0 + self.K @ self.du0)[self.rows]
+        w0 = self.du0[self.rows]
+        c = np.where(self.force, 1.0 / np.maximum(np.abs(np.diag(D)), 1e-300), np.abs(np.diag(F)))
+        nc, nr = len(self.cand), len(self.rnodes)
+        # row order: z of the nr held nodes, r of the held nodes, z of later candidates
+        iz = np.concatenate([np.arange(nr), 2 * nr + np.arange(nc - nr)])
+        ir = nr + np.arange(nr)
+        g, mu = self.g_all[self.cand], self.mu
+        An, slip = self.An.copy(), self.slip.copy()
+        p = len(self.rows)
+        self.converged = False
+        for _ in range(maxit):
+            A, b = F.copy(), -q.copy()          # default rows: reaction = 0 (free of the plane)
+            on = iz[An]
+            A[on], b[on] = D[on], -g[An] - w0[on]
+            Ar = An[:nr]
+            stick = ir[Ar & (slip == 0)]
+            A[stick], b[stick] = D[stick], -self.d0[Ar & (slip == 0)] - w0[stick]
+            sl = Ar & (slip != 0)
+            k = -mu * slip[sl]                   # f_r = -mu slip f_z
+            A[ir[sl]] = F[ir[sl]] - k[:, None] * F[iz[:nr][sl]]
+            b[ir[sl]] = -(q[ir[sl]] - k * q[iz[:nr][sl]])
+            y = np.linalg.solve(A, b)
+            f, w = q + F @ y, w0 + D @ y
+            lam_hat = f[iz] - c[iz] * (g + w[iz])
+            An_new = lam_hat > np.where(An, -self.tol, self.tol)
+            zeta = f[ir] - c[ir] * (self.d0 + w[ir])
+            bound = mu * np.maximum(lam_hat[:nr], 0.0)
+            hyst = np.where(slip == 0, self.tol, -self.tol)
+            slip_new = np.where(np.abs(zeta) <= bound + hyst, 0, -np.sign(zeta)).astype(np.int8)
+            slip_new[(slip != 0) & (slip_new == -slip)] = 0      # a reversing slide sticks first
+            slip_new = np.where(An_new[:nr], slip_new, 0).astype(np.int8)
+            self.y, self.An, self.slip, self.f = y, An, slip, f
+            if np.array_equal(An_new, An) and np.array_equal(slip_new[An[:nr]], slip[An[:nr]]):
+                self.converged = True
+                break
+            An, slip = An_new, slip_new

@@ -88,7 +88,7 @@ from scipy.optimize import nnls
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
 from .condensation import make_solver
-from .friction import CoupledFactor, friction_iterate, landing_slip, sliding_coupling
+from .friction import CoupledFactor, FrictionStep, friction_iterate, landing_slip, sliding_coupling
 from .linsolve import NotPositiveDefinite
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
@@ -322,11 +322,7 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         free, dofs, du_fixed = _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state)
         f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext0), _force_floor(mech))
         if plane is not None and plane.law == "coulomb":
-            if lin is None:     # warm start: the committed stick/slide set (no step predicted yet)
-                fric = plane.friction_force(state, res)
-            else:
-                state, fric, flips = friction_iterate(plane, state, u, lin, res, K,
-                                                      opts.rtol * f_ref, flips)
+            fric = plane.friction_force(state, res)
             Pi += (fext - fext0 - fric) @ u           # the same W, the new load
             fext = fext0 + fric
             res = r - fext
@@ -337,9 +333,13 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
             raise _StepFailure("the residual is not finite", history)
         if coupled and len(history) > _STALL and history[-1] > 0.5 * min(history[-_STALL - 1:-1]):
             coupled = False     # the coupled steps stall (module docstring): fixed friction forces
-        step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref,
-                     sliding_coupling(plane, state, res) if plane is not None and coupled else None)
-        step.friction = fext - fext0
+        if plane is not None and plane.law == "coulomb":
+            step = FrictionStep(plane, state, u, res, free, du_fixed, opts.rtol * f_ref, _factor,
+                                fext - fext0)
+        else:
+            step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref,
+                         sliding_coupling(plane, state, res) if plane is not None and coupled else None)
+            step.friction = fext - fext0
         shift = step.solve(solver, K, shift, history, policy)
         indefinite |= shift > 0.0
         flags["indefinite"] = indefinite
@@ -348,7 +348,7 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         held = not np.any(du_fixed)
         tensile = plane is not None and np.any(plane.reactions(res)[state.active] < -opts.rtol * f_ref)
         if held and not tensile and _balanced(rnorm, opts.rtol * f_ref, step.du, u) \
-                and energy <= opts.etol * e_ref:
+                and energy <= opts.etol * e_ref and getattr(step, "settled", True):
             if plane is not None and plane.cone_excess(state, res) > 1e3 * opts.rtol:
                 raise _StepFailure("Coulomb's stick/slide set cycled and the node held stuck lies "
                                    f"outside the friction cone ({plane.cone_excess(state, res):.2g} "
@@ -367,8 +367,11 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
             released |= step.release
             u_free = u_prev + max(alpha, 1.0) * step.du0
             lin = res0 + alpha * Kdu
-            state = landing_slip(plane, state, plane.hold(state, step.holds(alpha), u, u_start,
-                                                          u_free, released), u_free, lin, K)
+            if plane.law == "coulomb":
+                state = plane.hold(step.state, step.holds(alpha), u, u_start, u_free, released)
+            else:
+                state = landing_slip(plane, state, plane.hold(state, step.holds(alpha), u, u_start,
+                                                              u_free, released), u_free, lin, K)
 
 
 def _balanced(rnorm: float, tol: float, du: np.ndarray, u: np.ndarray) -> bool:
