@@ -88,7 +88,7 @@ from scipy.optimize import nnls
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
 from .condensation import make_solver
-from .friction import CoupledFactor, FrictionStep, friction_iterate, landing_slip, sliding_coupling
+from .friction import FrictionStep
 from .linsolve import NotPositiveDefinite
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
@@ -275,9 +275,6 @@ def _jumped_too_far(indefinite: bool, defect: float, W0: float, W1: float, dt: f
     return abs(defect) > opts.jump_tol * max(abs(W0), abs(W1))
 
 
-_STALL = 8          # iterations without halving the residual after which a step drops the
-#                     friction coupling from its Newton matrix
-
 _JUMPS = 2          # attempts to step across an instability (2x, 4x the last good step)
 
 
@@ -314,9 +311,6 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
                            "the deformation, or the mesh is too coarse", history) from None
     it, shift, indefinite = 0, 0.0, False
     released = np.zeros(len(plane.nodes), bool) if plane is not None else None
-    lin = None          # the linearized reactions of the last Newton step (Coulomb's stick/slide)
-    flips = np.zeros(len(plane.nodes), int) if plane is not None else None
-    coupled = True      # Newton's matrix with the sliding nodes' coupling to lambda (Coulomb)
     while True:
         res = r - fext0
         free, dofs, du_fixed = _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state)
@@ -331,15 +325,11 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         history.append(rnorm / f_ref)
         if not np.all(np.isfinite(res)):
             raise _StepFailure("the residual is not finite", history)
-        if coupled and len(history) > _STALL and history[-1] > 0.5 * min(history[-_STALL - 1:-1]):
-            coupled = False     # the coupled steps stall (module docstring): fixed friction forces
         if plane is not None and plane.law == "coulomb":
             step = FrictionStep(plane, state, u, res, free, du_fixed, opts.rtol * f_ref, _factor,
                                 fext - fext0)
         else:
-            step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref,
-                         sliding_coupling(plane, state, res) if plane is not None and coupled else None)
-            step.friction = fext - fext0
+            step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref)
         shift = step.solve(solver, K, shift, history, policy)
         indefinite |= shift > 0.0
         flags["indefinite"] = indefinite
@@ -360,18 +350,13 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
             raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely cause: a "
                                "structural instability (snap-through/buckling) that the step jumps "
                                "across, or a too-large step", history)
-        u_prev, Kdu, res0 = u, K @ step.du, res + (fext - fext0)
+        u_prev = u
         alpha, u, Pi, r, K, shift = _line_search(mech, solver, policy, step, u_start, u, Pi, res,
                                                  K, fext, shift, held, history)
         if plane is not None:
             released |= step.release
             u_free = u_prev + max(alpha, 1.0) * step.du0
-            lin = res0 + alpha * Kdu
-            if plane.law == "coulomb":
-                state = plane.hold(step.state, step.holds(alpha), u, u_start, u_free, released)
-            else:
-                state = landing_slip(plane, state, plane.hold(state, step.holds(alpha), u, u_start,
-                                                              u_free, released), u_free, lin, K)
+            state = plane.hold(step.state, step.holds(alpha), u, u_start, u_free, released)
 
 
 def _balanced(rnorm: float, tol: float, du: np.ndarray, u: np.ndarray) -> bool:
@@ -393,32 +378,11 @@ class _Step:
     linearized reaction lambda + (K du)_z would turn tensile (these are freed in K_ff, if it
     stays positive definite without them)."""
 
-    def __init__(self, plane, state, u, res, free, du_fixed, tol, coupling=None):
+    coupled = False     # accepted by the energy only (`fem.friction.FrictionStep`: also the residual)
+
+    def __init__(self, plane, state, u, res, free, du_fixed, tol):
         self.plane, self.state, self.u, self.res, self.du_fixed = plane, state, u, res, du_fixed
-        self.free, self.tol, self.coupling, self.coupled = free, tol, coupling, False
-
-    def _coupled(self, fac, K) -> None:
-        """Coulomb's sliding nodes: the step again with the Newton matrix K_ff + U V^T
-        (`fem.friction`), the nodes the QP pressed held on the plane (g + du_z = 0). Kept only if
-        it descends in the energy the line search judges (the friction forces fixed)."""
-        cf = CoupledFactor(fac, K, self.coupling)
-        du = cf.solve(-self.res, self.du_fixed)
-        pressed = self.qp[self.lam > 0.0]
-        if pressed.size:
-            zdof = 2 * self.plane.nodes[pressed] + 1
-            E = np.zeros((len(du), len(pressed)))
-            E[zdof, np.arange(len(pressed))] = 1.0
-            cols = cf.solve(E)
-            lam = np.linalg.solve(cols[zdof], -(self.plane.gap(self.u)[pressed] + du[zdof]))
-            du = du + cols @ lam
-        self.du, self.coupled = du, True
-
-    def reduces_residual(self, r_trial: np.ndarray, fext0: np.ndarray, alpha: float) -> bool:
-        """The merit test of a coupled (non-symmetric) step, which need not descend in the
-        energy: the free residual, friction included, falls by 1e-4 alpha of itself."""
-        base = r_trial - fext0
-        res = base - self.plane.friction_force(self.state, base)
-        return bool(np.linalg.norm(res[self.free]) <= (1.0 - 1e-4 * alpha) * np.linalg.norm(self.res[self.free]))
+        self.free, self.tol = free, tol
 
     def solve(self, solver, K, shift, history, policy, lower=True) -> float:
         """Factor (with a diagonal shift if K_ff is not positive definite), solve, and add
@@ -442,8 +406,6 @@ class _Step:
                 fac, shift = _factor(solver, K, free, shift, history, policy, lower=False)
             self._constrained(fac, np.flatnonzero(tensile))
             self.release = tensile
-        if self.coupling is not None:
-            self._coupled(fac, K)
         return shift
 
     def _constrained(self, fac, candidates: np.ndarray) -> None:
