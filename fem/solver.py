@@ -48,17 +48,15 @@ sticking law the frozen radial positions of the nodes held on the plane). Newton
   of 1e-6 on that shift removed this instance but neither made the case run (a later snap
   needs ~460 iterations) nor saved iterations over the robustness cases (28922 against 28223;
   round-off in the linear solves alone moves that total by ~7 %), so it is not used.
-* Coulomb friction (`fem.contact`, `fem.friction`): at every iterate the stick/slide set is
-  updated from the reactions the last Newton step predicted, the sliding nodes carry the friction
-  -mu lambda s of the iterate (part of the load, so the line search's energy is that of fixed
-  friction forces), and their coupling to lambda enters the Newton matrix as a rank-m update
-  (Woodbury on the same Cholesky factor); a coupled step is accepted by the energy or, since it
-  need not descend in it, by a fall of the residual. Like the sticking law, no extrapolation.
-  When the residual has not halved in _STALL = 8 iterations, the rest of the step drops the
-  coupling (the plain energy step with the friction forces fixed, a fixed point on lambda):
-  with an indefinite, shifted tangent the coupled steps of cup A with mu = 2 crept by 3e-7 m per
-  iteration at a constant residual for 400 iterations (u = 3.1 mm and 4.46 mm, where the wall
-  lands), and the path stopped there; uncoupled, it runs to 0.9 h1.
+* Coulomb friction (`fem.contact`, `fem.friction`): the step is `fem.friction.FrictionStep`,
+  the same quadratic model with the linearized frictional contact conditions solved exactly on
+  the contact dofs (the body condensed onto them with the factor of K_ff; a semismooth Newton
+  method on Alart and Curnier's complementarity functions for which nodes press, stick, slide),
+  so that the stick/slide set converges with the displacement. The sliding nodes carry the
+  friction -mu lambda s of the iterate (part of the load, so the line search's energy is that of
+  fixed friction forces); the step need not descend in it (Coulomb's law is not associated) and
+  is also accepted by a fall of the residual. An iterate is converged only if the condensed
+  problem keeps its sets (`settled`). Like the sticking law, no extrapolation.
 * Jumps: the energy lost in a step, W0 + work - W1 (trapezoid work), is summed over the steps as
   `SolverStats.dissipated_J`. For frictionless contact (conservative: only a snap loses
   energy), a step across an instability that loses more than jump_tol = 0.5 % of W is redone
