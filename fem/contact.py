@@ -22,13 +22,12 @@ Coulomb friction (``"coulomb"``, coefficient mu): a held node sticks at its anch
 at the start of the load step, or where it touched down in it) while its tangential reaction
 |t| <= mu lambda, and slides otherwise with t = -mu lambda sign(Delta), Delta = u_r - anchor: the
 plane's friction opposes the slip. The step is the backward-Euler increment of the law (the
-history is the anchor, moved to the converged position by `commit`). Which nodes slide is an
-active set like the normal one, updated at every Newton iterate by the primal-dual rule of the
-Tresca problem with the bound g = mu lambda of that iterate (`slide`): z = t - c Delta, stick
-where |z| < g, slide in the direction -sign(z) otherwise (c > 0, the node's diagonal stiffness,
-moves the iterates only, not the solution). A sliding node's radial dof is free and loaded by
-the constant force -g s, so each iterate minimizes a smooth energy; at convergence the residual
-holds t = -mu lambda s with lambda of the converged state itself. No regularisation: mu = 0 is
+history is the anchor, moved to the converged position by `commit`). Which nodes press, stick
+and slide is decided in every Newton iteration on the linearized problem, exactly
+(`fem.friction`: a semismooth Newton method on Alart and Curnier's complementarity functions,
+whose augmentation moves the iterates only, not the solution). A sliding node's radial dof is
+free and loaded by the friction -mu lambda s of the iterate; at convergence the residual holds
+t = -mu lambda s with lambda of the converged state itself. No regularisation: mu = 0 is
 frictionless, and a large mu sticks wherever lambda > 0.
 
 The contact pressure p is the L2 projection, on the deformed contact boundary (weight 2 pi r ds),
@@ -192,7 +191,7 @@ class RigidPlane:
         does not slide. A node `released` in this step (its reaction turned tensile: no
         friction can hold it) lands again where u puts it: it has slipped. If its free flight
         does not reach the plane, a node lands where u puts it. Coulomb: the same anchors; a node
-        held anew sticks first (`slide` decides)."""
+        held anew sticks first (`fem.friction` decides from the next iteration on)."""
         new = active & ~state.active
         stick = state.u_r_stick_m.copy()
         if self.law != "frictionless" and np.any(new):
@@ -208,27 +207,6 @@ class RigidPlane:
     def friction_bound(self, res: np.ndarray) -> np.ndarray:
         """g = mu max(lambda, 0) [N] per candidate, lambda the normal reaction in `res`."""
         return self.friction * np.maximum(self.reactions(res), 0.0)
-
-    def slide(self, state: ContactState, u: np.ndarray, res: np.ndarray, c: np.ndarray,
-              tol: float) -> ContactState:
-        """The stick/slide set at the iterate u (Coulomb; other laws: unchanged). res = r_int -
-        f_ext without friction (the sticking nodes' tangential reactions t), c [N/m] > 0 per
-        candidate: z = t - c Delta (t = -g s where sliding, Delta = 0 where sticking); stick where |z| < g, slide along
-        -sign(z) otherwise, with a hysteresis of `tol` [N] so that a converged set stays put."""
-        if self.law != "coulomb":
-            return state
-        rdof = 2 * self.nodes
-        g = self.friction_bound(res)
-        sticking = state.slip == 0
-        # a sticking node is at its anchor by its constraint (a node held anew may still have
-        # to jump there: not a slip), so its z is its reaction t alone
-        z = np.where(sticking, res[rdof], -g * state.slip - c * (u[rdof] - state.u_r_stick_m))
-        # a sliding node that would reverse sticks first (going straight to the reverse slide
-        # let nodes next to the cone's edge flip +1 <-> -1 for ever on cup A, mu = 0.3)
-        stick = np.where(sticking, np.abs(z) <= g + tol,
-                         (np.abs(z) < g - tol) | (-np.sign(z) != state.slip))
-        slip = np.where(state.active & ~stick, -np.sign(z), 0).astype(np.int8)
-        return ContactState(state.active, state.u_r_stick_m, slip)
 
     def friction_force(self, state: ContactState, res: np.ndarray) -> np.ndarray:
         """The plane's friction on the sliding nodes, -mu lambda s at their radial dofs [N]

@@ -48,17 +48,15 @@ sticking law the frozen radial positions of the nodes held on the plane). Newton
   of 1e-6 on that shift removed this instance but neither made the case run (a later snap
   needs ~460 iterations) nor saved iterations over the robustness cases (28922 against 28223;
   round-off in the linear solves alone moves that total by ~7 %), so it is not used.
-* Coulomb friction (`fem.contact`, `fem.friction`): at every iterate the stick/slide set is
-  updated from the reactions the last Newton step predicted, the sliding nodes carry the friction
-  -mu lambda s of the iterate (part of the load, so the line search's energy is that of fixed
-  friction forces), and their coupling to lambda enters the Newton matrix as a rank-m update
-  (Woodbury on the same Cholesky factor); a coupled step is accepted by the energy or, since it
-  need not descend in it, by a fall of the residual. Like the sticking law, no extrapolation.
-  When the residual has not halved in _STALL = 8 iterations, the rest of the step drops the
-  coupling (the plain energy step with the friction forces fixed, a fixed point on lambda):
-  with an indefinite, shifted tangent the coupled steps of cup A with mu = 2 crept by 3e-7 m per
-  iteration at a constant residual for 400 iterations (u = 3.1 mm and 4.46 mm, where the wall
-  lands), and the path stopped there; uncoupled, it runs to 0.9 h1.
+* Coulomb friction (`fem.contact`, `fem.friction`): the step is `fem.friction.FrictionStep`,
+  the same quadratic model with the linearized frictional contact conditions solved exactly on
+  the contact dofs (the body condensed onto them with the factor of K_ff; a semismooth Newton
+  method on Alart and Curnier's complementarity functions for which nodes press, stick, slide),
+  so that the stick/slide set converges with the displacement. The sliding nodes carry the
+  friction -mu lambda s of the iterate (part of the load, so the line search's energy is that of
+  fixed friction forces); the step need not descend in it (Coulomb's law is not associated) and
+  is also accepted by a fall of the residual. An iterate is converged only if the condensed
+  problem keeps its sets (`settled`). Like the sticking law, no extrapolation.
 * Jumps: the energy lost in a step, W0 + work - W1 (trapezoid work), is summed over the steps as
   `SolverStats.dissipated_J`. For frictionless contact (conservative: only a snap loses
   energy), a step across an instability that loses more than jump_tol = 0.5 % of W is redone
@@ -88,7 +86,7 @@ from scipy.optimize import nnls
 from .contact import ContactState, RigidPlane
 from .forms import Mechanics
 from .condensation import make_solver
-from .friction import CoupledFactor, friction_iterate, landing_slip, sliding_coupling
+from .friction import FrictionStep
 from .linsolve import NotPositiveDefinite
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
@@ -275,9 +273,6 @@ def _jumped_too_far(indefinite: bool, defect: float, W0: float, W1: float, dt: f
     return abs(defect) > opts.jump_tol * max(abs(W0), abs(W1))
 
 
-_STALL = 8          # iterations without halving the residual after which a step drops the
-#                     friction coupling from its Newton matrix
-
 _JUMPS = 2          # attempts to step across an instability (2x, 4x the last good step)
 
 
@@ -314,19 +309,12 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
                            "the deformation, or the mesh is too coarse", history) from None
     it, shift, indefinite = 0, 0.0, False
     released = np.zeros(len(plane.nodes), bool) if plane is not None else None
-    lin = None          # the linearized reactions of the last Newton step (Coulomb's stick/slide)
-    flips = np.zeros(len(plane.nodes), int) if plane is not None else None
-    coupled = True      # Newton's matrix with the sliding nodes' coupling to lambda (Coulomb)
     while True:
         res = r - fext0
         free, dofs, du_fixed = _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state)
         f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext0), _force_floor(mech))
         if plane is not None and plane.law == "coulomb":
-            if lin is None:     # warm start: the committed stick/slide set (no step predicted yet)
-                fric = plane.friction_force(state, res)
-            else:
-                state, fric, flips = friction_iterate(plane, state, u, lin, res, K,
-                                                      opts.rtol * f_ref, flips)
+            fric = plane.friction_force(state, res)
             Pi += (fext - fext0 - fric) @ u           # the same W, the new load
             fext = fext0 + fric
             res = r - fext
@@ -335,11 +323,11 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         history.append(rnorm / f_ref)
         if not np.all(np.isfinite(res)):
             raise _StepFailure("the residual is not finite", history)
-        if coupled and len(history) > _STALL and history[-1] > 0.5 * min(history[-_STALL - 1:-1]):
-            coupled = False     # the coupled steps stall (module docstring): fixed friction forces
-        step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref,
-                     sliding_coupling(plane, state, res) if plane is not None and coupled else None)
-        step.friction = fext - fext0
+        if plane is not None and plane.law == "coulomb":
+            step = FrictionStep(plane, state, u, res, free, du_fixed, opts.rtol * f_ref, _factor,
+                                fext - fext0)
+        else:
+            step = _Step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref)
         shift = step.solve(solver, K, shift, history, policy)
         indefinite |= shift > 0.0
         flags["indefinite"] = indefinite
@@ -348,7 +336,7 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         held = not np.any(du_fixed)
         tensile = plane is not None and np.any(plane.reactions(res)[state.active] < -opts.rtol * f_ref)
         if held and not tensile and _balanced(rnorm, opts.rtol * f_ref, step.du, u) \
-                and energy <= opts.etol * e_ref:
+                and energy <= opts.etol * e_ref and getattr(step, "settled", True):
             if plane is not None and plane.cone_excess(state, res) > 1e3 * opts.rtol:
                 raise _StepFailure("Coulomb's stick/slide set cycled and the node held stuck lies "
                                    f"outside the friction cone ({plane.cone_excess(state, res):.2g} "
@@ -360,15 +348,13 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
             raise _StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely cause: a "
                                "structural instability (snap-through/buckling) that the step jumps "
                                "across, or a too-large step", history)
-        u_prev, Kdu, res0 = u, K @ step.du, res + (fext - fext0)
+        u_prev = u
         alpha, u, Pi, r, K, shift = _line_search(mech, solver, policy, step, u_start, u, Pi, res,
                                                  K, fext, shift, held, history)
         if plane is not None:
             released |= step.release
             u_free = u_prev + max(alpha, 1.0) * step.du0
-            lin = res0 + alpha * Kdu
-            state = landing_slip(plane, state, plane.hold(state, step.holds(alpha), u, u_start,
-                                                          u_free, released), u_free, lin, K)
+            state = plane.hold(step.state, step.holds(alpha), u, u_start, u_free, released)
 
 
 def _balanced(rnorm: float, tol: float, du: np.ndarray, u: np.ndarray) -> bool:
@@ -390,32 +376,11 @@ class _Step:
     linearized reaction lambda + (K du)_z would turn tensile (these are freed in K_ff, if it
     stays positive definite without them)."""
 
-    def __init__(self, plane, state, u, res, free, du_fixed, tol, coupling=None):
+    coupled = False     # accepted by the energy only (`fem.friction.FrictionStep`: also the residual)
+
+    def __init__(self, plane, state, u, res, free, du_fixed, tol):
         self.plane, self.state, self.u, self.res, self.du_fixed = plane, state, u, res, du_fixed
-        self.free, self.tol, self.coupling, self.coupled = free, tol, coupling, False
-
-    def _coupled(self, fac, K) -> None:
-        """Coulomb's sliding nodes: the step again with the Newton matrix K_ff + U V^T
-        (`fem.friction`), the nodes the QP pressed held on the plane (g + du_z = 0). Kept only if
-        it descends in the energy the line search judges (the friction forces fixed)."""
-        cf = CoupledFactor(fac, K, self.coupling)
-        du = cf.solve(-self.res, self.du_fixed)
-        pressed = self.qp[self.lam > 0.0]
-        if pressed.size:
-            zdof = 2 * self.plane.nodes[pressed] + 1
-            E = np.zeros((len(du), len(pressed)))
-            E[zdof, np.arange(len(pressed))] = 1.0
-            cols = cf.solve(E)
-            lam = np.linalg.solve(cols[zdof], -(self.plane.gap(self.u)[pressed] + du[zdof]))
-            du = du + cols @ lam
-        self.du, self.coupled = du, True
-
-    def reduces_residual(self, r_trial: np.ndarray, fext0: np.ndarray, alpha: float) -> bool:
-        """The merit test of a coupled (non-symmetric) step, which need not descend in the
-        energy: the free residual, friction included, falls by 1e-4 alpha of itself."""
-        base = r_trial - fext0
-        res = base - self.plane.friction_force(self.state, base)
-        return bool(np.linalg.norm(res[self.free]) <= (1.0 - 1e-4 * alpha) * np.linalg.norm(self.res[self.free]))
+        self.free, self.tol = free, tol
 
     def solve(self, solver, K, shift, history, policy, lower=True) -> float:
         """Factor (with a diagonal shift if K_ff is not positive definite), solve, and add
@@ -439,8 +404,6 @@ class _Step:
                 fac, shift = _factor(solver, K, free, shift, history, policy, lower=False)
             self._constrained(fac, np.flatnonzero(tensile))
             self.release = tensile
-        if self.coupling is not None:
-            self._coupled(fac, K)
         return shift
 
     def _constrained(self, fac, candidates: np.ndarray) -> None:

@@ -15,7 +15,7 @@ import pytest
 from skfem import MeshQuad, MeshQuad2
 
 from fem.contact import RigidPlane
-from fem.cup import compress_cup
+from fem.cup import CupSetup, compress_cup
 from fem.forms import Mechanics
 from fem.geometry import cup_geometry
 from fem.kinematics import Kinematics
@@ -138,3 +138,29 @@ def test_work_is_stored_energy_plus_friction_dissipation():
         errors.append(abs(defect - friction) / friction)
     assert errors[-1] < 1e-3
     assert errors[1] < 0.45 * errors[0] and errors[2] < 0.45 * errors[1]
+
+
+def test_converged_states_hold_coulombs_law_node_by_node(mesh):
+    """Every converged state of a path with sticking and sliding nodes (coarse cup A, mu = 3, to
+    3 mm) satisfies the law at each held node, checked from the states alone: lambda >= 0; a
+    sticking node has not moved radially in the step (it is at its anchor) and |t| <= mu lambda;
+    a sliding node carries t = -mu lambda s and has moved in its slip direction s."""
+    cup = CupSetup.of(mesh, MAT, "coulomb", 3.0)
+    out = []
+    follow_path(cup.mech, cup.plate_at(0.0), 3e-3, plane=cup.plane, on_step=out.append,
+                options=SolverOptions(initial_step=0.05, max_step=0.05))
+    rd, mu, kinds = 2 * cup.plane.nodes, 3.0, set()
+    for s0, s1 in zip(out[:-1], out[1:]):
+        a, slip = s1.contact.active, s1.contact.slip
+        lam, t = s1.r_int[rd + 1], s1.r_int[rd]
+        scale = np.max(lam[a])
+        moved = s1.u[rd] - s0.u[rd]
+        assert np.all(lam[a] >= -1e-6 * scale)
+        stuck, sliding = a & (slip == 0), a & (slip != 0)
+        was = s0.contact.active                 # held at the step's start: anchored there
+        assert np.all(np.abs(moved[stuck & was]) <= 1e-12 * np.max(np.abs(s1.u)))
+        assert np.all(np.abs(t[stuck]) <= mu * lam[stuck] + 1e-6 * scale)
+        np.testing.assert_allclose(t[sliding], -mu * lam[sliding] * slip[sliding], atol=1e-6 * scale)
+        assert np.all(slip[sliding & was] * moved[sliding & was] > 0.0)
+        kinds |= {int(k) for k in slip[a]}
+    assert kinds >= {0, 1}
