@@ -35,7 +35,7 @@ import numpy as np
 
 from reduced.gas import XI, Gas
 
-__all__ = ["ContactProfile", "ring_gaps", "profile_leak_rate", "profile_liquid_rate"]
+__all__ = ["ContactProfile", "patch_average", "ring_gaps", "profile_leak_rate", "profile_liquid_rate"]
 
 
 @dataclass(frozen=True)
@@ -69,6 +69,46 @@ class ContactProfile:
         return float(np.pi * np.sum((f[1:] + f[:-1]) * np.diff(self.r_m)))
 
 
+def patch_average(profile: ContactProfile, length_m: float) -> ContactProfile:
+    """The nominal pressure of `profile` on patches of radial width `length_m` (module docstring,
+    "Patch-averaged pressure"): at radius x, the force on the annulus [x - L/2, x + L/2] over its area,
+
+        pbar(x) = (G(x + L/2) - G(x - L/2)) / ((x + L/2)^2 / 2 - (x - L/2)^2 / 2),   G(r) = int_0^r p s ds
+
+    with p r linear between the samples (the trapezoid rule of `ContactProfile.force_N`; G is then
+    piecewise quadratic and exact). A uniform pressure is returned unchanged wherever the window lies
+    inside it, and int pbar r dr = int p r dr. The result is sampled at its kinks r_i +- L/2 (no
+    others: pbar is a rational quadratic between them), intervals longer than L/2 split evenly; its
+    support is the input's widened by L/2 on each side (a window starting below r = 0 is cut there).
+    """
+    L = float(length_m)
+    if not (math.isfinite(L) and L > 0.0):
+        raise ValueError(f"length_m: the patch length must be finite and > 0, got {length_m}")
+    r, p = profile.r_m, profile.p_Pa
+    f = p * r
+    G = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(r))])
+    kinks = np.unique(np.concatenate([r - 0.5 * L, r + 0.5 * L]))
+    kinks = kinks[kinks > 0.0]
+    n = np.maximum(1, np.ceil(np.diff(kinks) / (0.5 * L) - 1e-9).astype(int))
+    start = np.repeat(kinks[:-1], n)
+    step = np.repeat(np.diff(kinks) / n, n)
+    j = np.arange(start.size) - np.repeat(np.cumsum(n) - n, n)
+    x = np.append(start + j * step, kinks[-1])
+    a, b = np.maximum(x - 0.5 * L, 0.0), x + 0.5 * L
+    pbar = (_cumulative(r, f, G, b) - _cumulative(r, f, G, a)) / (0.5 * (b * b - a * a))
+    pbar[pbar <= 1e-12 * max(float(p.max()), 0.0)] = 0.0     # round-off off the support
+    return ContactProfile(x, pbar)
+
+
+def _cumulative(r: np.ndarray, f: np.ndarray, G: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """G(x) = int_{r_0}^x f ds with f linear between the samples, 0 below r_0, G[-1] above r_n."""
+    i = np.clip(np.searchsorted(r, x, side="right") - 1, 0, r.size - 2)
+    h = r[i + 1] - r[i]
+    t = np.clip(x - r[i], 0.0, h)
+    inside = G[i] + f[i] * t + (f[i + 1] - f[i]) * t * t / (2.0 * h)
+    return np.where(x <= r[0], 0.0, np.where(x >= r[-1], G[-1], inside))
+
+
 def ring_gaps(profile: ContactProfile, u_c: Callable[[float], float], E_Pa: float,
               scale: float = 1.0, extra_Pa: float = 0.0) -> np.ndarray:
     """Gap u_i [m] of each ring: u_c of the contact pressure at its middle, scale p + extra_Pa
@@ -76,6 +116,11 @@ def ring_gaps(profile: ContactProfile, u_c: Callable[[float], float], E_Pa: floa
     p = profile.p_Pa
     mid = 0.5 * (p[1:] + p[:-1])
     touching = (p[1:] > 0) | (p[:-1] > 0)
+    values = getattr(u_c, "values", None)
+    if values is not None:                  # a UcTable: vectorised
+        gaps = np.full(mid.size, math.inf)
+        gaps[touching] = values((scale * mid[touching] + extra_Pa) / E_Pa)
+        return gaps
     uc = getattr(u_c, "scalar", u_c)
     return np.array([uc((scale * m + extra_Pa) / E_Pa) if t else math.inf for m, t in zip(mid, touching)])
 
@@ -109,7 +154,10 @@ def _series_flow(p_a: float, p_b: float, u3: np.ndarray, b: np.ndarray, c: np.nd
     """Q with P marched from p_a through the rings (Phi differences c_i Q) ending at p_b."""
     # upper bound: no ring passes more than it would with the whole drop across it alone
     q_hi = float(np.min(u3 * ((p_a + b) ** 2 - (p_b + b) ** 2) / (2.0 * c)))
-    lo, hi, q = 0.0, q_hi, 0.5 * q_hi
+    # start: each ring's conductance frozen at the mean pressure (exact for one ring, or all b equal)
+    q_lin = (p_a - p_b) / float(np.sum(c / (u3 * (0.5 * (p_a + p_b) + b))))
+    lo, hi = 0.0, q_hi
+    q = q_lin if 0.0 < q_lin < q_hi else 0.5 * q_hi
     for _ in range(100):
         p_in, dp_dq = _march(p_a, u3, b, c, q)
         f = p_in - p_b

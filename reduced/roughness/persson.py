@@ -322,6 +322,10 @@ def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: 
 
     Without adhesion the theory is linear elastic: u_c depends on p and E only through p/E*, so
     one table serves every modulus at this Poisson ratio, the relaxed E_eff(phi) included.
+
+    The table carries the spectrum's roll-off wavelength as `patch_length_m`: the theory's nominal
+    pressure is an average over a patch that holds the self-affine roughness's longest wavelength,
+    so the profile route averages the FEM's contact pressure over it (`reduced.profile_leak`).
     """
     from reduced.critical_gap import UcTable
 
@@ -329,4 +333,5 @@ def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: 
     table = critical_gap_table(spectrum, 1e6, nu, grid, method=method, gamma=gamma, a_c=a_c)
     note = (f"Persson theory ({method}, gamma {gamma:g}, a_c {a_c:g}, nu {nu:g}) of "
             f"{spectrum.provenance}")
-    return UcTable(table.p_over_E, table.u_c_m, provenance=note)
+    return UcTable(table.p_over_E, table.u_c_m, provenance=note,
+                   patch_length_m=spectrum.rolloff_wavelength_m())
