@@ -35,7 +35,7 @@ import numpy as np
 
 from reduced.gas import XI, Gas
 
-__all__ = ["ContactProfile", "patch_average", "ring_gaps", "profile_leak_rate", "profile_liquid_rate"]
+__all__ = ["ContactProfile", "contact_segments", "patch_average", "patch_contact", "ring_gaps", "profile_leak_rate", "profile_liquid_rate"]
 
 
 @dataclass(frozen=True)
@@ -77,8 +77,9 @@ def patch_average(profile: ContactProfile, length_m: float) -> ContactProfile:
 
     with p r linear between the samples (the trapezoid rule of `ContactProfile.force_N`; G is then
     piecewise quadratic and exact). A uniform pressure is returned unchanged wherever the window lies
-    inside it, and int pbar r dr = int p r dr. The result is sampled at its kinks r_i +- L/2 (no
-    others: pbar is a rational quadratic between them), intervals longer than L/2 split evenly; its
+    inside it, and int pbar r dr = int p r dr. The result is sampled at its kinks r_i +- L/2 (pbar is
+    a rational quadratic between them) and at the ends of the nominal contact (`patch_contact`),
+    intervals longer than L/2 split evenly; its
     support is the input's widened by L/2 on each side (a window starting below r = 0 is cut there).
     """
     L = float(length_m)
@@ -87,7 +88,8 @@ def patch_average(profile: ContactProfile, length_m: float) -> ContactProfile:
     r, p = profile.r_m, profile.p_Pa
     f = p * r
     G = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(r))])
-    kinks = np.unique(np.concatenate([r - 0.5 * L, r + 0.5 * L]))
+    a, b = contact_segments(profile)
+    kinks = np.unique(np.concatenate([r - 0.5 * L, r + 0.5 * L, a - 0.5 * L, b + 0.5 * L]))
     kinks = kinks[kinks > 0.0]
     n = np.maximum(1, np.ceil(np.diff(kinks) / (0.5 * L) - 1e-9).astype(int))
     start = np.repeat(kinks[:-1], n)
@@ -100,6 +102,37 @@ def patch_average(profile: ContactProfile, length_m: float) -> ContactProfile:
     return ContactProfile(x, pbar)
 
 
+def contact_segments(profile: ContactProfile) -> tuple[np.ndarray, np.ndarray]:
+    """The contact intervals [a_j, b_j] of `profile` (sorted, disjoint): a ring between two loaded
+    samples (p > 0) is in contact, one between a loaded and a free sample up to its middle (the
+    edge lies somewhere between the last node on the plane and the first off it); a loaded end
+    sample ends its interval there."""
+    r, loaded = profile.r_m, profile.p_Pa > 0
+    half = 0.5 * (r[1:] + r[:-1])
+    lo = np.where(loaded[:-1], r[:-1], half)[loaded[:-1] | loaded[1:]]
+    hi = np.where(loaded[1:], r[1:], half)[loaded[:-1] | loaded[1:]]
+    if lo.size == 0:
+        return lo, hi
+    start = np.concatenate([[True], lo[1:] > hi[:-1]])       # a new interval where a ring is free
+    end = np.concatenate([start[1:], [True]])
+    return lo[start], hi[end]
+
+
+def patch_contact(profile: ContactProfile, length_m: float, r_m: np.ndarray) -> np.ndarray:
+    """Which rings [r_i, r_i+1] of the grid `r_m` lie in the nominal contact of `profile` on patches
+    of width L = `length_m`: the contact intervals (`contact_segments`) widened by L/2 on each side,
+    i.e. the patches that hold contact (a lone loaded node's is L wide). Tested at the rings'
+    middles; `patch_average`'s grid has the widened intervals' ends among its radii."""
+    a, b = contact_segments(profile)
+    r = np.asarray(r_m, dtype=float)
+    mid = 0.5 * (r[1:] + r[:-1])
+    if a.size == 0:
+        return np.zeros(mid.size, dtype=bool)
+    a, b = a - 0.5 * float(length_m), b + 0.5 * float(length_m)
+    j = np.searchsorted(a, mid, side="right") - 1          # the last interval starting at or below
+    return (j >= 0) & (mid <= b[np.clip(j, 0, None)])
+
+
 def _cumulative(r: np.ndarray, f: np.ndarray, G: np.ndarray, x: np.ndarray) -> np.ndarray:
     """G(x) = int_{r_0}^x f ds with f linear between the samples, 0 below r_0, G[-1] above r_n."""
     i = np.clip(np.searchsorted(r, x, side="right") - 1, 0, r.size - 2)
@@ -110,19 +143,27 @@ def _cumulative(r: np.ndarray, f: np.ndarray, G: np.ndarray, x: np.ndarray) -> n
 
 
 def ring_gaps(profile: ContactProfile, u_c: Callable[[float], float], E_Pa: float,
-              scale: float = 1.0, extra_Pa: float = 0.0) -> np.ndarray:
+              scale: float = 1.0, extra_Pa: float | np.ndarray = 0.0) -> np.ndarray:
     """Gap u_i [m] of each ring: u_c of the contact pressure at its middle, scale p + extra_Pa
-    (kappa F0's share and eq (6)'s beta (p_a - p_b)); inf where neither touches (no contact)."""
+    (kappa F0's share and eq (6)'s beta (p_a - p_b)); inf where neither touches (no contact).
+    `extra_Pa` may be one value per ring (then a ring with extra_Pa > 0 is in contact too)."""
     p = profile.p_Pa
     mid = 0.5 * (p[1:] + p[:-1])
     touching = (p[1:] > 0) | (p[:-1] > 0)
+    if np.ndim(extra_Pa):
+        extra = np.asarray(extra_Pa, dtype=float)
+        if extra.shape != mid.shape:
+            raise ValueError(f"extra_Pa: one value per ring ({mid.size}) or one for all, got {extra.shape}")
+        touching = touching | (extra > 0)
+    else:
+        extra = np.full(mid.size, float(extra_Pa))
     values = getattr(u_c, "values", None)
     if values is not None:                  # a UcTable: vectorised
         gaps = np.full(mid.size, math.inf)
-        gaps[touching] = values((scale * mid[touching] + extra_Pa) / E_Pa)
+        gaps[touching] = values((scale * mid[touching] + extra[touching]) / E_Pa)
         return gaps
     uc = getattr(u_c, "scalar", u_c)
-    return np.array([uc((scale * m + extra_Pa) / E_Pa) if t else math.inf for m, t in zip(mid, touching)])
+    return np.array([uc((scale * m + x) / E_Pa) if t else math.inf for m, x, t in zip(mid, extra, touching)])
 
 
 def _geometry(r: np.ndarray, radial: str) -> np.ndarray:

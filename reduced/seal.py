@@ -17,8 +17,12 @@ stiffness factor kappa, modulus E for p/E); Ndot is molecules/s for air and m^3/
   wavelength for a table made from a spectrum) the pressure that enters u_c is the nominal one of
   rough-contact theory, the profile averaged over patches of width L (`profile_leak.patch_average`,
   the module docstring there says why), and the averaged profile carries the curve's force: at
-  sample k it is kappa F0_k A[p_k] / F(A[p_k]) + beta (p_a - p_b) A[1_k] (A: the patch average,
-  F: its force 2 pi int p r dr, 1_k: 1 on the profile's loaded points, 0 elsewhere). The FEM's lumped
+  sample k it is kappa F0_k A[p_k] / F(A[p_k]) (A: the patch average, F: its force 2 pi int p r dr),
+  raised by beta (p_a - p_b) on the nominal contact, the points within L/2 of a loaded sample
+  (`profile_leak.patch_contact`: the patches that hold contact; a lone loaded node's is L wide).
+  The suction's share is a pressure on the contact, as in eq 6, not a load to spread: averaged, a
+  lone node's share would be its tributary length over L and vanish under refinement, and added on
+  the average's support it would act on L plus the node's two element lengths. The FEM's lumped
   nodal pressures do not integrate to the contact force where the load is concentrated (a lone
   loaded corner node: +17 to +27 % on cup A, the vertex and midpoint nodes of a quadratic facet and
   the off-plane neighbours' radii weigh it wrongly), while F0 is that force by equilibrium; so the
@@ -34,7 +38,8 @@ import math
 import numpy as np
 
 from reduced.gas import Gas, ballistic_share, interpolated_leak_rate, liquid_volume_rate
-from reduced.profile_leak import ContactProfile, patch_average, profile_leak_rate, profile_liquid_rate, ring_gaps
+from reduced.profile_leak import (ContactProfile, patch_average, patch_contact, profile_leak_rate,
+                                  profile_liquid_rate, ring_gaps)
 from reduced.stiffness_curve import StiffnessCurve
 
 __all__ = ["StripSeal", "ProfileSeal", "SEALS"]
@@ -77,7 +82,7 @@ class ProfileSeal:
         if L is not None and not (math.isfinite(L) and L >= 0.0):
             raise ValueError(f"patch_length_m: must be finite and >= 0 (0: no averaging), got {L}")
         self.patch_length_m = L if L else None
-        self._averaged: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._averaged: dict[int, tuple[ContactProfile, np.ndarray]] = {}
 
     def flow(self, F: float, r: float, l: float, pb: float, kappa: float, E: float, u: float):
         k = int(np.clip(np.searchsorted(self.u, u, side="right") - 1, 0, self.u.size - 2))
@@ -105,23 +110,22 @@ class ProfileSeal:
             gaps = ring_gaps(prof, self.uc, E, scale=kappa, extra_Pa=extra)
             peak = kappa * float(prof.p_Pa.max()) + extra
         else:
-            r, load, share = self.averaged(k)
-            prof = ContactProfile(r, kappa * load + extra * share)
-            gaps = ring_gaps(prof, self.uc, E)
-            peak = float(prof.p_Pa.max())
+            prof, contact = self.averaged(k)
+            gaps = ring_gaps(prof, self.uc, E, scale=kappa, extra_Pa=np.where(contact, extra, 0.0))
+            peak = kappa * float(prof.p_Pa.max()) + extra
         if self.mu is not None:
             q = profile_liquid_rate(self.mu, self.pa, pb, prof.r_m, gaps)
         else:      # p_b < 0 only at trial states off the branch (the fold search): no gas inside
             q = profile_leak_rate(self.gas, self.pa, min(max(pb, 0.0), self.pa), prof.r_m, gaps)
         return q, peak, float(np.min(gaps))
 
-    def averaged(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(radii, A[p_k] carrying F0_k, A[1_k]) of sample k on the patch grid (module docstring)."""
+    def averaged(self, k: int) -> tuple[ContactProfile, np.ndarray]:
+        """Sample k's profile averaged over the patches and carrying F0_k, and which of its rings are
+        in the nominal contact (module docstring)."""
         if k not in self._averaged:
             prof, L = self.profiles[k], self.patch_length_m
-            load = patch_average(prof, L)
-            share = patch_average(ContactProfile(prof.r_m, (prof.p_Pa > 0).astype(float)), L)
-            F, F0 = load.force_N, float(self.F0[k])
+            avg = patch_average(prof, L)
+            F, F0 = avg.force_N, float(self.F0[k])
             scale = F0 / F if F > 0 and math.isfinite(F0) and F0 > 0 else 1.0
-            self._averaged[k] = (load.r_m, scale * load.p_Pa, share.p_Pa)
+            self._averaged[k] = (ContactProfile(avg.r_m, scale * avg.p_Pa), patch_contact(prof, L, avg.r_m))
         return self._averaged[k]
