@@ -9,9 +9,9 @@ corner at the first contact sample (its lumped pressure and its neighbours' dist
 load that grows under refinement), then the profile route's lifetimes at F1 = 5, 10, 20, 40, 80 N
 
 - before: the lumped nodal profile as it is (the table without a patch length);
-- after: the profile averaged over patches of the roughness's roll-off wavelength (the default:
-  `UcTable.patch_length_m` from `reduced.roughness.uc_table`, 120 um here), carrying F0, eq (6)'s
-  share on the nominal contact (`reduced.profile_leak`, `reduced.seal`);
+- after: the profile averaged over patches that hold every wavelength u_c depends on (the
+  default: `UcTable.patch_length_m` from `reduced.roughness.uc_table`, 202 um here), carrying F0,
+  eq (6)'s share on the nominal contact (`reduced.profile_leak`, `reduced.seal`);
 - with --scales: the same with the patch length times each factor (the length's weight);
 
 and last the level-to-level differences (coarse vs medium, medium vs fine) of each.
@@ -48,7 +48,7 @@ def main() -> None:
     variants = {"before": dataclasses.replace(uc, patch_length_m=None), "after": uc}
     for s in args.scales:
         variants[f"L x {s:g}"] = dataclasses.replace(uc, patch_length_m=s * L)
-    print(f"cup A, pmma-1.89, frictionless; patch length L = {1e6 * L:.1f} um (roll-off wavelength); "
+    print(f"cup A, pmma-1.89, frictionless; patch length L = {1e6 * L:.1f} um (reduced.roughness.persson.patch_length); "
           f"F1 = {', '.join(f'{F:g}' for F in FORCES_N)} N")
     table: dict[str, dict[str, list[float]]] = {name: {} for name in variants}
     for level in args.levels:

@@ -11,8 +11,8 @@ row and the first sealed row u_c falls linearly in p/E to 0 (no log of zero is t
 the first sealed row it stays 0.
 
 A table may carry `patch_length_m`, the radial width of the patch over which the nominal pressure
-p of rough-contact theory is defined (the roughness's roll-off wavelength for a table made from a
-spectrum, `reduced.roughness.uc_table`; None: not known). The profile route averages the contact
+p of rough-contact theory is defined (for a table made from a spectrum the smallest patch that
+holds every wavelength u_c depends on, `reduced.roughness.persson.patch_length`; None: not known). The profile route averages the contact
 pressure over it (`reduced.profile_leak.patch_average`, `reduced.seal`). In a CSV it is the comment
 line ``# patch_length_m = <metres>``.
 

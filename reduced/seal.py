@@ -13,8 +13,8 @@ stiffness factor kappa, modulus E for p/E); Ndot is molecules/s for air and m^3/
   pressure), linearly where one side is sealed. `p` reports the peak contact pressure and `u_c`
   the narrowest ring's gap, the critical constriction.
 
-  When the u_c table carries a patch length L (`UcTable.patch_length_m`: the roughness's roll-off
-  wavelength for a table made from a spectrum) the pressure that enters u_c is the nominal one of
+  When the u_c table carries a patch length L (`UcTable.patch_length_m`: for a table made from a
+  spectrum the smallest patch on which u_c is the whole spectrum's) the pressure that enters u_c is the nominal one of
   rough-contact theory, the profile averaged over patches of width L (`profile_leak.patch_average`,
   the module docstring there says why), and the averaged profile carries the curve's force: at
   sample k it is kappa F0_k A[p_k] / F(A[p_k]) (A: the patch average, F: its force 2 pi int p r dr),

@@ -244,14 +244,28 @@ def test_a_uc_table_carries_its_patch_length_through_a_csv(tmp_path):
         np.testing.assert_allclose(t.values(x), [t.scalar(v) for v in x], rtol=1e-13)
 
 
-def test_a_spectrum_table_carries_the_roll_off_wavelength():
-    from reduced.roughness import preset, uc_table
-    from reduced.roughness.spectrum import self_affine
+def test_a_spectrum_table_carries_the_patch_on_which_its_u_c_is_the_whole_spectrums():
+    from reduced.roughness import critical_gap_table, preset, uc_table
+    from reduced.roughness.persson import patch_length
+    from reduced.roughness.spectrum import PowerSpectrum, self_affine
 
     spec = self_affine(H=0.8, q0_per_m=250.0, q1_per_m=1e7, qr_per_m=5e4, h_rms_m=1e-6)
     assert spec.rolloff_wavelength_m() == pytest.approx(2 * np.pi / 5e4, rel=3e-3)   # the grid's step
+    L = patch_length(spec, 0.5)
+    q, C = spec.q_per_m, spec.C_m4
+
+    def u_c(q_cut):
+        keep = q >= q_cut
+        return critical_gap_table(PowerSpectrum(q[keep], C[keep]), 1e6, 0.5, [0.025]).u_c_m[0]
+
+    full = u_c(0.0)
+    assert u_c(2 * np.pi / L) / full >= 0.98                 # the patch keeps u_c to 2 %
+    assert u_c(1.02 * 2 * np.pi / L) / full < 0.98           # a smaller one does not
+    assert 1.0 < L * 5e4 / (2 * np.pi) < 3.0                  # beyond the roll-off, within a few
     params = preset("pmma-1.89").params
-    assert preset("pmma-1.89").spectrum().rolloff_wavelength_m() == pytest.approx(2 * np.pi / params["qr_per_m"],
-                                                                                   rel=3e-3)
+    pmma = patch_length(preset("pmma-1.89").spectrum(), 0.5)
+    assert pmma == pytest.approx(202e-6, rel=0.02)            # the stored preset (docstrings)
+    assert 1.5 < pmma * params["qr_per_m"] / (2 * np.pi) < 2.0
+    assert patch_length(preset("pmma-1.89").spectrum(), 0.5, p_over_E=0.01) > pmma      # lower p: longer
     table = uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5))
-    assert table.patch_length_m == spec.rolloff_wavelength_m()
+    assert table.patch_length_m == L
