@@ -9,9 +9,9 @@ corner at the first contact sample (its lumped pressure and its neighbours' dist
 load that grows under refinement), then the profile route's lifetimes at F1 = 5, 10, 20, 40, 80 N
 
 - before: the lumped nodal profile as it is (the table without a patch length);
-- after: the profile averaged over patches that hold every wavelength u_c depends on (the
-  default: `UcTable.patch_length_m` from `reduced.roughness.uc_table`, 202 um here), carrying F0,
-  eq (6)'s share on the nominal contact (`reduced.profile_leak`, `reduced.seal`);
+- after: the profile averaged over patches that hold every wavelength u_c depends on
+  (`UcTable.patch_length_m` from `reduced.roughness.uc_table(..., with_patch_length=True)`, 202 um
+  here), carrying F0, eq (6)'s share on the nominal contact (`reduced.profile_leak`, `reduced.seal`);
 - with --scales: the same with the patch length times each factor (the length's weight);
 
 and last the level-to-level differences (coarse vs medium, medium vs fine) of each.
@@ -31,6 +31,8 @@ from fem.material import NeoHookean
 from fem.mesh import cup_mesh
 from reduced.cup import CUP_A
 from reduced.lifetime import lifetime, reference_model
+from reduced.roughness import preset
+from reduced.roughness.persson import patch_length
 from validation import handoff
 from validation.crosscheck.context import pmma_uc_table
 
@@ -44,7 +46,8 @@ def main() -> None:
                     help="also run with the patch length times these factors")
     args = ap.parse_args()
     uc, g = pmma_uc_table("pmma-1.89"), cup_geometry("A")
-    L = uc.patch_length_m
+    L = patch_length(preset("pmma-1.89").spectrum(), 0.5)
+    uc = dataclasses.replace(uc, patch_length_m=L)
     variants = {"before": dataclasses.replace(uc, patch_length_m=None), "after": uc}
     for s in args.scales:
         variants[f"L x {s:g}"] = dataclasses.replace(uc, patch_length_m=s * L)

@@ -11,10 +11,11 @@ row and the first sealed row u_c falls linearly in p/E to 0 (no log of zero is t
 the first sealed row it stays 0.
 
 A table may carry `patch_length_m`, the radial width of the patch over which the nominal pressure
-p of rough-contact theory is defined (for a table made from a spectrum the smallest patch that
-holds every wavelength u_c depends on, `reduced.roughness.persson.patch_length`; None: not known). The profile route averages the contact
-pressure over it (`reduced.profile_leak.patch_average`, `reduced.seal`). In a CSV it is the comment
-line ``# patch_length_m = <metres>``.
+p of rough-contact theory is defined (from a spectrum: the smallest patch that holds every
+wavelength u_c depends on, `reduced.roughness.persson.patch_length`, attached by
+`uc_table(..., with_patch_length=True)`; None: not known). The profile route then averages the
+contact pressure over it (`reduced.profile_leak.patch_average`, `reduced.seal`). In a CSV it is the
+comment line ``# patch_length_m = <metres>``.
 
 `illustrative_uc_table()` is a stand-in until Persson-theory tables exist: a power law through the
 paper's 0.68 um at p/E = 0.025 (the 1.89 um rms sandblasted PMMA at 1 atm, E = 4 MPa). It is an

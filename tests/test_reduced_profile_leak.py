@@ -267,5 +267,6 @@ def test_a_spectrum_table_carries_the_patch_on_which_its_u_c_is_the_whole_spectr
     assert pmma == pytest.approx(202e-6, rel=0.02)            # the stored preset (docstrings)
     assert 1.5 < pmma * params["qr_per_m"] / (2 * np.pi) < 2.0
     assert patch_length(preset("pmma-1.89").spectrum(), 0.5, p_over_E=0.01) > pmma      # lower p: longer
-    table = uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5))
+    assert uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5)).patch_length_m is None     # opt-in
+    table = uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5), with_patch_length=True)
     assert table.patch_length_m == L

@@ -362,16 +362,19 @@ UC_TABLE_P_OVER_E = np.geomspace(1e-6, 1.0, 241)
 
 
 def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: float = 0.45,
-             a_c: float = 0.42, p_over_E: np.ndarray | None = None):
+             a_c: float = 0.42, p_over_E: np.ndarray | None = None, with_patch_length: bool = False):
     """u_c(p/E) of `spectrum` as the reduced model's `UcTable` (log-log interpolated).
 
     Without adhesion the theory is linear elastic: u_c depends on p and E only through p/E*, so
     one table serves every modulus at this Poisson ratio, the relaxed E_eff(phi) included.
 
-    The table carries `patch_length` (at its defaults, with this method, gamma and a_c) as
-    `patch_length_m`: the theory's nominal pressure is an average over a patch that holds every
-    wavelength u_c depends on, so the profile route averages the FEM's contact pressure over it
-    (`reduced.profile_leak`).
+    With `with_patch_length` the table carries `patch_length` (at its defaults, with this method,
+    gamma and a_c) as `patch_length_m`: the theory's nominal pressure is an average over a patch that
+    holds every wavelength u_c depends on, and the profile route then averages the FEM's contact
+    pressure over it (`reduced.profile_leak`, `reduced.seal`; it makes that route converge under mesh
+    refinement). Off by default for now: with relaxation the profile route ends where the FEM's
+    strip width l falls to 0 (the rim corner alone), where eq (10)'s term r' phi / l is singular,
+    and the averaged leak can reach that line where the integrator fails instead of stopping.
     """
     from reduced.critical_gap import UcTable
 
@@ -379,5 +382,5 @@ def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: 
     table = critical_gap_table(spectrum, 1e6, nu, grid, method=method, gamma=gamma, a_c=a_c)
     note = (f"Persson theory ({method}, gamma {gamma:g}, a_c {a_c:g}, nu {nu:g}) of "
             f"{spectrum.provenance}")
-    length = patch_length(spectrum, nu, method=method, gamma=gamma, a_c=a_c)
+    length = patch_length(spectrum, nu, method=method, gamma=gamma, a_c=a_c) if with_patch_length else None
     return UcTable(table.p_over_E, table.u_c_m, provenance=note, patch_length_m=length)
