@@ -10,6 +10,13 @@ only form a trailing block (once sealed, a higher pressure stays sealed). Betwee
 row and the first sealed row u_c falls linearly in p/E to 0 (no log of zero is taken); beyond
 the first sealed row it stays 0.
 
+A table may carry `patch_length_m`, the radial width of the patch over which the nominal pressure
+p of rough-contact theory is defined (from a spectrum: the smallest patch that holds every
+wavelength u_c depends on, `reduced.roughness.persson.patch_length`, attached by
+`uc_table(..., with_patch_length=True)`; None: not known). The profile route then averages the
+contact pressure over it (`reduced.profile_leak.patch_average`, `reduced.seal`). In a CSV it is the
+comment line ``# patch_length_m = <metres>``.
+
 `illustrative_uc_table()` is a stand-in until Persson-theory tables exist: a power law through the
 paper's 0.68 um at p/E = 0.025 (the 1.89 um rms sandblasted PMMA at 1 atm, E = 4 MPa). It is an
 input for examples, not a result and never a test oracle. `python -m reduced.critical_gap`
@@ -20,10 +27,12 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
 from reduced.loglog import LogLogPchip, elementwise, read_two_columns
 
@@ -31,6 +40,7 @@ __all__ = ["UcTable", "illustrative_uc_table", "ILLUSTRATIVE_UC_CSV"]
 
 ILLUSTRATIVE_UC_CSV = Path(__file__).parent / "data" / "uc_illustrative.csv"
 _HEADER = "p_over_E,u_c_m"
+_PATCH = re.compile(r"\s*patch_length_m\s*=\s*(\S+)\s*")
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,8 +50,10 @@ class UcTable:
     p_over_E: np.ndarray
     u_c_m: np.ndarray
     provenance: str = ""
+    patch_length_m: float | None = None
     _open: LogLogPchip = field(init=False, repr=False, compare=False)
     _seal: float = field(init=False, repr=False, compare=False)
+    _vec: tuple = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         p = np.array(self.p_over_E, dtype=float).reshape(-1)
@@ -59,12 +71,22 @@ class UcTable:
             raise ValueError("u_c_m: a sealed (0) row may only be followed by sealed rows")
         if open_rows < 2:
             raise ValueError("u_c_m: need at least 2 open (u_c > 0) rows to interpolate in log-log")
+        if self.patch_length_m is not None:
+            L = float(self.patch_length_m)
+            if not (math.isfinite(L) and L > 0):
+                raise ValueError(f"patch_length_m: must be finite and > 0 (or None), got {self.patch_length_m}")
+            object.__setattr__(self, "patch_length_m", L)
         p.flags.writeable = False
         u.flags.writeable = False
         object.__setattr__(self, "p_over_E", p)
         object.__setattr__(self, "u_c_m", u)
         object.__setattr__(self, "_open", LogLogPchip(p[:open_rows], u[:open_rows]))
         object.__setattr__(self, "_seal", float(p[open_rows]) if open_rows < p.size else math.inf)
+        # the same interpolant for arrays (`values`): ln u_c PCHIP in ln p/E, power laws beyond
+        lx, ly = np.log(p[:open_rows]), np.log(u[:open_rows])
+        cubic = PchipInterpolator(lx, ly, extrapolate=False)
+        slopes = cubic([lx[0], lx[-1]], 1)
+        object.__setattr__(self, "_vec", (cubic, lx[0], ly[0], float(slopes[0]), lx[-1], ly[-1], float(slopes[1])))
 
     @property
     def sealing_p_over_E(self) -> float:
@@ -88,11 +110,36 @@ class UcTable:
             return float(self.u_c_m[n - 1]) * (seal - x) / (seal - p_last)
         return self._open.value_and_slope(x)[0]
 
+    def values(self, p_over_E: np.ndarray) -> np.ndarray:
+        """u_c [m] at an array of p/E, vectorised (`scalar` element by element, to round-off)."""
+        x = np.asarray(p_over_E, dtype=float)
+        if x.size and not np.all(x > 0):
+            raise ValueError(f"p_over_E: contact pressure over modulus must be > 0, got {x[~(x > 0)][0]}")
+        cubic, t_lo, y_lo, s_lo, t_hi, y_hi, s_hi = self._vec
+        t = np.log(x)
+        inside = np.clip(t, t_lo, t_hi)
+        ln_u = np.where(t < t_lo, y_lo + s_lo * (t - t_lo), np.where(t > t_hi, y_hi + s_hi * (t - t_hi), cubic(inside)))
+        out = np.exp(ln_u)
+        if self._seal < math.inf:
+            n = self._open.n
+            p_last, u_last = float(self.p_over_E[n - 1]), float(self.u_c_m[n - 1])
+            ramp = u_last * (self._seal - x) / (self._seal - p_last)
+            out = np.where(x > p_last, np.where(x >= self._seal, 0.0, ramp), out)
+        return out
+
     # --------------------------------------------------------------------- IO
     @classmethod
     def from_csv(cls, path: str | os.PathLike) -> UcTable:
         p, u, comments = read_two_columns(path, _HEADER, "uc-table")
-        return cls(p, u, provenance=comments or f"csv:{Path(path).name}")
+        patch = _PATCH.search(comments)
+        length = None
+        if patch is not None:
+            try:
+                length = float(patch.group(1))
+            except ValueError:
+                raise ValueError(f"uc-table: '{path}': patch_length_m = {patch.group(1)!r} is not a number") from None
+            comments = (comments[:patch.start()] + " " + comments[patch.end():]).strip()
+        return cls(p, u, provenance=comments or f"csv:{Path(path).name}", patch_length_m=length)
 
     def to_csv(self, path: str | os.PathLike) -> Path:
         """Write the table atomically, provenance as '#' comment lines."""
@@ -100,6 +147,8 @@ class UcTable:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(f".{path.name}.tmp")
         with open(tmp, "w") as f:
+            if self.patch_length_m is not None:
+                f.write(f"# patch_length_m = {self.patch_length_m:.10g}\n")
             for line in self.provenance.splitlines():
                 f.write(f"# {line}\n")
             f.write(_HEADER + "\n")

@@ -23,6 +23,33 @@ and Q is the root of P_0(Q) = p_b (monotone; Newton with bracketing). A ring wit
 contact area percolates: sealed) stops the flow; a ring with no contact (p = 0) costs nothing.
 
 Water (eq 24 locally): j_V = -(u^3 / (12 eta)) dP/dr, so p_a - p_b = Q_V sum_i 12 eta g_i / (2 pi u_i^3).
+
+Patch-averaged pressure (`patch_average`, `patch_contact`; the profile route uses it when the u_c
+table carries a length, `reduced.seal`, e.g. `reduced.roughness.uc_table(..., with_patch_length=True)`). u_c(p) of rough-contact theory (Persson's theory, the
+critical-junction and effective-medium pictures of Sec. 4, 5.1) is a function of the *nominal*
+pressure, uniform on a patch that holds every roughness wavelength u_c depends on: the theory's
+contact, separation and percolation at the critical magnification are built up from the longest
+wavelengths down. Wavelengths longer than the patch only tilt and lift it and do not change u_c,
+so the smallest such patch L can be measured from the theory itself
+(`reduced.roughness.persson.patch_length`: cut the spectrum's long wavelengths until u_c at 1 atm on
+4 MPa changes by 2 %): 202 um on pmma-1.89 (99-220 um on the PMMA presets, 1.7 times the roll-off
+wavelength 2 pi / q_r below which their spectra are flat), 140 um on the table preset (its ~0.1 mm
+quasi-periodic structure; its assumed roll-off at 6.3 mm matters only at lower pressures). On
+shorter scales a pressure is not a nominal one, and u_c of it is outside the theory. The FEM's
+pointwise profile has exactly such a feature: at small plate displacement only the sharp rim corner
+touches, one loaded node whose lumped pressure (its force over its tributary length) doubles with
+each mesh refinement (a corner singularity), so u_c(p_max) falls and the leak seals as the mesh is
+refined (cup A on pmma-1.89: 42, 92, 193 kPa at u = 0.39 mm on the coarse, medium, fine meshes; the
+lifetimes at 5 N 154, 184, 608 s). Averaged over patches of width L, the pressure entering u_c is
+the force on the annulus [r - L/2, r + L/2] over its area: exact for a uniform pressure, force
+conserving, and a lone loaded node becomes a strip L wide at F / (2 pi r L), independent of the
+element size once the elements are shorter than L (on cup A's rim: coarse 20-140 um, medium
+8-66 um, fine 4-32 um). The length is `UcTable.patch_length_m`, set by `reduced.roughness.uc_table`
+with `with_patch_length=True` (cup A, pmma-1.89, lifetimes at 5-80 N: medium vs fine within 1.8 %,
+coarse vs medium 8.7 %; unaveraged 70 % and 16.5 %; `benchmarks/bench_profile_convergence.py`).
+Eq (6)'s suction share beta (p_a - p_b) is a pressure on the contact, not a load to spread: it is
+added on the nominal contact, the FEM's contact intervals (edges half-way between the last loaded
+node and the first free one) widened by L/2 each side (the patches that hold contact).
 """
 
 from __future__ import annotations
@@ -35,7 +62,7 @@ import numpy as np
 
 from reduced.gas import XI, Gas
 
-__all__ = ["ContactProfile", "ring_gaps", "profile_leak_rate", "profile_liquid_rate"]
+__all__ = ["ContactProfile", "contact_segments", "patch_average", "patch_contact", "ring_gaps", "profile_leak_rate", "profile_liquid_rate"]
 
 
 @dataclass(frozen=True)
@@ -69,15 +96,101 @@ class ContactProfile:
         return float(np.pi * np.sum((f[1:] + f[:-1]) * np.diff(self.r_m)))
 
 
+def patch_average(profile: ContactProfile, length_m: float) -> ContactProfile:
+    """The nominal pressure of `profile` on patches of radial width `length_m` (module docstring,
+    "Patch-averaged pressure"): at radius x, the force on the annulus [x - L/2, x + L/2] over its area,
+
+        pbar(x) = (G(x + L/2) - G(x - L/2)) / ((x + L/2)^2 / 2 - (x - L/2)^2 / 2),   G(r) = int_0^r p s ds
+
+    with p r linear between the samples (the trapezoid rule of `ContactProfile.force_N`; G is then
+    piecewise quadratic and exact). A uniform pressure is returned unchanged wherever the window lies
+    inside it, and int pbar r dr = int p r dr. The result is sampled at its kinks r_i +- L/2 (pbar is
+    a rational quadratic between them) and at the ends of the nominal contact (`patch_contact`),
+    intervals longer than L/2 split evenly; its
+    support is the input's widened by L/2 on each side (a window starting below r = 0 is cut there).
+    """
+    L = float(length_m)
+    if not (math.isfinite(L) and L > 0.0):
+        raise ValueError(f"length_m: the patch length must be finite and > 0, got {length_m}")
+    r, p = profile.r_m, profile.p_Pa
+    f = p * r
+    G = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(r))])
+    a, b = contact_segments(profile)
+    kinks = np.unique(np.concatenate([r - 0.5 * L, r + 0.5 * L, a - 0.5 * L, b + 0.5 * L]))
+    kinks = kinks[kinks > 0.0]
+    n = np.maximum(1, np.ceil(np.diff(kinks) / (0.5 * L) - 1e-9).astype(int))
+    start = np.repeat(kinks[:-1], n)
+    step = np.repeat(np.diff(kinks) / n, n)
+    j = np.arange(start.size) - np.repeat(np.cumsum(n) - n, n)
+    x = np.append(start + j * step, kinks[-1])
+    a, b = np.maximum(x - 0.5 * L, 0.0), x + 0.5 * L
+    pbar = (_cumulative(r, f, G, b) - _cumulative(r, f, G, a)) / (0.5 * (b * b - a * a))
+    pbar[pbar <= 1e-12 * max(float(p.max()), 0.0)] = 0.0     # round-off off the support
+    return ContactProfile(x, pbar)
+
+
+def contact_segments(profile: ContactProfile) -> tuple[np.ndarray, np.ndarray]:
+    """The contact intervals [a_j, b_j] of `profile` (sorted, disjoint): a ring between two loaded
+    samples (p > 0) is in contact, one between a loaded and a free sample up to its middle (the
+    edge lies somewhere between the last node on the plane and the first off it); a loaded end
+    sample ends its interval there."""
+    r, loaded = profile.r_m, profile.p_Pa > 0
+    half = 0.5 * (r[1:] + r[:-1])
+    lo = np.where(loaded[:-1], r[:-1], half)[loaded[:-1] | loaded[1:]]
+    hi = np.where(loaded[1:], r[1:], half)[loaded[:-1] | loaded[1:]]
+    if lo.size == 0:
+        return lo, hi
+    start = np.concatenate([[True], lo[1:] > hi[:-1]])       # a new interval where a ring is free
+    end = np.concatenate([start[1:], [True]])
+    return lo[start], hi[end]
+
+
+def patch_contact(profile: ContactProfile, length_m: float, r_m: np.ndarray) -> np.ndarray:
+    """Which rings [r_i, r_i+1] of the grid `r_m` lie in the nominal contact of `profile` on patches
+    of width L = `length_m`: the contact intervals (`contact_segments`) widened by L/2 on each side,
+    i.e. the patches that hold contact (a lone loaded node's is L wide). Tested at the rings'
+    middles; `patch_average`'s grid has the widened intervals' ends among its radii."""
+    a, b = contact_segments(profile)
+    r = np.asarray(r_m, dtype=float)
+    mid = 0.5 * (r[1:] + r[:-1])
+    if a.size == 0:
+        return np.zeros(mid.size, dtype=bool)
+    a, b = a - 0.5 * float(length_m), b + 0.5 * float(length_m)
+    j = np.searchsorted(a, mid, side="right") - 1          # the last interval starting at or below
+    return (j >= 0) & (mid <= b[np.clip(j, 0, None)])
+
+
+def _cumulative(r: np.ndarray, f: np.ndarray, G: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """G(x) = int_{r_0}^x f ds with f linear between the samples, 0 below r_0, G[-1] above r_n."""
+    i = np.clip(np.searchsorted(r, x, side="right") - 1, 0, r.size - 2)
+    h = r[i + 1] - r[i]
+    t = np.clip(x - r[i], 0.0, h)
+    inside = G[i] + f[i] * t + (f[i + 1] - f[i]) * t * t / (2.0 * h)
+    return np.where(x <= r[0], 0.0, np.where(x >= r[-1], G[-1], inside))
+
+
 def ring_gaps(profile: ContactProfile, u_c: Callable[[float], float], E_Pa: float,
-              scale: float = 1.0, extra_Pa: float = 0.0) -> np.ndarray:
+              scale: float = 1.0, extra_Pa: float | np.ndarray = 0.0) -> np.ndarray:
     """Gap u_i [m] of each ring: u_c of the contact pressure at its middle, scale p + extra_Pa
-    (kappa F0's share and eq (6)'s beta (p_a - p_b)); inf where neither touches (no contact)."""
+    (kappa F0's share and eq (6)'s beta (p_a - p_b)); inf where neither touches (no contact).
+    `extra_Pa` may be one value per ring (then a ring with extra_Pa > 0 is in contact too)."""
     p = profile.p_Pa
     mid = 0.5 * (p[1:] + p[:-1])
     touching = (p[1:] > 0) | (p[:-1] > 0)
+    if np.ndim(extra_Pa):
+        extra = np.asarray(extra_Pa, dtype=float)
+        if extra.shape != mid.shape:
+            raise ValueError(f"extra_Pa: one value per ring ({mid.size}) or one for all, got {extra.shape}")
+        touching = touching | (extra > 0)
+    else:
+        extra = np.full(mid.size, float(extra_Pa))
+    values = getattr(u_c, "values", None)
+    if values is not None:                  # a UcTable: vectorised
+        gaps = np.full(mid.size, math.inf)
+        gaps[touching] = values((scale * mid[touching] + extra[touching]) / E_Pa)
+        return gaps
     uc = getattr(u_c, "scalar", u_c)
-    return np.array([uc((scale * m + extra_Pa) / E_Pa) if t else math.inf for m, t in zip(mid, touching)])
+    return np.array([uc((scale * m + x) / E_Pa) if t else math.inf for m, x, t in zip(mid, extra, touching)])
 
 
 def _geometry(r: np.ndarray, radial: str) -> np.ndarray:
@@ -109,10 +222,19 @@ def _series_flow(p_a: float, p_b: float, u3: np.ndarray, b: np.ndarray, c: np.nd
     """Q with P marched from p_a through the rings (Phi differences c_i Q) ending at p_b."""
     # upper bound: no ring passes more than it would with the whole drop across it alone
     q_hi = float(np.min(u3 * ((p_a + b) ** 2 - (p_b + b) ** 2) / (2.0 * c)))
-    lo, hi, q = 0.0, q_hi, 0.5 * q_hi
+    # start: each ring's conductance frozen at the mean pressure (exact for one ring, or all b equal)
+    q_lin = (p_a - p_b) / float(np.sum(c / (u3 * (0.5 * (p_a + p_b) + b))))
+    lo, hi = 0.0, q_hi
+    q = q_lin if 0.0 < q_lin < q_hi else 0.5 * q_hi
+    # the march's round-off: each ring's P = sqrt((P + b)^2 - ...) - b cancels to ~eps (P + b); at
+    # nanometre gaps b = a/u reaches 1e9 Pa and P_in is no better than that, so a residual at that
+    # level is converged (Newton would wander in the noise)
+    noise = 1e-13 * (p_a + float(np.max(b))) * math.sqrt(u3.size)
     for _ in range(100):
         p_in, dp_dq = _march(p_a, u3, b, c, q)
         f = p_in - p_b
+        if abs(f) <= noise:
+            return q
         if f > 0.0:
             lo = q
         else:

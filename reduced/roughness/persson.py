@@ -312,16 +312,69 @@ def critical_gap_table(spectrum: PowerSpectrum, E_Pa: float, nu: float, p_over_E
                     float(gamma), float(a_c), spectrum.provenance)
 
 
+#: reference pressure and tolerance of `patch_length`: 1 atm on E = 4 MPa (the presets' calibration
+#: point, Sec. 5.1), and u_c kept to 2 %
+PATCH_P_OVER_E, PATCH_TOL = 0.025, 0.02
+
+
+def patch_length(spectrum: PowerSpectrum, nu: float, *, p_over_E: float = PATCH_P_OVER_E,
+                 tol: float = PATCH_TOL, method: str = "emt", gamma: float = 0.45,
+                 a_c: float = 0.42) -> float:
+    """The smallest patch [m] on which u_c(p) is the whole spectrum's: 2 pi / q_cut for the largest
+    lower cutoff q_cut (a wavevector of the spectrum's grid) at which u_c at `p_over_E` of the
+    spectrum restricted to q >= q_cut is still >= (1 - tol) times the full one.
+
+    The nominal pressure of the theory must be uniform on patches that hold every wavelength u_c
+    depends on; longer ones do not change it (they only tilt and lift the patch), so a pressure
+    averaged over such a patch is a nominal pressure, and one varying on shorter scales is not. u_c
+    falls monotonically as long wavelengths are removed (bisection over the grid). The length grows
+    at lower pressure (fewer long wavelengths are flattened): pmma-1.89 202 um at p/E = 0.025 and
+    235 um at 0.01 (roll-off wavelength 120 um); the table preset 140 um and 2.4 mm. If u_c is 0
+    (sealed) at `p_over_E`, the wavelength with the most mean-square height per logarithmic band
+    (`PowerSpectrum.rolloff_wavelength_m`).
+    """
+    if not (0.0 < tol < 1.0 and p_over_E > 0.0):
+        raise ValueError(f"tol, p_over_E: need 0 < tol < 1 and p_over_E > 0, got {tol}, {p_over_E}")
+    q, C = spectrum.q_per_m, spectrum.C_m4
+
+    def gap(i: int) -> float:
+        part = spectrum if i == 0 else PowerSpectrum(q[i:], C[i:])
+        return float(critical_gap_table(part, 1e6, nu, [p_over_E], method=method, gamma=gamma,
+                                        a_c=a_c).u_c_m[0])
+
+    full = gap(0)
+    if full <= 0.0:
+        return spectrum.rolloff_wavelength_m()
+    lo, hi = 0, q.size - 10                 # u_c(lo) keeps the tolerance; keep >= 10 wavevectors
+    if gap(hi) >= (1.0 - tol) * full:
+        return float(2 * np.pi / q[hi])
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if gap(mid) >= (1.0 - tol) * full:
+            lo = mid
+        else:
+            hi = mid
+    return float(2 * np.pi / q[lo])
+
+
 #: p/E grid of the u_c tables handed to the reduced model: 40 points per decade over [1e-6, 1]
 UC_TABLE_P_OVER_E = np.geomspace(1e-6, 1.0, 241)
 
 
 def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: float = 0.45,
-             a_c: float = 0.42, p_over_E: np.ndarray | None = None):
+             a_c: float = 0.42, p_over_E: np.ndarray | None = None, with_patch_length: bool = False):
     """u_c(p/E) of `spectrum` as the reduced model's `UcTable` (log-log interpolated).
 
     Without adhesion the theory is linear elastic: u_c depends on p and E only through p/E*, so
     one table serves every modulus at this Poisson ratio, the relaxed E_eff(phi) included.
+
+    With `with_patch_length` the table carries `patch_length` (at its defaults, with this method,
+    gamma and a_c) as `patch_length_m`: the theory's nominal pressure is an average over a patch that
+    holds every wavelength u_c depends on, and the profile route then averages the FEM's contact
+    pressure over it (`reduced.profile_leak`, `reduced.seal`; it makes that route converge under mesh
+    refinement). Off by default for now: with relaxation the profile route ends where the FEM's
+    strip width l falls to 0 (the rim corner alone), where eq (10)'s term r' phi / l is singular,
+    and the averaged leak can reach that line where the integrator fails instead of stopping.
     """
     from reduced.critical_gap import UcTable
 
@@ -329,4 +382,5 @@ def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: 
     table = critical_gap_table(spectrum, 1e6, nu, grid, method=method, gamma=gamma, a_c=a_c)
     note = (f"Persson theory ({method}, gamma {gamma:g}, a_c {a_c:g}, nu {nu:g}) of "
             f"{spectrum.provenance}")
-    return UcTable(table.p_over_E, table.u_c_m, provenance=note)
+    length = patch_length(spectrum, nu, method=method, gamma=gamma, a_c=a_c) if with_patch_length else None
+    return UcTable(table.p_over_E, table.u_c_m, provenance=note, patch_length_m=length)

@@ -95,6 +95,13 @@ class PowerSpectrum:
                 self.q_per_m ** (n + 2) * self.C_m4, lnq)
         return self._moments[n]
 
+    def rolloff_wavelength_m(self) -> float:
+        """2 pi / q* [m], q* the wavevector where q^2 C(q) is largest: the wavelength that carries the
+        most mean-square height per logarithmic band (d<h^2> / d ln q = 2 pi q^2 C). For
+        `self_affine` with a roll-off it is 2 pi / q_r (C flat below q_r, q^2 C rising as q^2, and
+        falling as q^(-2H) above), the longest wavelength of the self-affine roughness."""
+        return float(2 * np.pi / self.q_per_m[int(np.argmax(self.q_per_m ** 2 * self.C_m4))])
+
     def h_rms_m(self) -> float:
         """rms height, ``sqrt(2 pi int q C dq)``."""
         return float(np.sqrt(self.moment(0)[-1]))
