@@ -22,7 +22,11 @@ The interpolation error is measured by grid refinement (benchmarks/bench_coupled
 the contact zone next to the seal is the table's (the plane's reaction with the interface gas at
 p_b) less the gas pressure rise across the zone, P - p_b = dp (r - r_k) / (r_cut - r_k), linear from
 the seal to the zone's outer edge (``interface="linear"``; "p_b" keeps the table's, "p_a" takes the
-whole dp off: the two bounds).
+whole dp off: the two bounds). When the u_c table carries a patch length (`UcTable.patch_length_m`,
+from the roughness spectrum) that solid pressure is averaged over patches of that width before
+u_c is read, as on the profile route (`reduced.profile_leak.patch_average`): the nominal pressure
+of rough-contact theory, which makes the leak independent of the mesh where the rim corner alone
+touches.
 
 The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a dp
 grid of `samples` points. A stiffness factor kappa makes the cup kappa times stiffer, as the
@@ -218,7 +222,12 @@ class CoupledCavity:
 
     def _solid_profile(self, i: int, j: int) -> ContactProfile | None:
         """The solid contact pressure at node (i, j) of the kappa-times-stiffer cup (`solid_profile`)."""
-        return solid_profile(self.table, i, j, self.kappa, self._dp[j], self.interface)
+        return solid_profile(self.table, i, j, self.kappa, self._dp[j], self.interface, self.patch_length_m)
+
+    @property
+    def patch_length_m(self) -> float | None:
+        """The u_c table's patch length [m]: the profiles' pressures are averaged over it (None: raw)."""
+        return getattr(self.u_c, "patch_length_m", None) or None
 
     # -------------------------------------------------------------- the branch at fixed F1
     def u_at(self, F1: float, dp: float) -> float:

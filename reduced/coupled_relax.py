@@ -114,7 +114,7 @@ class _NodeRates:
         at s_j (kappa-free), the leak at the p_b of the Chebyshev points x."""
         none = np.zeros(_CHEBYSHEV)
         pa, s = self.pa, self.s[j]
-        prof = solid_profile(cc.table, i, j, 1.0, s, cc.interface)
+        prof = solid_profile(cc.table, i, j, 1.0, s, cc.interface, cc.patch_length_m)
         if prof is None:
             raise ValueError(f"suction table: no contact profile at u = {1e3 * self.u[i]:.4g} mm, "
                              f"dp = {s / 1e3:.4g} kPa (the cavity is open)")

@@ -108,6 +108,7 @@ class ForceBalance:
     def state(self, h: float, N: float, kappa: float, E: float, F1: float):
         """(Ndot, p_b, p, u_c, ballistic share, r, rp, l, V, Vp, F, Fh) at a point, eqs (6), (9), (23)."""
         r, rp, V, Vp, l = self.geo.at(h)
+        l = self.seal.width(l)
         F, Fh = self.spring(h)
         pa = self.pa
         if self.liquid:          # p_b from the force balance (7); volume flow eq (24)

@@ -55,6 +55,10 @@ class StripSeal:
         self.uc, self.gas, self.pa, self.beta = getattr(u_c, "scalar", u_c), gas, p_a, beta
         self.mu = liquid_viscosity
 
+    def width(self, l: float) -> float:
+        """The width of the strip a point of the cup crosses (eq 10's l): the strip's own."""
+        return l
+
     def flow(self, F: float, r: float, l: float, pb: float, kappa: float, E: float, u: float):
         """(Ndot, p, u_c, ballistic share) with the stiffness force F = F0(h) [N]."""
         if l <= 0.0:             # a line contact: eq (6)'s pressure is unbounded, u_c = 0 (sealed)
@@ -83,6 +87,12 @@ class ProfileSeal:
             raise ValueError(f"patch_length_m: must be finite and >= 0 (0: no averaging), got {L}")
         self.patch_length_m = L if L else None
         self._averaged: dict[int, tuple[ContactProfile, np.ndarray]] = {}
+
+    def width(self, l: float) -> float:
+        """The width of the strip a point of the cup crosses (eq 10's l): the FEM's strip, at least
+        one patch (the nominal contact of a lone loaded node is L wide, `patch_contact`); without a
+        patch length the FEM's, 0 where the rim corner alone touches."""
+        return max(l, self.patch_length_m) if self.patch_length_m else l
 
     def flow(self, F: float, r: float, l: float, pb: float, kappa: float, E: float, u: float):
         k = int(np.clip(np.searchsorted(self.u, u, side="right") - 1, 0, self.u.size - 2))

@@ -16,7 +16,7 @@ from functools import cached_property
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from reduced.profile_leak import ContactProfile
+from reduced.profile_leak import ContactProfile, patch_average
 from reduced.suction_table import SuctionTable
 
 __all__ = ["TableSurface", "cell", "solid_profile"]
@@ -73,10 +73,12 @@ class TableSurface:
 
 
 def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,
-                  interface: str) -> ContactProfile | None:
+                  interface: str, patch_length_m: float | None = None) -> ContactProfile | None:
     """The solid contact pressure at node (i, j): scale p_tab less the interface gas's rise over
-    p_b across the zone [r_k, r_cut] at the pressure difference dp (`reduced.coupled`); None where
-    the table has no profile."""
+    p_b across the zone [r_k, r_cut] at the pressure difference dp (`reduced.coupled`), averaged
+    over patches of `patch_length_m` when given (the nominal pressure of rough-contact theory,
+    `reduced.profile_leak.patch_average`; the suction's share is in the FEM's pressures already);
+    None where the table has no profile."""
     prof = table.profiles[i][j]
     if prof is None:
         return None
@@ -87,4 +89,5 @@ def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,
     rise = {"p_b": 0.0, "p_a": 1.0}.get(interface)
     if rise is None:
         rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
-    return ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
+    solid = ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
+    return patch_average(solid, patch_length_m) if patch_length_m else solid

@@ -229,6 +229,17 @@ def test_the_profile_seal_averages_when_the_table_carries_a_patch_length():
         ProfileSeal(_point_load_curve(W), table, AIR, P_A, 0.8, None, patch_length_m=-1.0)
 
 
+def test_eq10s_strip_under_a_lone_loaded_node_is_one_patch():
+    """The contact time of eq (10) needs the width of the strip a point crosses: a lone loaded node
+    (the FEM's l = 0) holds one patch of nominal contact, so the averaged seal's width is L there and
+    the FEM's strip where that is wider; the raw seal keeps the FEM's 0 (the line where r' phi / l
+    is singular)."""
+    table = dataclasses.replace(UC, patch_length_m=W)
+    seal = ProfileSeal(_point_load_curve(W / 16), table, AIR, P_A, 0.8, None)
+    assert seal.width(0.0) == W and seal.width(3 * W) == 3 * W
+    assert ProfileSeal(_point_load_curve(W / 16), UC, AIR, P_A, 0.8, None).width(0.0) == 0.0
+
+
 def test_a_uc_table_carries_its_patch_length_through_a_csv(tmp_path):
     table = dataclasses.replace(UC, patch_length_m=1.2e-4, provenance="a test table\nsecond line")
     back = UcTable.from_csv(table.to_csv(tmp_path / "uc.csv"))
@@ -267,6 +278,7 @@ def test_a_spectrum_table_carries_the_patch_on_which_its_u_c_is_the_whole_spectr
     assert pmma == pytest.approx(202e-6, rel=0.02)            # the stored preset (docstrings)
     assert 1.5 < pmma * params["qr_per_m"] / (2 * np.pi) < 2.0
     assert patch_length(preset("pmma-1.89").spectrum(), 0.5, p_over_E=0.01) > pmma      # lower p: longer
-    assert uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5)).patch_length_m is None     # opt-in
-    table = uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5), with_patch_length=True)
+    off = uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5), with_patch_length=False)
+    assert off.patch_length_m is None                                                     # opt-out
+    table = uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5))                     # the default
     assert table.patch_length_m == L

@@ -362,7 +362,7 @@ UC_TABLE_P_OVER_E = np.geomspace(1e-6, 1.0, 241)
 
 
 def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: float = 0.45,
-             a_c: float = 0.42, p_over_E: np.ndarray | None = None, with_patch_length: bool = False):
+             a_c: float = 0.42, p_over_E: np.ndarray | None = None, with_patch_length: bool = True):
     """u_c(p/E) of `spectrum` as the reduced model's `UcTable` (log-log interpolated).
 
     Without adhesion the theory is linear elastic: u_c depends on p and E only through p/E*, so
@@ -372,9 +372,8 @@ def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: 
     gamma and a_c) as `patch_length_m`: the theory's nominal pressure is an average over a patch that
     holds every wavelength u_c depends on, and the profile route then averages the FEM's contact
     pressure over it (`reduced.profile_leak`, `reduced.seal`; it makes that route converge under mesh
-    refinement). Off by default for now: with relaxation the profile route ends where the FEM's
-    strip width l falls to 0 (the rim corner alone), where eq (10)'s term r' phi / l is singular,
-    and the averaged leak can reach that line where the integrator fails instead of stopping.
+    refinement; eq (10)'s strip is then at least one patch wide, `reduced.seal.ProfileSeal.width`).
+    On by default; False: the raw FEM profile (mesh-dependent where the rim corner alone touches).
     """
     from reduced.critical_gap import UcTable
 
