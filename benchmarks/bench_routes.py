@@ -51,6 +51,8 @@ def main() -> None:
     ap.add_argument("--levels", nargs="+", default=["coarse", "medium", "fine"])
     ap.add_argument("--coupled-levels", nargs="*", default=["coarse", "medium"],
                     help="levels whose suction table is built (fine: ~20 min)")
+    ap.add_argument("--cache-dir", default="out/bench_routes",
+                    help="where suction tables are kept (cupcheck validate --cache-dir D keeps its own in D/suction)")
     args = ap.parse_args()
     uc = {s: pmma_uc_table(s) for s in SURFACES}
     g = cup_geometry("A")
@@ -71,13 +73,13 @@ def main() -> None:
                  largest_holdable_force(models["pmma-1.89"]),
                  f"FEM path + {spent / len(FORCES_N):.2g} s per lifetime")
         if level in args.coupled_levels:
-            _coupled(g, level, uc)
+            _coupled(g, level, uc, args.cache_dir)
         _profile_flows(curve, uc["pmma-1.89"])
 
 
-def _coupled(g, level: str, uc: dict) -> None:
+def _coupled(g, level: str, uc: dict, cache_dir: str) -> None:
     t0 = time.perf_counter()
-    table = suction_table_for(g, fidelity=level, cache_dir="out/bench_routes")
+    table = suction_table_for(g, fidelity=level, cache_dir=cache_dir)
     read = time.perf_counter() - t0
     u_start = 1e-3 * table.provenance["h1_mm"] - CUP_A.h_start_m
     models = {s: CoupledCavity(table, uc[s]) for s in SURFACES}
