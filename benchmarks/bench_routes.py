@@ -9,9 +9,9 @@ p_a = 1e5 Pa). For each FEM level: the FEM path's time, then per route the lifet
 - paper: the FEM's F0 through eq (6)'s strip and the cone laws (3)-(5);
 - profile: the FEM's F0, r_c, V and contact-pressure profiles at dp = 0, beta (p_a - p_b) added;
 - coupled: the FEM suction table on the default (u, dp) grid (`validation.coupled.build`, cached in
-  out/bench_routes/; the table's cost is the FEM time it recorded when it was built), the cup's
+  --cache-dir; the table's cost is the FEM time it recorded when it was built), the cup's
   state and profile from the table (`reduced.coupled`).
-Last, the profile route's molecule flow at fixed states (p_b = 50 kPa) along the path, which shows
+Last, the raw (not patch-averaged) profile's molecule flow at fixed states (p_b = 50 kPa) along the path, which shows
 where the levels disagree: at small u only the sharp rim corner touches, one loaded node whose
 lumped pressure grows as the mesh is refined.
 """
@@ -102,7 +102,7 @@ def _profile_flows(curve, uc) -> None:
         gaps = ring_gaps(prof, uc, 4e6, extra_Pa=0.8 * 5e4)
         flows.append(f"u {1e3 * curve.u_m[k]:.2f} mm: {profile_leak_rate(AIR, 1e5, 5e4, prof.r_m, gaps):.3g}/s "
                      f"(narrowest gap {1e9 * np.min(gaps):.0f} nm, {prof.r_m.size} points)")
-    print("  profile flow at p_b = 50 kPa: " + "; ".join(flows))
+    print("  raw (not patch-averaged) profile flow at p_b = 50 kPa: " + "; ".join(flows))
 
 
 if __name__ == "__main__":
