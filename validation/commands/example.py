@@ -51,7 +51,7 @@ FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (written atomically)")
     add_cup_arguments(p, "the FEM runs on it and the lifetimes use it")
-    add_cup_law_arguments(p, default_route="paper")
+    add_cup_law_arguments(p, default_route="profile")
     add_contact_arguments(p.add_argument_group("FEM contact"),
                           "as in the paper: its F0 was measured on soap-lubricated glass and its "
                           "lifetimes on soap-cleaned surfaces, Sec. 5.3-5.5; sticking is Appendix A's "
@@ -247,7 +247,9 @@ def run(args: argparse.Namespace) -> int:
              f"{choice.label}, FEM {args.contact_choice.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
     wall = time.perf_counter() - t0
     slope = float(curve.force(curve.h1_m - 1e-3))
-    crossed = {"profile": "the FEM's contact-pressure profiles",
+    patch = getattr(uc, "patch_length_m", None)
+    crossed = {"profile": "the FEM's contact-pressure profiles" + (f", averaged over patches of {1e6 * patch:.0f} um"
+                                                                 if patch else " (raw: the u_c table has no patch length)"),
                "coupled": "the contact-pressure profile of each (u, dp) state of the FEM suction table "
                           f"(largest holdable force {holdable:.4g} N)" if seal == "coupled" else "",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
