@@ -92,7 +92,7 @@ def test_example_writes_table_and_figure(capsys, tmp_path):
     lines = (tmp_path / "ex" / "lifetime_vs_force.csv").read_text().splitlines()
     assert lines[0].startswith("cup,route,force_N,lifetime_s,reason")
     assert len(lines) == 17                                   # 5, 10, ..., 80 N
-    assert all(l.startswith("A,paper,") for l in lines[1:])
+    assert all(l.startswith("A,profile,") for l in lines[1:])          # the default route
     lives = [float(l.split(",")[3]) for l in lines[1:]]
     assert all(math.isfinite(t) and t > 0 for t in lives)
     png = (tmp_path / "ex" / "lifetime_vs_force.png").read_bytes()
