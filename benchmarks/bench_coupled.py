@@ -4,7 +4,7 @@ of several grids and meshes, beside the paper route, and beta as the FEM sees it
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled.py [--tables DIR]
 
 Tables (frictionless cup A, `fem.suction`; built once and kept as JSON in --tables, default
-out/bench_coupled): the default grid of `cupcheck suction` (u = 0.001 ... 0.8 h1, 53 values;
+out/bench_coupled): the default grid of `cupcheck suction` (u = 0.001 ... 0.8 h1, 105 values;
 dp = 0 ... 100 kPa in 1 kPa) on the coarse and medium meshes, and on the coarse
 mesh the same with every other u or dp dropped, every u or dp interval halved, and one more u at
 0.0025 h1. Prints per

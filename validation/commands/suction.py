@@ -42,7 +42,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default="medium",
                    help="mesh level (default medium)")
     r.add_argument("--u-mm", type=float, nargs="+", default=None, dest="u_mm", metavar="U",
-                   help="plate displacements [mm], increasing, in (0, h1] (default: 53 values "
+                   help="plate displacements [mm], increasing, in (0, h1] (default: 105 values "
                         "from 0.001 to 0.8 h1, graded towards 0)")
     r.add_argument("--dp-kPa", type=float, nargs="+", default=list(DEFAULT_GRID.dp_kPa), dest="dp_kPa",
                    metavar="DP",

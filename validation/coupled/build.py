@@ -1,8 +1,9 @@
 """The FEM suction table of a design, built once and kept: the input of the coupled route.
 
-`SuctionGridSpec` names the (u, dp) grid: the default one (`DEFAULT_GRID`, 53 u values graded towards
-u = 0 up to 0.8 h1, dp = 0, 1, ..., 100 kPa; halving either spacing moves cup A's lifetimes by
-<= 0.9 %, benchmarks/bench_coupled.py) and a coarse one for quick checks (`QUICK_GRID`).
+`SuctionGridSpec` names the (u, dp) grid: the default one (`DEFAULT_GRID`, 105 u values graded towards
+u = 0 up to 0.8 h1, dp = 0, 1, ..., 100 kPa; halving the u spacing moves cup A's lifetimes by
+<= 0.2 %, the dp spacing by <= 0.8 %, benchmarks/bench_coupled.py) and a coarse one for quick checks
+(`QUICK_GRID`).
 `suction_table_for` runs `fem.suction.suction_grid` on a design and converts it to the reduced
 model's `SuctionTable`; with a cache directory the table goes through `joblib.Memory`, keyed by the
 design, the law, the grid and a hash of the sources that make it (`fem`, `validation.coupled` and
@@ -42,9 +43,12 @@ class SuctionGridSpec:
         return f"{len(self.u_fractions)} u x {len(self.dp_kPa)} dp"
 
 
-DEFAULT_GRID = SuctionGridSpec(
-    tuple(sorted(set(_U_COARSE) | {0.5 * (a + b) for a, b in zip(_U_COARSE, _U_COARSE[1:])})),
-    tuple(float(x) for x in range(0, 101)))
+def _halved(u: tuple[float, ...]) -> tuple[float, ...]:
+    """The values with the midpoint of every interval added."""
+    return tuple(sorted(set(u) | {0.5 * (a + b) for a, b in zip(u, u[1:])}))
+
+
+DEFAULT_GRID = SuctionGridSpec(_halved(_halved(_U_COARSE)), tuple(float(x) for x in range(0, 101)))
 QUICK_GRID = SuctionGridSpec(_U_COARSE, tuple(float(x) for x in range(0, 101, 5)))
 
 
