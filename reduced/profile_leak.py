@@ -248,7 +248,10 @@ def _series_flow(p_a: float, p_b: float, u3: np.ndarray, b: np.ndarray, c: np.nd
 
 
 def _march(p_a: float, u3: np.ndarray, b: np.ndarray, c: np.ndarray, q: float) -> tuple[float, float]:
-    """(P at the inner edge, dP/dQ) for flow q; -inf if the pressure would fall below zero."""
+    """(P at the inner edge, dP/dQ) for flow q; -inf if the pressure would fall below zero on the
+    way (a gas has none: the flow is too large). Without that stop a ring with a small b after one
+    that left P below -b would square its way back up, P_in(q) would not be monotone and the root
+    search could settle on a flow no state has."""
     P, dP = p_a, 0.0
     for i in range(u3.size - 1, -1, -1):
         w = (P + b[i]) ** 2 - 2.0 * c[i] * q / u3[i]
@@ -257,6 +260,8 @@ def _march(p_a: float, u3: np.ndarray, b: np.ndarray, c: np.ndarray, q: float) -
         root = math.sqrt(w)
         dP = ((P + b[i]) * dP - c[i] / u3[i]) / root
         P = root - b[i]
+        if P < 0.0:
+            return -math.inf, -math.inf
     return P, dP
 
 

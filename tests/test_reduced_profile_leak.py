@@ -282,3 +282,25 @@ def test_a_spectrum_table_carries_the_patch_on_which_its_u_c_is_the_whole_spectr
     assert off.patch_length_m is None                                                     # opt-out
     table = uc_table(spec, 0.5, p_over_E=np.geomspace(1e-3, 0.1, 5))                     # the default
     assert table.patch_length_m == L
+
+
+def test_the_march_stops_where_the_gas_pressure_would_fall_below_zero():
+    """P_in(Q) through rings in series must fall monotonically with Q for the root search to find
+    the one flow with P_in = p_b. A narrow outer ring (large b = a/u) can leave P below -b of a wide
+    inner ring, whose formula then squares P back up: a gas has no negative pressure, so such a Q
+    is too large (-inf), and P_in never rises with Q."""
+    from reduced.gas import XI
+    from reduced.profile_leak import _march
+
+    u = np.array([10e-6, 10e-9])                  # inner ring wide open, outer ring narrow
+    c = 12.0 * AIR.viscosity_Pa_s * AIR.kT_J * np.array([0.05, 0.01]) / (2.0 * np.pi)
+    b = XI * AIR.n_lambda_per_m2 * AIR.kT_J / 2.0 / u
+    u3 = u ** 3
+    q_outer = u3[1] * ((P_A + b[1]) ** 2) / (2.0 * c[1])        # the outer ring's largest flow
+    q = np.linspace(0.0, 0.999 * q_outer, 400)[1:]
+    p_in = np.array([_march(P_A, u3, b, c, x)[0] for x in q])
+    assert np.all(np.diff(p_in[np.isfinite(p_in)]) < 0)
+    assert not np.isfinite(p_in[-1])              # P would pass below 0 after the narrow ring
+    # and the flow at p_b = 0 is the largest with P >= 0 all the way
+    Q = profile_leak_rate(AIR, P_A, 0.0, np.array([10e-3, 10.5e-3, 10.6e-3]), u)
+    assert _march(P_A, u3, b, c, 1.001 * Q)[0] == -np.inf
