@@ -81,7 +81,7 @@ def _coupled(g, level: str, uc: dict, cache_dir: str) -> None:
     t0 = time.perf_counter()
     table = suction_table_for(g, fidelity=level, cache_dir=cache_dir)
     read = time.perf_counter() - t0
-    u_start = 1e-3 * table.provenance["h1_mm"] - CUP_A.h_start_m
+    u_start = table.h1_m - CUP_A.h_start_m
     models = {s: CoupledCavity(table, uc[s]) for s in SURFACES}
     t0 = time.perf_counter()
     models["pmma-1.89"].lifetime(FORCES_N[0], u_start)               # the nodes' conductances, once

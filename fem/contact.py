@@ -220,7 +220,7 @@ class RigidPlane:
     def cone_excess(self, state: ContactState, r_int: np.ndarray) -> float:
         """Coulomb: the largest excess of a sticking node's tangential reaction over the cone,
         max(|t| - mu lambda, 0), relative to the largest nodal normal reaction; 0 for the other
-        laws. Round-off at a converged state, unless a node had to be held stuck (`fem.friction`)."""
+        laws. Round-off at a converged state (`fem.friction` solves the cone exactly)."""
         a = state.active & (state.slip == 0)
         if self.law != "coulomb" or not a.any():
             return 0.0

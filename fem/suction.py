@@ -42,6 +42,7 @@ class SuctionGrid:
 
     h1_m: float
     contact: str
+    friction: float             # Coulomb's mu (0 for the other laws)
     material: NeoHookean
     u_m: np.ndarray
     dp_Pa: np.ndarray
@@ -110,7 +111,7 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
                          f"u = {u_i * 1e3:.4g} mm, dp = {hi / 1e3:.4g} kPa")
     take = np.vectorize(lambda o, k: o[k], otypes=[float])
     return SuctionGrid(
-        h1_m=h1, contact=contact, material=material, u_m=u, dp_Pa=dp,
+        h1_m=h1, contact=contact, friction=cup.plane.friction, material=material, u_m=u, dp_Pa=dp,
         F1_N=take(outputs, 0), contact_force_N=take(outputs, 1), V_m3=take(outputs, 2),
         seal_r_m=take(outputs, 3), cut_r_m=take(outputs, 4), r_c_m=take(outputs, 5),
         potential_J=take(outputs, 6),

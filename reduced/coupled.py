@@ -208,9 +208,6 @@ class CoupledCavity:
                 if dp > self.p_a_Pa:
                     continue
                 prof = self._solid_profile(i, j)
-                if prof is None:
-                    raise ValueError(f"suction table: no contact profile at u = {1e3 * self._u[i]:.4g} mm, "
-                                     f"dp = {dp / 1e3:.4g} kPa (the cavity is open)")
                 drive = max(dp, 1.0)
                 gaps = ring_gaps(prof, self.u_c, E)
                 if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
@@ -220,7 +217,7 @@ class CoupledCavity:
                                               self.radial) / drive
         return out
 
-    def _solid_profile(self, i: int, j: int) -> ContactProfile | None:
+    def _solid_profile(self, i: int, j: int) -> ContactProfile:
         """The solid contact pressure at node (i, j) of the kappa-times-stiffer cup (`solid_profile`)."""
         return solid_profile(self.table, i, j, self.kappa, self._dp[j], self.interface, self.patch_length_m)
 
@@ -277,6 +274,19 @@ class CoupledCavity:
         dp = brentq(lambda d: self.F1(u_start_m, d), 0.0, top, xtol=1e-9)
         return dp, (self.p_a_Pa - dp) * self.V(u_start_m, dp) / self.gas.kT_J
 
+    def loaded(self, F1: float, u_start_m: float) -> tuple[float, float | None, float]:
+        """(N0, dp0, dp_lo): the start content of the cup released at u_start (`start`), the dp of
+        the F1 branch's state that holds it (None if F1 is more than the cup holds with it: the
+        over-force), and the branch's low-dp end inside the table."""
+        _, N0 = self.start(u_start_m)
+        lo, hi = self._dp_range(F1)
+        if not np.isfinite(lo) or N0 > self.content(F1, lo)[1]:
+            return N0, None, lo
+        if N0 < self.content(F1, hi)[1]:
+            raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
+                             f"{1e3 * self._u[-1]:.4g} mm; extend the table")
+        return N0, brentq(lambda d: self.content(F1, d)[1] - N0, lo, hi, xtol=1e-10 * max(hi, 1.0)), lo
+
     def largest_holdable_force(self, u_start_m: float) -> float:
         """The largest F1 [N] the cup released at u_start holds at t = 0: the branch at that F1
         just reaches the start content at its low-dp end (bisection on F1). With relaxation: the
@@ -309,17 +319,11 @@ class CoupledCavity:
             if not (t_max_s > 0 and 0 < rtol < 1e-2):
                 raise ValueError(f"t_max_s, rtol: need t_max_s > 0 and 0 < rtol < 0.01, got {t_max_s}, {rtol}")
             return relaxed_lifetime(self, F1, u_start_m, t_max_s, rtol)
-        _, N0 = self.start(u_start_m)
-        lo, hi = self._dp_range(F1)
-        empty = np.zeros(0)
-        if not np.isfinite(lo) or N0 > self.content(F1, lo)[1]:
+        N0, dp0, lo = self.loaded(F1, u_start_m)
+        if dp0 is None:
             return CoupledLifetime(F1, 0.0, "over_force", f"F1 = {F1:g} N exceeds what the cup holds "
                                    f"with its start content: it detaches at once", N0,
-                                   *(empty,) * 6, p_a_Pa=self.p_a_Pa)
-        if N0 < self.content(F1, hi)[1]:
-            raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
-                             f"{1e3 * self._u[-1]:.4g} mm; extend the table")
-        dp0 = brentq(lambda d: self.content(F1, d)[1] - N0, lo, hi, xtol=1e-10 * max(hi, 1.0))
+                                   *(np.zeros(0),) * 6, p_a_Pa=self.p_a_Pa)
         dps = np.linspace(dp0, lo, self.samples)
         u, V = np.array([self._on_branch(F1, d) for d in dps]).T
         N = (self.p_a_Pa - dps) * V / self.gas.kT_J

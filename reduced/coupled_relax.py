@@ -44,10 +44,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.polynomial import chebyshev
-from scipy.optimize import brentq
 
 from reduced.ode import dopri5
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
+from reduced.coupled_branch import Branch, BranchPoint
 from reduced.table_surface import TableSurface, cell, solid_profile
 
 if TYPE_CHECKING:
@@ -106,7 +106,7 @@ class _NodeRates:
             for j in range(ns):
                 self.fixed[i, j], self.coef[i, j] = self._fit(cc, i, j, E_ref, x)
         at_ref = np.concatenate([self._raw(cc.kappa, j) for j in range(ns)])
-        self.top = float(np.max(at_ref[np.isfinite(at_ref)]))
+        self.top = float(np.max(at_ref[np.isfinite(at_ref)]))   # ln of the conductances' scale
         self._last: tuple = (None, None, None)
 
     def _fit(self, cc: CoupledCavity, i: int, j: int, E_ref: float, x: np.ndarray) -> tuple[float, np.ndarray]:
@@ -115,9 +115,6 @@ class _NodeRates:
         none = np.zeros(_CHEBYSHEV)
         pa, s = self.pa, self.s[j]
         prof = solid_profile(cc.table, i, j, 1.0, s, cc.interface, cc.patch_length_m)
-        if prof is None:
-            raise ValueError(f"suction table: no contact profile at u = {1e3 * self.u[i]:.4g} mm, "
-                             f"dp = {s / 1e3:.4g} kPa (the cavity is open)")
         gaps = ring_gaps(prof, cc.u_c, E_ref, scale=cc.kappa)
         if np.all(np.isinf(gaps)):
             return math.inf, none                        # no contact: no resistance
@@ -130,11 +127,6 @@ class _NodeRates:
             return math.log(leak(pa - 1.0)), none        # the dp -> 0 limit, as unrelaxed
         pb = 0.5 * (self.lo[j] + pa) + 0.5 * (pa - self.lo[j]) * x
         return math.nan, chebyshev.chebfit(x, [math.log(leak(b) / (pa - b)) for b in pb], _CHEBYSHEV - 1)
-
-    @property
-    def largest(self) -> float:
-        """ln of the scale of the conductances (sealed below 1e-20 of it, as unrelaxed)."""
-        return self.top
 
     def _raw(self, kappa: float, j: int) -> np.ndarray:
         """ln(Ndot / dp) at the nodes (u_i, s_j) at kappa; nan beyond p_a, +-inf open / sealed."""
@@ -159,168 +151,6 @@ class _NodeRates:
             z = np.stack([self.column(kappa, j), self.column(kappa, j + 1)], axis=1)
             self._last = (kappa, j, TableSurface(self.u, self.s[j:j + 2], z, self.along_u))
         return self._last[2](u, s)
-
-
-@dataclass(frozen=True)
-class _Point:
-    """A state on the branch at one kappa (table coordinates) with what its derivatives need."""
-
-    u: float
-    s: float
-    N: float
-    dN_ds: float
-    F: tuple[float, float, float]      # F1_tab and its u, s slopes
-    V: tuple[float, float, float]
-
-
-class _Branch:
-    """The branch of pull F1 at the current kappa: the state that holds N gas (module docstring)."""
-
-    def __init__(self, cc: CoupledCavity, F1: float, surfaces: dict[str, TableSurface]):
-        self.cc, self.F1, self.S = cc, F1, surfaces
-        self.kT, self.pa = cc.gas.kT_J, cc.p_a_Pa
-        self.u_lo, self.u_hi = float(cc.table.u_m[0]), float(cc.table.u_m[-1])
-        self.s_max = float(cc.table.dp_Pa[-1])
-        self.last_u, self.last_s = self.u_hi, 0.0
-        self._edge: tuple[float | None, _Point | None] = (None, None)
-
-    def u_of(self, s: float, k: float) -> float:
-        """u with k F1_tab(u, s) = F1 (F1 falls with u); u_lo where even u_lo cannot hold F1."""
-        F = self.S["F1"]
-
-        def f(u: float) -> tuple[float, float]:
-            z, z_u, _ = F.value_and_slopes(u, s)
-            return k * z - self.F1, k * z_u
-        f_lo, f_hi = f(self.u_lo)[0], f(self.u_hi)[0]
-        slack = 1e-9 * max(abs(self.F1), 1.0)
-        if f_lo <= slack:
-            return self.u_lo
-        if f_hi > 0:
-            if f_hi <= slack:
-                return self.u_hi
-            raise ValueError(f"F1 = {self.F1:g} N presses the cup beyond the table's u = "
-                             f"{1e3 * self.u_hi:.4g} mm at dp = {k * s / 1e3:.4g} kPa; extend the table")
-        u = _newton(f, self.u_lo, self.u_hi, 1.0, self.last_u, 1e-13 * self.u_hi)
-        self.last_u = u
-        return u
-
-    def point(self, s: float, k: float) -> _Point:
-        u = self.u_of(s, k)
-        F, V = self.S["F1"].value_and_slopes(u, s), self.S["V"].value_and_slopes(u, s)
-        g = self.pa - k * s
-        det = k * F[1] * (g * V[2] - k * V[0]) - k * F[2] * g * V[1]
-        return _Point(u, s, g * V[0] / self.kT, det / (k * F[1] * self.kT), F, V)
-
-    def edge(self, k: float) -> _Point:
-        """The branch's state at the table's smallest u (the end of the data)."""
-        if self._edge[0] != k:
-            top = self.s_top(k)
-            g = lambda s: k * self.S["F1"](self.u_lo, s) - self.F1      # noqa: E731
-            s = top if g(top) <= 0 else (0.0 if g(0.0) >= 0 else brentq(g, 0.0, top, xtol=1e-12 * top))
-            self._edge = (k, self.point(s, k))
-        return self._edge[1]
-
-    def s_top(self, k: float) -> float:
-        return min(self.s_max, self.pa / k)
-
-    def solve(self, N: float, k: float) -> tuple[_Point, str | None]:
-        """(the state holding N, None), or (the branch's end, 'fold' or 'table_edge') if N lies
-        beyond it (the dynamics is continued there with the end values)."""
-        s_lo, s_hi = self.edge(k).s, self.s_top(k)
-        P = self.point(min(max(self.last_s, s_lo), s_hi), k)
-        if P.dN_ds >= 0:                                 # at or below a fold: the fold lies above
-            P = self._fold(P, self._climb(P, k, s_hi), k)
-            if P.N <= N:
-                return self._keep(P), "fold"
-        if P.N >= N:
-            lo, hi = self._up(P, N, k, s_hi)
-        else:
-            lo, hi, end = self._down(P, N, k, s_lo)
-            if end is not None:
-                return self._keep(lo), end
-        if lo.N == N:
-            return self._keep(lo), None
-
-        def f(x: float) -> tuple[float, float]:
-            Q = self.point(x, k)
-            return Q.N - N, Q.dN_ds
-        s = _newton(f, lo.s, hi.s, 1.0, lo.s + (N - lo.N) / lo.dN_ds if lo.dN_ds < 0 else lo.s,
-                    1e-14 * self.s_max)
-        return self._keep(self.point(s, k)), None
-
-    def _keep(self, P: _Point) -> _Point:
-        self.last_s, self.last_u = P.s, P.u
-        return P
-
-    def _step(self, P: _Point, N: float) -> float:
-        return max(2.0 * abs(N - P.N) / abs(P.dN_ds), 1e-6 * self.s_max) if P.dN_ds < 0 else 1e-3 * self.s_max
-
-    def _down(self, P: _Point, N: float, k: float, s_lo: float) -> tuple[_Point, _Point, str | None]:
-        """Below P (N(P) < N): (lo, hi, None) with N(lo) >= N > N(hi), or (the fold or the edge,
-        -, its name) if the branch ends before holding N."""
-        step = self._step(P, N)
-        while True:
-            Q = self.point(max(P.s - step, s_lo), k)
-            if Q.dN_ds >= 0:
-                fold = self._fold(Q, P, k)
-                return (fold, P, "fold" if fold.N < N else None)
-            if Q.N >= N:
-                return Q, P, None
-            if Q.s <= s_lo:
-                return Q, P, "table_edge"
-            P, step = Q, 2.0 * step
-
-    def _up(self, P: _Point, N: float, k: float, s_hi: float) -> tuple[_Point, _Point]:
-        """Above P (N(P) >= N): (lo, hi) with N(lo) >= N >= N(hi)."""
-        step = self._step(P, N)
-        while True:
-            Q = self.point(min(P.s + step, s_hi), k)
-            if Q.N <= N:
-                return P, Q
-            if Q.s >= s_hi:
-                raise ValueError(f"suction table: the branch at F1 = {self.F1:g} N holds more than "
-                                 f"N = {N:.6g} up to its top dp = {k * s_hi / 1e3:.4g} kPa; extend dp")
-            P, step = Q, 2.0 * step
-
-    def _climb(self, P: _Point, k: float, s_hi: float) -> _Point:
-        """The first state above P on the stable side (dN/ds < 0)."""
-        step = 1e-4 * self.s_max
-        while True:
-            Q = self.point(min(P.s + step, s_hi), k)
-            if Q.dN_ds < 0:
-                return Q
-            if Q.s >= s_hi:
-                raise ValueError(f"suction table: no stable state at F1 = {self.F1:g} N below "
-                                 f"dp = {k * s_hi / 1e3:.4g} kPa")
-            P, step = Q, 2.0 * step
-
-    def _fold(self, below: _Point, above: _Point, k: float) -> _Point:
-        """The fold dN/ds = 0 between a state `below` (dN/ds >= 0) and one `above` (< 0)."""
-        if below.dN_ds == 0:
-            return below
-        s = brentq(lambda x: self.point(x, k).dN_ds, below.s, above.s, xtol=1e-14 * self.s_max)
-        return self.point(s, k)
-
-
-def _newton(f: Callable[[float], tuple[float, float]], lo: float, hi: float, sign_lo: float,
-            x0: float, xtol: float) -> float:
-    """Root of f (value, slope) in [lo, hi], f having the sign of sign_lo at lo and the other at
-    hi: Newton steps, bisection where one leaves the bracket."""
-    x = min(max(x0, lo), hi)
-    for _ in range(200):
-        fx, dfx = f(x)
-        if fx == 0.0:
-            return x
-        if (fx > 0) == (sign_lo > 0):
-            lo = x
-        else:
-            hi = x
-        step = x - fx / dfx if dfx != 0.0 else math.nan
-        x_new = step if min(lo, hi) < step < max(lo, hi) else 0.5 * (lo + hi)
-        if abs(x_new - x) <= xtol or abs(hi - lo) <= xtol:
-            return x_new
-        x = x_new
-    raise RuntimeError(f"coupled branch: no convergence in [{lo:.6g}, {hi:.6g}]")
 
 
 @dataclass(frozen=True, eq=False)
@@ -365,7 +195,7 @@ def _det3(m: list[list[float]]) -> float:
 class _Rates:
     """Ndot, phidot and D at a state."""
 
-    point: _Point
+    point: BranchPoint
     kappa: float
     N_dot: float
     phi_dot: float
@@ -375,9 +205,9 @@ class _Rates:
 class _Dynamics:
     """dN/dt (the leak) and dphi/dt (eq 10 with rdot from the 3 x 3 system) at (N, phi)."""
 
-    def __init__(self, cc: CoupledCavity, parts: RelaxedParts, branch: _Branch):
+    def __init__(self, cc: CoupledCavity, parts: RelaxedParts, branch: Branch):
         self.cc, self.parts, self.br = cc, parts, branch
-        self.sealed_below = parts.rates.largest + math.log(1e-20)
+        self.sealed_below = parts.rates.top + math.log(1e-20)        # as unrelaxed
         self._last: tuple = (None, None)
 
     def __call__(self, N: float, phi: float) -> _Rates:
@@ -387,7 +217,7 @@ class _Dynamics:
             self._last = ((N, phi), self.rates(P, k, dk, phi))
         return self._last[1]
 
-    def rates(self, P: _Point, k: float, dk: float, phi: float) -> _Rates:
+    def rates(self, P: BranchPoint, k: float, dk: float, phi: float) -> _Rates:
         S, kT = self.parts.surfaces, self.cc.gas.kT_J
         z = self.parts.rates(k, P.u, P.s)
         N_dot = k * P.s * math.exp(z) if z > self.sealed_below else 0.0
@@ -432,22 +262,16 @@ class _Run:
 
     def __init__(self, cc: CoupledCavity, F1: float):
         self.cc, self.F1, self.parts = cc, F1, cc._relaxed
-        self.branch = _Branch(cc, F1, self.parts.surfaces)
+        self.branch = Branch(cc, F1, self.parts.surfaces)
         self.dyn = _Dynamics(cc, self.parts, self.branch)
         self.N0 = math.nan
 
-    def start(self, u_start: float, k0: float) -> _Point | None:
+    def start(self, u_start: float, k0: float) -> BranchPoint | None:
         """The state at t = 0 (N0 fixed at F1 = 0 and kappa(0), Sec. 3), None for an over-force."""
-        cc, F1 = self.cc, self.F1
-        frozen = replace(cc, kappa=k0, relaxation=None, phi0_s=None)      # the cup at t = 0
-        _, self.N0 = frozen.start(u_start)
-        lo, hi = frozen._dp_range(F1)
-        if not np.isfinite(lo) or self.N0 > frozen.content(F1, lo)[1]:
+        frozen = replace(self.cc, kappa=k0, relaxation=None, phi0_s=None)      # the cup at t = 0
+        self.N0, dp0, _ = frozen.loaded(self.F1, u_start)
+        if dp0 is None:
             return None
-        if self.N0 < frozen.content(F1, hi)[1]:
-            raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
-                             f"{1e3 * cc.table.u_m[-1]:.4g} mm; extend the table")
-        dp0 = brentq(lambda d: frozen.content(F1, d)[1] - self.N0, lo, hi, xtol=1e-10 * max(hi, 1.0))
         self.branch.last_s = dp0 / k0
         P0, end = self.branch.solve(self.N0, k0)
         return P0 if end is None else None
@@ -471,7 +295,7 @@ class _Run:
         return dopri5(rhs, 0.0, [0.0, 0.0], t_max, rtol, [rtol * Q_scale, 1e-6],
                       events=[edge_event, fold_event], h0=1e-3 * Q_scale / first.N_dot)
 
-    def trajectory(self, sol, P0: _Point) -> list[tuple]:
+    def trajectory(self, sol, P0: BranchPoint) -> list[tuple]:
         """The rows at the accepted steps, each solved on the branch from the start on."""
         self.branch.last_u, self.branch.last_s = P0.u, P0.s
         rows = []

@@ -18,6 +18,7 @@ JSON (one file; units in the key names)::
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -69,6 +70,12 @@ class SuctionTable:
         u.flags.writeable = dp.flags.writeable = False
         object.__setattr__(self, "u_m", u)
         object.__setattr__(self, "dp_Pa", dp)
+
+    @property
+    def h1_m(self) -> float:
+        """The free cup's height [m] the table's u is measured from (provenance ``h1_mm``; nan if
+        the table does not record it)."""
+        return 1e-3 * float(self.provenance.get("h1_mm", math.nan))
 
     def to_json(self, path: str | os.PathLike) -> Path:
         """Write the table (atomically: a temporary file renamed into place)."""

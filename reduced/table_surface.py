@@ -38,16 +38,7 @@ class TableSurface:
                       else None)
 
     def __call__(self, a: float, b: float) -> float:
-        i, j, s, t = cell(self.u, self.dp, a, b)
-        z0, z1 = self.z[i, j:j + 2], self.z[i + 1, j:j + 2]
-        if self.slope is None:
-            col = (1 - s) * z0 + s * z1
-        else:
-            h = self.u[i + 1] - self.u[i]
-            h00, h10, h01, h11 = (2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2,
-                                  s**3 - s**2)
-            col = h00 * z0 + h10 * h * self.slope[i, j:j + 2] + h01 * z1 + h11 * h * self.slope[i + 1, j:j + 2]
-        return float((1 - t) * col[0] + t * col[1])
+        return self.value_and_slopes(a, b)[0]
 
     def value_and_slopes(self, a: float, b: float) -> tuple[float, float, float]:
         """(z, dz/du, dz/ddp) at (a, b) (on Python floats: it is called in the inner loops)."""
@@ -73,15 +64,16 @@ class TableSurface:
 
 
 def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,
-                  interface: str, patch_length_m: float | None = None) -> ContactProfile | None:
+                  interface: str, patch_length_m: float | None = None) -> ContactProfile:
     """The solid contact pressure at node (i, j): scale p_tab less the interface gas's rise over
     p_b across the zone [r_k, r_cut] at the pressure difference dp (`reduced.coupled`), averaged
     over patches of `patch_length_m` when given (the nominal pressure of rough-contact theory,
-    `reduced.profile_leak.patch_average`; the suction's share is in the FEM's pressures already);
-    None where the table has no profile."""
+    `reduced.profile_leak.patch_average`; the suction's share is in the FEM's pressures already).
+    ValueError where the table has no profile (the cavity is open there)."""
     prof = table.profiles[i][j]
     if prof is None:
-        return None
+        raise ValueError(f"suction table: no contact profile at u = {1e3 * table.u_m[i]:.4g} mm, "
+                         f"dp = {table.dp_Pa[j] / 1e3:.4g} kPa (the cavity is open)")
     r, p = prof.r_m, scale * prof.p_Pa
     rk, rcut = table.seal_r_m[i, j], table.cut_r_m[i, j]
     tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too

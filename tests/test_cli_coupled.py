@@ -16,17 +16,10 @@ from reduced.gas import Gas
 from reduced.profile_leak import ContactProfile
 from reduced.suction_table import SuctionTable
 from reduced.viscoelastic import default_relaxation, measurement_contact_time
+from tests.cli import run_cli as _run
 from validation.cli import main
 from validation.coupled.table import fem_beta
 
-
-def _run(capsys, *argv):
-    try:
-        code = main(list(argv))
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")

@@ -8,16 +8,9 @@ import pytest
 from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
 from reduced.cup import CUP_A
 from reduced.lifetime import lifetime_by_quadrature, reference_model
+from tests.cli import run_cli as _run
 from validation.cli import main
 
-
-def _run(capsys, *argv):
-    try:
-        code = main(list(argv))
-    except SystemExit as exc:               # argparse's own errors
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_json_reference_mode(capsys):

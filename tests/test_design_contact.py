@@ -8,23 +8,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fem.geometry import Design, design_from_mapping, geometry_from_mapping, load_design, load_geometry
+from fem.geometry import Design, geometry_from_mapping, load_design, load_geometry
 from fem.interface import (API, CONTACT_LAWS, FILE, ContactChoice, ContactLaw, choose_contact,
                            contact_law)
 from reduced.stiffness_curve import StiffnessCurve
-from validation.cli import main
+from tests.cli import run_cli as _run
 
 COULOMB_TOML = '[contact]\nlaw = "coulomb"\nfriction = 0.3\n'
 FAST = ["--fidelity", "coarse", "--u-max-mm", "1"]
 
-
-def _run(capsys, *argv):
-    try:
-        code = main([str(a) for a in argv])
-    except SystemExit as exc:               # argparse's own errors
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def _design(tmp_path: Path, text: str, name: str = "d.toml") -> Path:

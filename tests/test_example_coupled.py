@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from tests.cli import run_cli as _run
 from validation.cli import main
 from validation.coupled.build import SuctionGridSpec, suction_table_for
 
@@ -14,14 +15,6 @@ from validation.coupled.build import SuctionGridSpec, suction_table_for
 SMALL = SuctionGridSpec((0.005, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8),
                         (0.0, 2.0, 5.0, 10.0, 20.0, 40.0, 70.0, 100.0))
 
-
-def _run(capsys, *argv):
-    try:
-        code = main(list(argv))
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +46,7 @@ def test_coupled_example_lifetimes_are_the_librarys(coupled_example, table_file)
                                   "p_b_final_Pa"]
     table = SuctionTable.from_json(table_file)
     model = CoupledCavity(table, uc_table(preset("pmma-1.89").spectrum(), 0.5))
-    u_start = 1e-3 * table.provenance["h1_mm"] - CUP_A.h_start_m
+    u_start = table.h1_m - CUP_A.h_start_m
     for F, life, reason in zip(rows.force_N, rows.lifetime_s, rows.reason):
         expected = model.lifetime(F, u_start)
         assert reason == expected.reason

@@ -12,7 +12,7 @@ import pytest
 from reduced.appendix_a import appendix_a_curve
 from reduced.cup import CUP_A
 from reduced.stiffness_curve import StiffnessCurve
-from validation.cli import main
+from tests.cli import run_cli as _run
 from validation.design import preset_design
 
 DESIGNER_TOML = """r1_mm = 25
@@ -22,14 +22,6 @@ r_mm = [5, 25]
 d_mm = [2.0, 0.4]
 """
 
-
-def _run(capsys, *argv):
-    try:
-        code = main([str(a) for a in argv])
-    except SystemExit as exc:               # argparse's own errors
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def _curve_for(design: dict, path: Path) -> Path:

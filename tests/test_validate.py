@@ -274,7 +274,7 @@ def test_quick_report_paper_numbers(quick_report):
 
     direct = CoupledCavity(cached, pmma_uc_table("pmma-1.89"), Gas(T_K=293.15), 1e5,
                            relaxation=default_relaxation(), phi0_s=measurement_contact_time(CUP_A)).lifetime(
-        10.0, 1e-3 * cached.provenance["h1_mm"] - CUP_A.h_start_m)
+        10.0, cached.h1_m - CUP_A.h_start_m)
     assert float(coupled.loc["lifetime at 10 N on a rough surface", "cupcheck"]) == pytest.approx(
         direct.lifetime_s, rel=1e-6)                  # the CSV keeps 8 significant digits
     # the calibrated inputs hit their targets (the calibration's own tolerance)

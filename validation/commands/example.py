@@ -152,7 +152,7 @@ def coupled_lifetimes(args: argparse.Namespace, geometry, uc, choice, tmp: Path)
                                   cache_dir=None if args.no_cache else args.cache_dir,
                                   progress=terminal_progress("suction"))
     table.to_json(tmp / "suction_table.json")
-    u_start = 1e-3 * table.provenance["h1_mm"] - choice.cup.h_start_m
+    u_start = table.h1_m - choice.cup.h_start_m
     model = CoupledCavity(table, uc)
     results = [model.lifetime(F, u_start) for F in FORCES_N]
     return results, model.largest_holdable_force(u_start)

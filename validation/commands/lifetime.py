@@ -127,14 +127,9 @@ def build_model(args: argparse.Namespace):
     from reduced.appendix_a import appendix_a_curve
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel, largest_holdable_force, reference_model
-    from reduced.viscoelastic import RelaxationModulus, default_relaxation
     from validation.guards import check_design, check_modulus
 
-    for F in args.force_N:
-        if not (math.isfinite(F) and F > 0):
-            raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
-    if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
-        raise ValueError("--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
+    check_run_options(args)
     check_modulus(args.E_MPa, "--E-MPa")
     geometry, seal = route_model(args)
     curve, choice = _curve_and_cup(args)
@@ -164,16 +159,9 @@ def build_model(args: argparse.Namespace):
         if not (math.isfinite(args.d0_mm) and args.d0_mm > 0):
             raise ValueError(f"--d0-mm: wall thickness must be > 0 mm, got {args.d0_mm:g}")
         curve = appendix_a_curve(cup, E_Pa=1e6 * args.E_MPa, d0_m=1e-3 * args.d0_mm)
-    if not (math.isfinite(args.kappa) and args.kappa > 0):
-        raise ValueError(f"--kappa: stiffness factor must be > 0, got {args.kappa:g}")
     if args.kappa != 1.0:
         curve = curve.scaled(args.kappa)
-    if args.relaxation == "none":
-        relax = None
-    elif args.relaxation == "default":
-        relax = default_relaxation()
-    else:
-        relax = RelaxationModulus.from_csv(args.relaxation)
+    relax = relaxation_law(args.relaxation)
     gas = Gas(T_K=args.T_K)
     model = LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
                          E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
@@ -183,6 +171,27 @@ def build_model(args: argparse.Namespace):
                          label=choice.label)
     largest_holdable_force(model)   # builds the start state: checks geometry and curve range now
     return model
+
+
+def check_run_options(args: argparse.Namespace) -> None:
+    """The options every route checks before its model: the forces, the integration's t_max and
+    rtol, and kappa (ValueError naming the option)."""
+    for F in args.force_N:
+        if not (math.isfinite(F) and F > 0):
+            raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
+    if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
+        raise ValueError("--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
+    if not (math.isfinite(args.kappa) and args.kappa > 0):
+        raise ValueError(f"--kappa: stiffness factor must be > 0, got {args.kappa:g}")
+
+
+def relaxation_law(value: str):
+    """The `RelaxationModulus` of --relaxation: None (none), the default power law, or a CSV."""
+    from reduced.viscoelastic import RelaxationModulus, default_relaxation
+
+    if value == "none":
+        return None
+    return default_relaxation() if value == "default" else RelaxationModulus.from_csv(value)
 
 
 def _curve_and_cup(args: argparse.Namespace):

@@ -58,7 +58,6 @@ def run(args: argparse.Namespace) -> int:
     from fem.suction import suction_grid
     from validation.commands._failure import solver_failure
     from validation.coupled.table import suction_table
-    from validation.handoff import contact_provenance
     from validation.output import atomic_file, terminal_progress
 
     try:
@@ -68,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     except ConvergenceError as exc:
         raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
     table = suction_table(grid, {"geometry": job["geometry"], "fidelity": args.fidelity,
-                                 **contact_provenance(law.law, law.friction, job["contact"].source)})
+                                 "contact_source": job["contact"].source})
     with atomic_file(args.out) as tmp:
         table.to_json(tmp)
     s = grid.stats

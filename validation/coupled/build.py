@@ -68,7 +68,7 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: str = "fri
     if cache_dir is not None:
         from joblib import Memory
         build = Memory(str(cache_dir), verbose=0).cache(_build, ignore=["progress"])
-    code = package_version("fem") + package_version("validation/coupled") + _file_hash(*_TABLE_TYPES)
+    code = "".join(package_version(p) for p in ("fem", "validation/coupled", *_TABLE_TYPES))
     return build(geometry, fidelity, contact, friction, E_Pa, nu, grid, code, progress=progress)
 
 
@@ -77,23 +77,15 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: str = "fri
 _TABLE_TYPES = ("reduced/suction_table.py", "reduced/stiffness_curve.py")
 
 
-def _file_hash(*paths: str) -> str:
-    import hashlib
-
-    root = Path(__file__).resolve().parents[2]
-    return hashlib.sha256(b"".join((root / p).read_bytes() for p in paths)).hexdigest()[:16]
-
-
 def _build(geometry, fidelity, contact, friction, E_Pa, nu, grid, code, progress=None):
     from fem.cup import cup_height
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
     from fem.suction import suction_grid
     from validation.coupled.table import suction_table
-    from validation.handoff import contact_provenance
 
     mesh = cup_mesh(geometry, fidelity)
     result = suction_grid(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), grid.u_m(cup_height(mesh)), grid.dp_Pa,
                           contact=contact, friction=friction, progress=progress)
     return suction_table(result, {"geometry": geometry.describe(), "fidelity": fidelity,
-                                  "grid": grid.describe(), **contact_provenance(contact, friction)})
+                                  "grid": grid.describe()})

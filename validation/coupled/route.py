@@ -31,7 +31,7 @@ def coupled_model(args: argparse.Namespace):
     from reduced.gas import Gas
     from reduced.suction_table import SuctionTable
     from reduced.viscoelastic import measurement_contact_time
-    from validation.commands.lifetime import build_uc
+    from validation.commands.lifetime import build_uc, check_run_options
     from validation.design import resolve_cup
 
     if args.reference_mode:
@@ -45,16 +45,10 @@ def coupled_model(args: argparse.Namespace):
         raise ValueError("--suction-table: --route coupled needs the FEM table of `cupcheck suction` (.json)")
     if not Path(args.suction_table).is_file():
         raise ValueError(f"--suction-table: no such file '{args.suction_table}'")
-    for F in args.force_N:
-        if not (math.isfinite(F) and F > 0):
-            raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
-    if not (math.isfinite(args.kappa) and args.kappa > 0):
-        raise ValueError(f"--kappa: stiffness factor must be > 0, got {args.kappa:g}")
-    if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
-        raise ValueError("--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
+    check_run_options(args)
     relaxation = _relaxation(args)
     table = SuctionTable.from_json(args.suction_table)
-    h1 = 1e-3 * float(table.provenance.get("h1_mm", math.nan))
+    h1 = table.h1_m
     recorded = _TableDesign(table.provenance.get("geometry"), h1)
     choice = resolve_cup(recorded if recorded.design else None, cup=args.cup,
                          geometry_file=args.geometry, r_start_mm=args.r_start_mm,
@@ -74,7 +68,7 @@ def coupled_model(args: argparse.Namespace):
 def _relaxation(args: argparse.Namespace):
     """The `RelaxationModulus` of --relaxation (none, default or a CSV), as the paper route reads
     it; --phi0-s checked here so that its error names the option."""
-    from reduced.viscoelastic import RelaxationModulus, default_relaxation
+    from validation.commands.lifetime import relaxation_law
 
     if args.relaxation == "none":
         if args.phi0_s is not None:
@@ -82,7 +76,7 @@ def _relaxation(args: argparse.Namespace):
         return None
     if args.phi0_s is not None and not (math.isfinite(args.phi0_s) and args.phi0_s > 0):
         raise ValueError(f"--phi0-s: measurement contact time must be finite and > 0 s, got {args.phi0_s:g}")
-    return default_relaxation() if args.relaxation == "default" else RelaxationModulus.from_csv(args.relaxation)
+    return relaxation_law(args.relaxation)
 
 
 def run_coupled(args: argparse.Namespace) -> int:

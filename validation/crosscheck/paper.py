@@ -116,7 +116,7 @@ def coupled_route(ctx: Context) -> Route:
         t = table(cup)
         return CoupledCavity(t, pmma_uc_table(surface), Gas(T_K=293.15), P_A, kappa=kappa,
                              relaxation=default_relaxation(), phi0_s=measurement_contact_time(CUPS[cup])), \
-            1e-3 * t.provenance["h1_mm"] - CUPS[cup].h_start_m
+            t.h1_m - CUPS[cup].h_start_m
 
     def life(cup, surface, F1, kappa=1.0, fluid="air", **options):
         m, u_start = cavity(cup, surface, kappa)

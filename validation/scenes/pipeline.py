@@ -34,9 +34,10 @@ _ROOT = Path(__file__).resolve().parents[2]
 
 @lru_cache(maxsize=None)
 def package_version(package: str) -> str:
-    """A hash of a package's sources (part of every cache key of its products)."""
+    """A hash of a package's sources, or of one source file (part of every cache key of its products)."""
     h = hashlib.sha256()
-    for path in sorted((_ROOT / package).rglob("*.py")):
+    root = _ROOT / package
+    for path in [root] if root.is_file() else sorted(root.rglob("*.py")):
         h.update(path.relative_to(_ROOT).as_posix().encode())
         h.update(path.read_bytes())
     return h.hexdigest()[:16]
