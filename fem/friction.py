@@ -22,8 +22,7 @@ i.e. node a is pressed where lh > 0, sticks (Delta = 0) where |t - c_t Delta| <=
 of the condensed system; the coupling of a sliding node's friction to its normal reaction (Coulomb's
 law is not associated, the matrix is not symmetric) is in it exactly, so the outer Newton iteration
 keeps its quadratic rate and the stick/slide set is decided with the displacement instead of
-between iterations (that set cycled: 483 Newton iterations and 6 cut-backs on cup A, medium,
-mu = 0.3, against 97 and none so).
+between iterations, where it cycled (docs/fem.md, solver notes).
 
 The augmentation c > 0 (here the node's diagonal stiffness) cannot change a converged state: at a
 zero of the complementarity functions the conditions above hold for any c. In this form it does
@@ -48,7 +47,7 @@ _SSN_ITERATIONS = 30    # active-set guesses per Newton iteration (a cycle ends 
 
 
 class FrictionStep:
-    """The Newton step of one iterate for Coulomb contact (the interface of `fem.solver._Step`).
+    """The Newton step of one iterate for Coulomb contact (the interface of `fem.contact_step.ContactStep`).
 
     The base factor holds every node held at the iterate (z and r) and the prescribed dofs; the
     condensed problem then decides, in one iteration, which nodes are pressed, released, stuck or
@@ -67,7 +66,7 @@ class FrictionStep:
         self.state, self.settled = state, False
 
     def solve(self, solver, K, shift, history, policy, lower=True) -> float:
-        """Factor the base block (`factor`: `fem.solver._factor`, shifted if not positive
+        """Factor the base block (`factor`: `fem.factorization.factor_shifted`, shifted if not positive
         definite), solve the condensed problem, add the free nodes the step penetrates until none
         does. Returns the shift used."""
         plane, old = self.plane, self.old
