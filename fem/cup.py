@@ -61,7 +61,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 from skfem import Mesh
@@ -74,6 +74,7 @@ from .postprocess import (BIOT_STRETCH, enclosed_volume, half_maximum_width, inn
 from .forms import Mechanics
 from .integrity import check_state
 from .kinematics import Kinematics
+from .laws import plane_law
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
@@ -86,7 +87,7 @@ class CupResponse:
     """The cup's response per converged step (module docstring). Arrays are over steps."""
 
     h1_m: float
-    contact: str
+    contact: str                # the law's name (`contact_law`: the law with its mu)
     material: NeoHookean
     u_m: np.ndarray
     F0_N: np.ndarray
@@ -109,6 +110,11 @@ class CupResponse:
     nodal_pressure_Pa: tuple[np.ndarray, ...] = field(repr=False)
     friction: float = 0.0       # Coulomb's mu (contact "coulomb")
     cone_excess: np.ndarray | None = None   # Coulomb: largest excess over the cone / max lambda
+
+    @property
+    def contact_law(self) -> ContactLaw:
+        """The contact law of the run, with Coulomb's mu."""
+        return ContactLaw(self.contact, self.friction)
 
     @property
     def h_m(self) -> np.ndarray:
@@ -138,7 +144,7 @@ def cup_height(mesh: Mesh) -> float:
 
 
 def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
-                 contact: Literal["frictionless", "sticking", "coulomb"] = "frictionless",
+                 contact: ContactLaw | str = ContactLaw(),
                  u_max_m: float | None = None, friction: float = 0.0,
                  progress: Callable[[float, str], None] | None = None,
                  admissible_only: bool = True, **solver_opts: Any) -> CupResponse:
@@ -146,9 +152,10 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     reaches the plane; the steep rise of F0 where the wall is squeezed flat lies just below it)
     and return its `CupResponse`.
 
-    contact: the law at the plane (`fem.contact`): frictionless, sticking, or coulomb with
-    Coulomb's coefficient `friction` (mu in [0, 100]; `fem.interface.ContactLaw` checks both; a
-    design file's law is `fem.geometry.load_design(path).contact`).
+    contact: the law at the plane, a `fem.interface.ContactLaw` (frictionless, sticking, or
+    coulomb with Coulomb's mu in [0, 100]; a design file's law is
+    `fem.geometry.load_design(path).contact`); or, the older spelling, the law's name with mu as
+    `friction` (`fem.laws.plane_law` converts either).
     admissible_only: end the path with `fem.integrity.StateRejected` at the first converged state
     that violates contact between the nodes or crosses itself (module docstring); False follows
     the solver's path regardless (for studies of the solver itself).
@@ -182,7 +189,8 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
                         on_step=on_step, name="u [m]")
     per_step = {f.name: np.array([getattr(st, f.name) for st in steps])
                 for f in fields(_StepOutputs) if f.name not in _PER_STEP_OBJECTS}
-    return CupResponse(h1_m=h1, contact=contact, friction=friction, material=material, stats=stats, mesh=mesh,
+    law = plane.law
+    return CupResponse(h1_m=h1, contact=law.name, friction=law.mu, material=material, stats=stats, mesh=mesh,
                        **per_step, **{name: tuple(getattr(st, name) for st in steps)
                                       for name in _PER_STEP_OBJECTS})
 
@@ -198,15 +206,16 @@ class CupSetup:
     path: np.ndarray
 
     @classmethod
-    def of(cls, mesh: Mesh, material: NeoHookean, contact: str, friction: float = 0.0) -> "CupSetup":
-        """Check the contact law, Coulomb's mu (`fem.interface.ContactLaw`) and the material
-        (ValueError) and build the setup."""
-        ContactLaw(contact, friction)
+    def of(cls, mesh: Mesh, material: NeoHookean, contact: ContactLaw | str = ContactLaw(),
+           friction: float = 0.0) -> "CupSetup":
+        """Check the contact law (`fem.laws.plane_law`: a `ContactLaw`, or a name and Coulomb's mu)
+        and the material (ValueError) and build the setup."""
+        law = plane_law(contact, friction)
         if not isinstance(material, NeoHookean):
             raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
         kin = Kinematics.of(mesh)
         top = _boundary_nodes(mesh, "top_plate")
-        plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top, friction=friction)
+        plane = RigidPlane(kin, mesh.boundary_facets(), law=law, exclude=top)
         return cls(Mechanics(kin, material), plane, top, boundary_path(mesh, "cavity"))
 
     def plate_at(self, u0_m: float, moving: bool = True) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
@@ -267,7 +276,7 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
         penetration_m=plane.largest_penetration(s.u), energy_J=s.energy_J,
         newton_iterations=s.iterations, unstable=s.unstable,
         min_stretch=float(np.min(smallest_stretch(mech.kin.deformation_gradient(s.u)))),
-        cone_excess=plane.cone_excess(s.contact, s.r_int),
+        cone_excess=plane.law.cone_excess(plane, s.contact, s.r_int),
         pressure=prof, displacements=s.u, nodal_pressure_Pa=p_nodes)
 
 

@@ -118,7 +118,7 @@ class FrictionStep:
         """The merit test of a step that need not descend in the energy: the free residual of
         the new sets, friction included, falls by 1e-4 alpha of the iterate's."""
         base = r_trial - fext0
-        res = base - self.plane.friction_force(self.state, base)
+        res = base - self.plane.law.friction_force(self.plane, self.state, base)
         free = self.free.copy()
         free[self.plane.constraints(self.state)[0]] = False
         now = (self.res0 - self.friction)[self.free]
@@ -140,7 +140,7 @@ class _Condensed:
     def __init__(self, plane: RigidPlane, old: ContactState, u, res0, K: sp.csr_matrix, fac,
                  du0, held: np.ndarray, tol: float):
         self.plane, self.K, self.fac, self.du0, self.res0, self.tol = plane, K, fac, du0, res0, tol
-        self.mu, self.held, self.nodes = plane.friction, held, held.copy()
+        self.mu, self.held, self.nodes = plane.law.mu, held, held.copy()
         rd = 2 * plane.nodes
         self.rows = np.concatenate([rd[held] + 1, rd[held]])
         self.force = np.zeros(len(self.rows), bool)          # the unknown is a force

@@ -30,7 +30,7 @@ def total_potential(mech, u, fext):
 
 def conservative(plane) -> bool:
     """Whether the total energy is the path's potential: no contact, or frictionless contact."""
-    return plane is None or plane.law == "frictionless"
+    return plane is None or plane.law.conservative
 
 
 def line_search(mech, solver, policy, step, u_start, u, Pi, res, K, fext, shift, held, history,

@@ -5,7 +5,7 @@ f_ext . u over the admissible set (the prescribed values, g >= 0, and the anchor
 held on the plane). The predictor is the converged state of the last step; the first iteration
 imposes the prescribed increment through the tangent (a tangent predictor, which sees the
 contact; a secant extrapolation pushed the contact front through the plane). Each iteration
-takes the contact step (`fem.contact_step`, or Coulomb's `fem.friction`) on the shifted
+takes the contact law's step (`fem.laws`: `fem.contact_step`, or Coulomb's `fem.friction`) on the shifted
 factorization (`fem.factorization`) and the line search (`fem.linesearch`).
 
 Converged: the prescribed values hold, no held node pulls on the plane beyond the tolerance,
@@ -21,9 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .contact_step import ContactStep
-from .factorization import factor_shifted
 from .failure import StepFailure
-from .friction import FrictionStep
 from .linesearch import line_search, total_potential
 
 if TYPE_CHECKING:
@@ -61,8 +59,8 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         res = r - fext0
         free, dofs, du_fixed = _free_dofs(n, fixed_dofs, fixed_vals, u, plane, state)
         f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext0), _force_floor(mech))
-        if plane is not None and plane.law == "coulomb":
-            fric = plane.friction_force(state, res)
+        fric = plane.law.friction_force(plane, state, res) if plane is not None else None
+        if fric is not None:                          # the friction of the iterate is a load
             Pi += (fext - fext0 - fric) @ u           # the same W, the new load
             fext = fext0 + fric
             res = r - fext
@@ -71,11 +69,10 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         history.append(rnorm / f_ref)
         if not np.all(np.isfinite(res)):
             raise StepFailure("the residual is not finite", history)
-        if plane is not None and plane.law == "coulomb":
-            step = FrictionStep(plane, state, u, res, free, du_fixed, opts.rtol * f_ref,
-                                factor_shifted, fext - fext0)
+        if plane is not None:
+            step = plane.law.step(plane, state, u, res, free, du_fixed, opts.rtol * f_ref, fext - fext0)
         else:
-            step = ContactStep(plane, state, u, res, free, du_fixed, opts.rtol * f_ref)
+            step = ContactStep(None, state, u, res, free, du_fixed, opts.rtol * f_ref)
         shift = step.solve(solver, K, shift, history, policy)
         indefinite |= shift > 0.0
         flags["indefinite"] = indefinite
@@ -85,9 +82,9 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         tensile = plane is not None and np.any(plane.reactions(res)[state.active] < -opts.rtol * f_ref)
         if held and not tensile and balanced(rnorm, opts.rtol * f_ref, step.du, u) \
                 and energy <= opts.etol * e_ref and getattr(step, "settled", True):
-            if plane is not None and plane.cone_excess(state, res) > 1e3 * opts.rtol:
+            if plane is not None and plane.law.cone_excess(plane, state, res) > 1e3 * opts.rtol:
                 raise StepFailure("Coulomb's stick/slide set cycled and the node held stuck lies "
-                                  f"outside the friction cone ({plane.cone_excess(state, res):.2g} "
+                                  f"outside the friction cone ({plane.law.cone_excess(plane, state, res):.2g} "
                                   "of the largest normal reaction); likely cause: a too-large step, "
                                   "or a friction bound falling steeply with the slip", history)
             return u, r, state, it, indefinite

@@ -183,7 +183,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         dissipated += defect
         dt_ok = t1 - t
         if plane is not None:
-            state1 = plane.commit(state1, u1)
+            state1 = plane.law.commit(plane, state1, u1)
         u0, r0, W0, state, t, jumps, m0 = u1, r1, W1, state1, t1, 0, m1
         if on_step:
             on_step(StepResult(t, u1, r1, W1, state1, its, bool(indefinite)))
