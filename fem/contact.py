@@ -41,7 +41,7 @@ pointwise profile is the lumped projection p_a = lambda_a / sum_b M_ab, which is
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -50,10 +50,7 @@ import scipy.sparse.linalg as spla
 from .interface import CONTACT_LAWS
 from .kinematics import Kinematics
 
-if TYPE_CHECKING:
-    from .laws import PlaneLaw
-
-__all__ = ["RigidPlane", "ContactState", "PressureProfile", "CONTACT_LAWS"]
+__all__ = ["RigidPlane", "ContactState", "PressureProfile", "PlaneLaw", "CONTACT_LAWS"]
 
 # 1D quadratic shape functions on s in [0, 1] for facet nodes (vertex 0, vertex 1, midpoint)
 _GAUSS_S, _GAUSS_W = np.polynomial.legendre.leggauss(4)
@@ -74,6 +71,29 @@ class ContactState:
     u_r_stick_m: np.ndarray    # float [ncand], where active: the radial displacement of the anchor
     #                            (sticking: the touchdown point; coulomb: the step's start or touchdown)
     slip: np.ndarray           # int8 [ncand]: coulomb: 0 sticks, +1 / -1 slides outward / inward
+
+
+class PlaneLaw(Protocol):
+    """What the path follower asks of a contact law (`fem.laws` holds the three laws)."""
+
+    name: ClassVar[str]             # one of CONTACT_LAWS
+    mu: float                       # Coulomb's coefficient (0 but for coulomb)
+    conservative: ClassVar[bool]    # the total energy is the path's potential
+    anchored: ClassVar[bool]        # held nodes keep their radial anchor
+
+    def step(self, plane: "RigidPlane", state: ContactState, u: np.ndarray, res: np.ndarray,
+             free: np.ndarray, du_fixed: np.ndarray, tol: float, friction: np.ndarray) -> Any:
+        """The Newton step of an iterate (`fem.contact_step.ContactStep`'s interface)."""
+
+    def friction_force(self, plane: "RigidPlane", state: ContactState,
+                       res: np.ndarray) -> np.ndarray | None:
+        """The plane's friction on the sliding nodes [N], or None for a law without friction."""
+
+    def cone_excess(self, plane: "RigidPlane", state: ContactState, r_int: np.ndarray) -> float:
+        """The largest excess of a stuck node over the friction cone / max lambda."""
+
+    def commit(self, plane: "RigidPlane", state: ContactState, u: np.ndarray) -> ContactState:
+        """The state carried into the next load step."""
 
 
 @dataclass(frozen=True)
@@ -103,7 +123,7 @@ class RigidPlane:
 
     kin: Kinematics
     facets: np.ndarray            # candidate boundary facets (global facet indices)
-    law: "PlaneLaw"
+    law: PlaneLaw
     exclude: np.ndarray | None = None   # nodes that are never candidates (e.g. clamped ones)
     nodes: np.ndarray = field(init=False, repr=False)           # the candidate nodes
     _facet_nodes: np.ndarray = field(init=False, repr=False)    # [3, nfacets]: vertices, midpoint
@@ -120,7 +140,7 @@ class RigidPlane:
         object.__setattr__(self, "nodes", nodes)
 
     @classmethod
-    def on(cls, kin: Kinematics, boundaries: list[str], law: "PlaneLaw",
+    def on(cls, kin: Kinematics, boundaries: list[str], law: PlaneLaw,
            exclude: list[str] = ()) -> "RigidPlane":
         """Candidates: the facets of the named boundaries, minus nodes on the `exclude` boundaries."""
         mesh = kin.mesh

@@ -67,6 +67,7 @@ import numpy as np
 from skfem import Mesh
 
 from .contact import PressureProfile, RigidPlane
+from .fields import write_fields
 from .interface import ContactLaw
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
 from .postprocess import (BIOT_STRETCH, enclosed_volume, half_maximum_width, inner_contact_radius,
@@ -132,7 +133,6 @@ class CupResponse:
         """Write displacement, Cauchy stress (element means) and contact pressure on the reference
         mesh: one step as VTU (or another format meshio infers from the suffix), or, to an .xdmf,
         one step or every step (step=None) as a time series over u (`fem.fields`)."""
-        from .fields import write_fields
         return write_fields(self, path, step)
 
 

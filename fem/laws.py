@@ -4,7 +4,8 @@ A law (`Frictionless`, `Sticking`, `Coulomb`) supplies the Newton step that deci
 press (and stick or slide), the plane's friction on the sliding nodes, the check of the friction
 cone, the commit of its state at the end of a load step, whether held nodes are anchored
 radially, and whether the path is conservative (the energy is its potential: jump control and
-extrapolation apply). The geometry of the plane and the contact state are `fem.contact`'s.
+extrapolation apply): `fem.contact.PlaneLaw`. The plane's geometry and the contact state are
+`fem.contact`'s.
 
 `plane_law` is the one conversion from the plain data of `fem.interface.ContactLaw` (or the
 string and mu of the older keyword pair ``contact=, friction=``) to a law object.
@@ -13,17 +14,17 @@ string and mu of the older keyword pair ``contact=, friction=``) to a law object
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Union
+from typing import ClassVar
 
 import numpy as np
 
-from .contact import ContactState
+from .contact import ContactState, PlaneLaw
 from .contact_step import ContactStep
 from .factorization import factor_shifted
 from .friction import FrictionStep
 from .interface import ContactLaw
 
-__all__ = ["Frictionless", "Sticking", "Coulomb", "PlaneLaw", "plane_law"]
+__all__ = ["Frictionless", "Sticking", "Coulomb", "plane_law"]
 
 
 @dataclass(frozen=True)
@@ -118,9 +119,6 @@ class Coulomb:
         """The anchors move to the converged positions (the law is incremental)."""
         anchor = np.where(state.active, u[2 * plane.nodes], state.u_r_stick_m)
         return ContactState(state.active, anchor, state.slip)
-
-
-PlaneLaw = Union[Frictionless, Sticking, Coulomb]
 
 
 def plane_law(contact: ContactLaw | str = ContactLaw(), friction: float = 0.0) -> PlaneLaw:

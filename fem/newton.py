@@ -16,24 +16,18 @@ condensed problem keeps its sets. Anything else raises `fem.failure.StepFailure`
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from .contact_step import ContactStep
 from .failure import StepFailure
 from .linesearch import line_search, total_potential
 
-if TYPE_CHECKING:
-    from .solver import SolverOptions
-
 __all__ = ["newton_step", "balanced"]
 
 
-def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts: "SolverOptions", solver,
-                policy):
-    """Newton iterations of one step with a contact step per iteration (module docstring);
-    returns (u, r_int, contact state, iterations, whether the tangent was indefinite on the way)."""
+def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy):
+    """Newton iterations of one step with a contact step per iteration (module docstring), to the
+    tolerances of `opts` (a `fem.solver.SolverOptions`); returns (u, r_int, contact state, iterations, whether the tangent was indefinite on the way)."""
     flags = {"indefinite": False}
     try:
         return _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags)
