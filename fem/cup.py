@@ -79,7 +79,7 @@ from .laws import plane_law
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["compress_cup", "CupResponse", "cup_height", "REQUIRED_BOUNDARIES"]
+__all__ = ["compress_cup", "CupResponse", "CupSetup", "cup_height", "REQUIRED_BOUNDARIES"]
 
 
 
