@@ -6,7 +6,7 @@ eliminating its vertical dof like a Dirichlet condition; for ``"sticking"`` cont
 displacement is also frozen where it touched down. The nodal contact reaction lambda_a (the
 internal force at the eliminated dof, > 0 when the plane pushes) is what the constraint costs.
 Which nodes are held is decided inside each Newton step by a small linear complementarity
-problem (`fem.solver`): the nodes the step would push through the plane and the held nodes it
+problem (`fem.contact_step`): the nodes the step would push through the plane and the held nodes it
 would pull on; `project` puts any node that still penetrates back on the plane, `hold` records
 the new set. A converged step satisfies g >= 0, lambda >= 0, g lambda = 0 at the nodes (to the
 Newton tolerance), so there is no enforcement parameter whose value could change the result.

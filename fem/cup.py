@@ -1,59 +1,41 @@
 """The cup job: press the cup's top plate down onto the rigid plane z = 0 and record its response.
 
-    from fem.material import NeoHookean
-    from fem.cup import compress_cup
-    resp = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact="frictionless", u_max_m=5e-3)
+    from fem import ContactLaw, NeoHookean, compress_cup
+    resp = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact=ContactLaw("frictionless"),
+                        u_max_m=5e-3)
     resp.F0_N, resp.r_c_m, resp.l_m, resp.V_m3        # per converged step, at resp.u_m
     resp.write_fields("cup.vtu")                        # displacement, Cauchy stress, pressure
 
 The mesh is a scikit-fem ``MeshQuad2`` (or ``MeshTri2``) of the cross-section in metres (x = r,
 y = z) with the boundary tags 'top_plate' (the edge at r0, clamped to the rigid plate) and 'cavity'
-(the lower, cavity-facing surface, from the plate down to the rim); 'outer' and 'rim' are usual
-(`fem.mesh`) but not needed. The rim's inner corner rests on the plane, z = 0, in the undeformed
-state. h1 is the height of the lowest top-plate node.
+(the lower, cavity-facing surface, from the plate down to the rim; `fem.mesh`). The rim's inner
+corner rests on the plane in the undeformed state; h1 is the height of the lowest top-plate node.
 
 Loading (Sec. 5.3): the plate moves down by u (displacement control), h = h1 - u; the top-plate
-nodes follow it rigidly (u_r = 0, u_z = -u). Every boundary node except those on the plate may
-touch the plane (`fem.contact`); the contact zones are whatever the solution makes them. A
-converged state in which a facet dips below the plane between its nodes, beyond 5 % of the rim's
-thickness, or in which the wall's outline crosses itself (a fold: no self-contact is modelled)
-ends the path with `fem.integrity.StateRejected` saying where and why (`fem.integrity`).
+nodes follow it rigidly (u_r = 0, u_z = -u). Every other boundary node may touch the plane under
+the chosen contact law (`fem.contact`, `fem.laws`); the contact zones are whatever the solution
+makes them. A converged state that dips below the plane between its nodes or whose wall outline
+crosses itself (no self-contact is modelled) ends the path with `fem.integrity.StateRejected`.
 
-The pressure profile p(r) (`fem.contact.PressureProfile`) holds the lumped nodal pressure of the
-nodes in contact, sorted by deformed radius, and the consistent L2 projection at the boundary
-Gauss points (for integrals). r_c, the strip widths and V come from the pure functions of
-`fem.postprocess`.
+Per converged step `CupResponse` holds (SI; the measures are the pure functions of
+`fem.postprocess`, docs/fem.md and docs/stiffness.md discuss them):
 
-Per converged step, `CupResponse` holds (all SI):
-
-* ``F0_N``: the reaction on the top plate, the cup spring force F0 (eq. 7); ``F0_contact_N``: the
-  integrated contact force 2 pi int p r dr, which equals F0 by equilibrium (a check, both stored);
-* ``r_c_m``: the inner contact radius (eq. 3's r), `postprocess.inner_contact_radius`: between
-  the innermost node in contact and its free neighbour, where a square-root edge extrapolates to 0;
-* ``V_m3``: the cavity volume under the plate and inside the cup down to z = 0 (the region of
-  eq. 4), `postprocess.enclosed_volume` of the deformed cavity path down to its first contact;
-* ``l_m``: the strip width l handed to the reduced model (eq. 5's l, the width of the strip of
-  eq. 6 that carries the contact load): the force-quartile width 2 (r_75 - r_25) of the innermost
-  contact zone, the sealing strip next to r_c (`postprocess.quartile_width`: the middle half of
-  the strip's radial line force int p dr lies within l / 2; exact for a uniform strip; it rests on
-  the cumulative load only, so the singular pressure at a sharp corner moves it by what it carries,
-  and it does not use r_c, which jumps by a node spacing whenever the front passes a node; it
-  converges with the mesh: `benchmarks/bench_mesh_levels.py`); 0 where the mesh resolves no strip
-  (one loaded node: the rim corner alone); ``l_median_m``: the median-force width 2 (r_half - r_c)
-  (`postprocess.median_force_width`, scatters by the jumps of r_c);
-* ``l_weighted_m``: the pressure-weighted width (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
-  (the integrals over the Gauss-point projection), l (1 + l / 2 r_c) for a uniform
-  strip; its int p^2 reacts to the singular rim-corner pressure, so it scatters 10-30 % between
-  mesh levels (kept for comparison); ``l_half_max_m``: the width at half maximum of the lumped nodal
-  pressure (`postprocess.half_maximum_width`);
-* ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
-  elastic energy), ``newton_iterations``, ``unstable`` (the tangent lost definiteness in the step
-  that ended there: buckling or a snap, across which the path may jump, `fem.solver`), and the pressure profiles ``pressure[i]``;
-* ``min_stretch``: the smallest principal stretch anywhere in the wall (`postprocess.smallest_stretch`
-  at the quadrature points). Below Biot's 0.544 (`postprocess.BIOT_STRETCH`) a compressed free
-  surface can fold, and the curve from there on (`CupResponse.folding_u_m`) depends on the mesh:
-  cup A reaches it at the outer face next to the clamped plate, at ~0.83 h1 with sticking contact
-  (where the fine level's path turns unstable) and just at 0.9 h1 frictionless.
+* ``F0_N``: the plate reaction, the cup spring force F0 (eq. 7); ``F0_contact_N``: the
+  integrated contact force 2 pi int p r dr, equal to F0 by equilibrium (a check);
+* ``r_c_m``: the inner contact radius (eq. 3's r), `postprocess.inner_contact_radius`;
+* ``V_m3``: the cavity volume of eq. 4's region, `postprocess.enclosed_volume`;
+* ``l_m``: the strip width handed to the reduced model (eq. 5's l): the force-quartile width
+  2 (r_75 - r_25) of the innermost contact zone (`postprocess.quartile_width`: it rests on the
+  cumulative load only, so it converges with the mesh while r_c jumps by node spacings), 0 where
+  the mesh resolves no strip; for comparison ``l_median_m`` (median-force width),
+  ``l_weighted_m`` (pressure-weighted width, (int p dA)^2 / (2 pi r_c int p^2 dA), sensitive to
+  the singular rim-corner pressure) and ``l_half_max_m`` (width at half maximum);
+* ``pressure[i]``: the contact-pressure profile (`fem.contact.PressureProfile`: lumped nodal
+  values sorted by radius, and the consistent L2 projection at the Gauss points for integrals);
+* ``penetration_m``, ``energy_J``, ``newton_iterations``, ``unstable`` (the step crossed an
+  instability, `fem.solver`), ``cone_excess`` (Coulomb's cone check);
+* ``min_stretch``: the smallest principal stretch in the wall; below Biot's 0.544 a compressed
+  free surface can fold and the curve beyond (`CupResponse.folding_u_m`) depends on the mesh.
 """
 
 from __future__ import annotations

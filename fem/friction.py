@@ -1,7 +1,7 @@
 """Coulomb friction in the Newton iteration: the linearized frictional contact problem, solved exactly.
 
 The law and its state live in `fem.contact` (`RigidPlane`: held nodes, anchors, slip directions).
-Every Newton iteration of a load step (`fem.solver`) minimizes the quadratic model of the energy
+Every Newton iteration of a load step (`fem.newton`) minimizes the quadratic model of the energy
 subject to the linearized contact and friction conditions at the candidate nodes a:
 
     normal:      g_a + du_z,a >= 0,  lambda_a >= 0,  lambda_a (g_a + du_z,a) = 0

@@ -27,7 +27,8 @@ __all__ = ["newton_step", "balanced"]
 
 def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy):
     """Newton iterations of one step with a contact step per iteration (module docstring), to the
-    tolerances of `opts` (a `fem.solver.SolverOptions`); returns (u, r_int, contact state, iterations, whether the tangent was indefinite on the way)."""
+    tolerances of `opts` (a `fem.solver.SolverOptions`); returns (u, r_int, contact state,
+    iterations, whether the tangent was indefinite on the way)."""
     flags = {"indefinite": False}
     try:
         return _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags)
@@ -76,9 +77,10 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         tensile = plane is not None and np.any(plane.reactions(res)[state.active] < -opts.rtol * f_ref)
         if held and not tensile and balanced(rnorm, opts.rtol * f_ref, step.du, u) \
                 and energy <= opts.etol * e_ref and getattr(step, "settled", True):
-            if plane is not None and plane.law.cone_excess(plane, state, res) > 1e3 * opts.rtol:
+            excess = plane.law.cone_excess(plane, state, res) if plane is not None else 0.0
+            if excess > 1e3 * opts.rtol:
                 raise StepFailure("Coulomb's stick/slide set cycled and the node held stuck lies "
-                                  f"outside the friction cone ({plane.law.cone_excess(plane, state, res):.2g} "
+                                  f"outside the friction cone ({excess:.2g} "
                                   "of the largest normal reaction); likely cause: a too-large step, "
                                   "or a friction bound falling steeply with the slip", history)
             return u, r, state, it, indefinite

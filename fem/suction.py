@@ -70,8 +70,8 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
                  **solver_opts: Any) -> SuctionGrid:
     """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in (0, h1];
     dp_Pa: increasing, starting at 0. contact: a `fem.interface.ContactLaw`, or the law's name
-    with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input, `fem.solver.ConvergenceError`
-    naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
+    with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input,
+    `fem.solver.ConvergenceError` naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
     converged state violates contact between the nodes or folds onto itself."""
     h1 = cup_height(mesh)
     u = np.asarray(u_m, float)
