@@ -59,7 +59,7 @@ from .integrity import check_state
 from .kinematics import Kinematics
 from .laws import plane_law
 from .material import NeoHookean
-from .solver import SolverOptions, SolverStats, StepResult, follow_path
+from .solver import ConvergenceError, SolverOptions, SolverStats, StepResult, follow_path
 
 __all__ = ["compress_cup", "CupResponse", "CupSetup", "cup_height", "REQUIRED_BOUNDARIES"]
 
@@ -93,6 +93,7 @@ class CupResponse:
     nodal_pressure_Pa: tuple[np.ndarray, ...] = field(repr=False)
     friction: float = 0.0       # Coulomb's mu (contact "coulomb")
     cone_excess: np.ndarray | None = None   # Coulomb: largest excess over the cone / max lambda
+    partial: bool = False       # the converged part of a path that failed later (`compress_cup`)
 
     @property
     def contact_law(self) -> ContactLaw:
@@ -143,7 +144,8 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     the solver's path regardless (for studies of the solver itself).
     solver_opts: fields of `fem.solver.SolverOptions` (rtol, etol, max_iterations, initial_step,
     max_step, min_step, growth). Raises ValueError for bad input, `fem.solver.ConvergenceError`
-    (a RuntimeError) if a step cannot be converged.
+    (a RuntimeError) if a step cannot be converged; it carries the converged part as
+    ``exc.partial`` (a `CupResponse` flagged partial, up to u = exc.t_from).
     """
     h1 = cup_height(mesh)
     cup = CupSetup.of(mesh, material, contact, friction)
@@ -167,14 +169,24 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
             progress(s.t / u_max, f"step {len(steps) - 1}: u = {s.t * 1e3:.4g} mm of {u_max * 1e3:.4g} mm, "
                                   f"{s.iterations} Newton iterations")
 
-    stats = follow_path(mech, cup.plate_at(0.0), u_max, plane=plane, options=options,
-                        on_step=on_step, name="u [m]")
+    try:
+        stats = follow_path(mech, cup.plate_at(0.0), u_max, plane=plane, options=options,
+                            on_step=on_step, name="u [m]")
+    except ConvergenceError as exc:
+        if exc.stats is not None:       # the solver gave up: keep what converged
+            exc.partial = _response(steps, h1, plane, material, exc.stats, mesh, partial=True)
+        raise
+    return _response(steps, h1, plane, material, stats, mesh)
+
+
+def _response(steps: list["_StepOutputs"], h1: float, plane: RigidPlane, material: NeoHookean,
+              stats: SolverStats, mesh: Mesh, partial: bool = False) -> CupResponse:
+    """The `CupResponse` of the converged steps."""
     per_step = {f.name: np.array([getattr(st, f.name) for st in steps])
                 for f in fields(_StepOutputs) if f.name not in _PER_STEP_OBJECTS}
-    law = plane.law
-    return CupResponse(h1_m=h1, contact=law.name, friction=law.mu, material=material, stats=stats, mesh=mesh,
-                       **per_step, **{name: tuple(getattr(st, name) for st in steps)
-                                      for name in _PER_STEP_OBJECTS})
+    return CupResponse(h1_m=h1, contact=plane.law.name, friction=plane.law.mu, material=material,
+                       stats=stats, mesh=mesh, partial=partial, **per_step,
+                       **{name: tuple(getattr(st, name) for st in steps) for name in _PER_STEP_OBJECTS})
 
 
 @dataclass(frozen=True, eq=False)

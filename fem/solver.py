@@ -23,6 +23,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -40,15 +41,20 @@ __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "S
 class ConvergenceError(RuntimeError):
     """A load step could not be converged even with the smallest allowed step.
 
-    The message is one line; the attributes say where (the step, its load range t_from -> t_to)
-    and why (`cause`, with the likely cause), and keep the residual `history` of the last attempt.
+    The message is one line; the attributes say where (the step, its load range t_from -> t_to:
+    t_from is the last converged load) and why (`cause`, with the likely cause), and keep the
+    residual `history` of the last attempt, the cost of the path up to there (`stats`), and what
+    a caller made of the converged part (`partial`, e.g. `fem.cup.CupResponse`; None if nothing).
     """
 
     def __init__(self, message: str, *, step: int = 0, t_from: float = math.nan,
-                 t_to: float = math.nan, cause: str = "", history: tuple[float, ...] = ()):
+                 t_to: float = math.nan, cause: str = "", history: tuple[float, ...] = (),
+                 stats: "SolverStats | None" = None):
         super().__init__(message)
         self.step, self.t_from, self.t_to = step, t_from, t_to
         self.cause, self.history = cause, tuple(history)
+        self.stats: SolverStats | None = stats
+        self.partial: Any = None
 
 
 @dataclass(frozen=True)
@@ -164,6 +170,9 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
                     f"(step halved below min_step = {options.min_step:g} of the range, last "
                     f"residual {last} after {len(fail.history)} iterations): {fail.cause}",
                     step=steps + 1, t_from=t, t_to=t1, cause=fail.cause, history=fail.history,
+                    stats=SolverStats(steps, iterations, cutbacks, time.perf_counter() - begin,
+                                      int(n), unstable, float(dissipated), policy.factorizations,
+                                      policy.failed),
                 ) from None
             continue
         W1 = m1.energy(u1)
