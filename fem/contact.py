@@ -6,7 +6,7 @@ eliminating its vertical dof like a Dirichlet condition; for ``"sticking"`` cont
 displacement is also frozen where it touched down. The nodal contact reaction lambda_a (the
 internal force at the eliminated dof, > 0 when the plane pushes) is what the constraint costs.
 Which nodes are held is decided inside each Newton step by a small linear complementarity
-problem (`fem.solver`): the nodes the step would push through the plane and the held nodes it
+problem (`fem.contact_step`): the nodes the step would push through the plane and the held nodes it
 would pull on; `project` puts any node that still penetrates back on the plane, `hold` records
 the new set. A converged step satisfies g >= 0, lambda >= 0, g lambda = 0 at the nodes (to the
 Newton tolerance), so there is no enforcement parameter whose value could change the result.
@@ -22,7 +22,7 @@ Coulomb friction (``"coulomb"``, coefficient mu): a held node sticks at its anch
 at the start of the load step, or where it touched down in it) while its tangential reaction
 |t| <= mu lambda, and slides otherwise with t = -mu lambda sign(Delta), Delta = u_r - anchor: the
 plane's friction opposes the slip. The step is the backward-Euler increment of the law (the
-history is the anchor, moved to the converged position by `commit`). Which nodes press, stick
+history is the anchor, moved to the converged position by `fem.laws.Coulomb.commit`). Which nodes press, stick
 and slide is decided in every Newton iteration on the linearized problem, exactly
 (`fem.friction`: a semismooth Newton method on Alart and Curnier's complementarity functions,
 whose augmentation moves the iterates only, not the solution). A sliding node's radial dof is
@@ -41,18 +41,16 @@ pointwise profile is the lumped projection p_a = lambda_a / sum_b M_ab, which is
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .interface import CONTACT_LAWS
 from .kinematics import Kinematics
 
-__all__ = ["RigidPlane", "ContactState", "PressureProfile", "CONTACT_LAWS"]
-
-ContactLaw = Literal["frictionless", "sticking", "coulomb"]
-CONTACT_LAWS = ("frictionless", "sticking", "coulomb")
+__all__ = ["RigidPlane", "ContactState", "PressureProfile", "PlaneLaw", "CONTACT_LAWS"]
 
 # 1D quadratic shape functions on s in [0, 1] for facet nodes (vertex 0, vertex 1, midpoint)
 _GAUSS_S, _GAUSS_W = np.polynomial.legendre.leggauss(4)
@@ -73,6 +71,29 @@ class ContactState:
     u_r_stick_m: np.ndarray    # float [ncand], where active: the radial displacement of the anchor
     #                            (sticking: the touchdown point; coulomb: the step's start or touchdown)
     slip: np.ndarray           # int8 [ncand]: coulomb: 0 sticks, +1 / -1 slides outward / inward
+
+
+class PlaneLaw(Protocol):
+    """What the path follower asks of a contact law (`fem.laws` holds the three laws)."""
+
+    name: ClassVar[str]             # one of CONTACT_LAWS
+    mu: float                       # Coulomb's coefficient (0 but for coulomb)
+    conservative: ClassVar[bool]    # the total energy is the path's potential
+    anchored: ClassVar[bool]        # held nodes keep their radial anchor
+
+    def step(self, plane: "RigidPlane", state: ContactState, u: np.ndarray, res: np.ndarray,
+             free: np.ndarray, du_fixed: np.ndarray, tol: float, friction: np.ndarray) -> Any:
+        """The Newton step of an iterate (`fem.contact_step.ContactStep`'s interface)."""
+
+    def friction_force(self, plane: "RigidPlane", state: ContactState,
+                       res: np.ndarray) -> np.ndarray | None:
+        """The plane's friction on the sliding nodes [N], or None for a law without friction."""
+
+    def cone_excess(self, plane: "RigidPlane", state: ContactState, r_int: np.ndarray) -> float:
+        """The largest excess of a stuck node over the friction cone / max lambda."""
+
+    def commit(self, plane: "RigidPlane", state: ContactState, u: np.ndarray) -> ContactState:
+        """The state carried into the next load step."""
 
 
 @dataclass(frozen=True)
@@ -97,21 +118,17 @@ class PressureProfile:
 
 @dataclass(frozen=True, eq=False)
 class RigidPlane:
-    """The rigid plane z = 0 and the boundary facets that may touch it."""
+    """The rigid plane z = 0, the boundary facets that may touch it, and the contact law
+    (`fem.laws`: frictionless, sticking, coulomb)."""
 
     kin: Kinematics
     facets: np.ndarray            # candidate boundary facets (global facet indices)
-    law: ContactLaw = "frictionless"
+    law: PlaneLaw
     exclude: np.ndarray | None = None   # nodes that are never candidates (e.g. clamped ones)
-    friction: float = 0.0               # Coulomb's coefficient mu (law "coulomb")
     nodes: np.ndarray = field(init=False, repr=False)           # the candidate nodes
     _facet_nodes: np.ndarray = field(init=False, repr=False)    # [3, nfacets]: vertices, midpoint
 
     def __post_init__(self) -> None:
-        if self.law not in CONTACT_LAWS:
-            raise ValueError(f"contact: must be one of {', '.join(CONTACT_LAWS)}, got {self.law!r}")
-        if not (np.isfinite(self.friction) and self.friction >= 0.0):
-            raise ValueError(f"friction: Coulomb's coefficient must be finite and >= 0, got {self.friction}")
         mesh = self.kin.mesh
         nv = int(mesh.t.max()) + 1      # number of vertices; Q2 edge nodes follow them
         # facet nodes: two vertices and the midpoint node (numbered after the vertices)
@@ -123,8 +140,8 @@ class RigidPlane:
         object.__setattr__(self, "nodes", nodes)
 
     @classmethod
-    def on(cls, kin: Kinematics, boundaries: list[str], exclude: list[str] = (),
-           law: ContactLaw = "frictionless", friction: float = 0.0) -> "RigidPlane":
+    def on(cls, kin: Kinematics, boundaries: list[str], law: PlaneLaw,
+           exclude: list[str] = ()) -> "RigidPlane":
         """Candidates: the facets of the named boundaries, minus nodes on the `exclude` boundaries."""
         mesh = kin.mesh
         facets = np.unique(np.concatenate([mesh.boundaries[b] for b in boundaries]))
@@ -132,7 +149,7 @@ class RigidPlane:
         if exclude:
             excl = np.unique(np.concatenate(
                 [kin.basis.get_dofs(mesh.boundaries[b]).all() // 2 for b in exclude]))
-        return cls(kin, facets, law, excl, friction)
+        return cls(kin, facets, law, excl)
 
     # --- the state -----------------------------------------------------------------------
     def initial_state(self) -> ContactState:
@@ -149,7 +166,7 @@ class RigidPlane:
         a = np.flatnonzero(state.active)
         dofs = [2 * self.nodes[a] + 1]
         vals = [-self.kin.node_coordinates()[1, self.nodes[a]]]
-        if self.law != "frictionless":
+        if self.law.anchored:
             stuck = a[state.slip[a] == 0]
             dofs.append(2 * self.nodes[stuck])
             vals.append(state.u_r_stick_m[stuck])
@@ -172,7 +189,7 @@ class RigidPlane:
         g = self.gap(u)
         land = ~on_plane & (g < 0.0)
         out[2 * nodes[on_plane | land] + 1] = -Z[on_plane | land]
-        if self.law != "frictionless":
+        if self.law.anchored:
             held = on_plane & state.active & (state.slip == 0)
             out[2 * nodes[held]] = state.u_r_stick_m[held]
             if np.any(land):
@@ -194,7 +211,7 @@ class RigidPlane:
         held anew sticks first (`fem.friction` decides from the next iteration on)."""
         new = active & ~state.active
         stick = state.u_r_stick_m.copy()
-        if self.law != "frictionless" and np.any(new):
+        if self.law.anchored and np.any(new):
             nodes = self.nodes[new]
             g0, g1 = self.gap(u_start)[new], self.gap(u_free)[new]
             fly = (g1 < 0.0) & ~released[new]
@@ -202,39 +219,6 @@ class RigidPlane:
             r1 = np.where(fly, u_free[2 * nodes], u[2 * nodes])
             stick[new] = u_start[2 * nodes] + np.clip(t, 0.0, 1.0) * (r1 - u_start[2 * nodes])
         return ContactState(active, stick, np.where(active & ~new, state.slip, 0).astype(np.int8))
-
-    # --- Coulomb friction (module docstring) -----------------------------------------------
-    def friction_bound(self, res: np.ndarray) -> np.ndarray:
-        """g = mu max(lambda, 0) [N] per candidate, lambda the normal reaction in `res`."""
-        return self.friction * np.maximum(self.reactions(res), 0.0)
-
-    def friction_force(self, state: ContactState, res: np.ndarray) -> np.ndarray:
-        """The plane's friction on the sliding nodes, -mu lambda s at their radial dofs [N]
-        (lambda from `res`, the residual without friction); zero for the other laws."""
-        f = np.zeros_like(res)
-        if self.law == "coulomb":
-            s = state.active & (state.slip != 0)
-            f[2 * self.nodes[s]] = -self.friction_bound(res)[s] * state.slip[s]
-        return f
-
-    def cone_excess(self, state: ContactState, r_int: np.ndarray) -> float:
-        """Coulomb: the largest excess of a sticking node's tangential reaction over the cone,
-        max(|t| - mu lambda, 0), relative to the largest nodal normal reaction; 0 for the other
-        laws. Round-off at a converged state (`fem.friction` solves the cone exactly)."""
-        a = state.active & (state.slip == 0)
-        if self.law != "coulomb" or not a.any():
-            return 0.0
-        lam = self.reactions(r_int)
-        excess = np.abs(r_int[2 * self.nodes[a]]) - self.friction * np.maximum(lam[a], 0.0)
-        return float(max(np.max(excess), 0.0) / max(np.max(lam[state.active]), 1e-300))
-
-    def commit(self, state: ContactState, u: np.ndarray) -> ContactState:
-        """The state carried into the next load step: Coulomb anchors move to the converged
-        positions (the law is incremental); sticking anchors stay where the nodes touched down."""
-        if self.law != "coulomb":
-            return state
-        anchor = np.where(state.active, u[2 * self.nodes], state.u_r_stick_m)
-        return ContactState(state.active, anchor, state.slip)
 
     # --- post-processing -----------------------------------------------------------------
     def _positions(self, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:

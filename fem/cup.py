@@ -1,59 +1,41 @@
 """The cup job: press the cup's top plate down onto the rigid plane z = 0 and record its response.
 
-    from fem.material import NeoHookean
-    from fem.cup import compress_cup
-    resp = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact="frictionless", u_max_m=5e-3)
+    from fem import ContactLaw, NeoHookean, compress_cup
+    resp = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact=ContactLaw("frictionless"),
+                        u_max_m=5e-3)
     resp.F0_N, resp.r_c_m, resp.l_m, resp.V_m3        # per converged step, at resp.u_m
     resp.write_fields("cup.vtu")                        # displacement, Cauchy stress, pressure
 
 The mesh is a scikit-fem ``MeshQuad2`` (or ``MeshTri2``) of the cross-section in metres (x = r,
 y = z) with the boundary tags 'top_plate' (the edge at r0, clamped to the rigid plate) and 'cavity'
-(the lower, cavity-facing surface, from the plate down to the rim); 'outer' and 'rim' are usual
-(`fem.mesh`) but not needed. The rim's inner corner rests on the plane, z = 0, in the undeformed
-state. h1 is the height of the lowest top-plate node.
+(the lower, cavity-facing surface, from the plate down to the rim; `fem.mesh`). The rim's inner
+corner rests on the plane in the undeformed state; h1 is the height of the lowest top-plate node.
 
 Loading (Sec. 5.3): the plate moves down by u (displacement control), h = h1 - u; the top-plate
-nodes follow it rigidly (u_r = 0, u_z = -u). Every boundary node except those on the plate may
-touch the plane (`fem.contact`); the contact zones are whatever the solution makes them. A
-converged state in which a facet dips below the plane between its nodes, beyond 5 % of the rim's
-thickness, or in which the wall's outline crosses itself (a fold: no self-contact is modelled)
-ends the path with `fem.integrity.StateRejected` saying where and why (`fem.integrity`).
+nodes follow it rigidly (u_r = 0, u_z = -u). Every other boundary node may touch the plane under
+the chosen contact law (`fem.contact`, `fem.laws`); the contact zones are whatever the solution
+makes them. A converged state that dips below the plane between its nodes or whose wall outline
+crosses itself (no self-contact is modelled) ends the path with `fem.integrity.StateRejected`.
 
-The pressure profile p(r) (`fem.contact.PressureProfile`) holds the lumped nodal pressure of the
-nodes in contact, sorted by deformed radius, and the consistent L2 projection at the boundary
-Gauss points (for integrals). r_c, the strip widths and V come from the pure functions of
-`fem.postprocess`.
+Per converged step `CupResponse` holds (SI; the measures are the pure functions of
+`fem.postprocess`, docs/fem.md and docs/stiffness.md discuss them):
 
-Per converged step, `CupResponse` holds (all SI):
-
-* ``F0_N``: the reaction on the top plate, the cup spring force F0 (eq. 7); ``F0_contact_N``: the
-  integrated contact force 2 pi int p r dr, which equals F0 by equilibrium (a check, both stored);
-* ``r_c_m``: the inner contact radius (eq. 3's r), `postprocess.inner_contact_radius`: between
-  the innermost node in contact and its free neighbour, where a square-root edge extrapolates to 0;
-* ``V_m3``: the cavity volume under the plate and inside the cup down to z = 0 (the region of
-  eq. 4), `postprocess.enclosed_volume` of the deformed cavity path down to its first contact;
-* ``l_m``: the strip width l handed to the reduced model (eq. 5's l, the width of the strip of
-  eq. 6 that carries the contact load): the force-quartile width 2 (r_75 - r_25) of the innermost
-  contact zone, the sealing strip next to r_c (`postprocess.quartile_width`: the middle half of
-  the strip's radial line force int p dr lies within l / 2; exact for a uniform strip; it rests on
-  the cumulative load only, so the singular pressure at a sharp corner moves it by what it carries,
-  and it does not use r_c, which jumps by a node spacing whenever the front passes a node; it
-  converges with the mesh: `benchmarks/bench_mesh_levels.py`); 0 where the mesh resolves no strip
-  (one loaded node: the rim corner alone); ``l_median_m``: the median-force width 2 (r_half - r_c)
-  (`postprocess.median_force_width`, scatters by the jumps of r_c);
-* ``l_weighted_m``: the pressure-weighted width (int p dA)^2 / (2 pi r_c int p^2 dA), dA = 2 pi r dr
-  (the integrals over the Gauss-point projection), l (1 + l / 2 r_c) for a uniform
-  strip; its int p^2 reacts to the singular rim-corner pressure, so it scatters 10-30 % between
-  mesh levels (kept for comparison); ``l_half_max_m``: the width at half maximum of the lumped nodal
-  pressure (`postprocess.half_maximum_width`);
-* ``penetration_m`` (largest violation of z >= 0 along the contact edges), ``energy_J`` (stored
-  elastic energy), ``newton_iterations``, ``unstable`` (the tangent lost definiteness in the step
-  that ended there: buckling or a snap, across which the path may jump, `fem.solver`), and the pressure profiles ``pressure[i]``;
-* ``min_stretch``: the smallest principal stretch anywhere in the wall (`postprocess.smallest_stretch`
-  at the quadrature points). Below Biot's 0.544 (`postprocess.BIOT_STRETCH`) a compressed free
-  surface can fold, and the curve from there on (`CupResponse.folding_u_m`) depends on the mesh:
-  cup A reaches it at the outer face next to the clamped plate, at ~0.83 h1 with sticking contact
-  (where the fine level's path turns unstable) and just at 0.9 h1 frictionless.
+* ``F0_N``: the plate reaction, the cup spring force F0 (eq. 7); ``F0_contact_N``: the
+  integrated contact force 2 pi int p r dr, equal to F0 by equilibrium (a check);
+* ``r_c_m``: the inner contact radius (eq. 3's r), `postprocess.inner_contact_radius`;
+* ``V_m3``: the cavity volume of eq. 4's region, `postprocess.enclosed_volume`;
+* ``l_m``: the strip width handed to the reduced model (eq. 5's l): the force-quartile width
+  2 (r_75 - r_25) of the innermost contact zone (`postprocess.quartile_width`: it rests on the
+  cumulative load only, so it converges with the mesh while r_c jumps by node spacings), 0 where
+  the mesh resolves no strip; for comparison ``l_median_m`` (median-force width),
+  ``l_weighted_m`` (pressure-weighted width, (int p dA)^2 / (2 pi r_c int p^2 dA), sensitive to
+  the singular rim-corner pressure) and ``l_half_max_m`` (width at half maximum);
+* ``pressure[i]``: the contact-pressure profile (`fem.contact.PressureProfile`: lumped nodal
+  values sorted by radius, and the consistent L2 projection at the Gauss points for integrals);
+* ``penetration_m``, ``energy_J``, ``newton_iterations``, ``unstable`` (the step crossed an
+  instability, `fem.solver`), ``cone_excess`` (Coulomb's cone check);
+* ``min_stretch``: the smallest principal stretch in the wall; below Biot's 0.544 a compressed
+  free surface can fold and the curve beyond (`CupResponse.folding_u_m`) depends on the mesh.
 """
 
 from __future__ import annotations
@@ -61,12 +43,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 from skfem import Mesh
 
 from .contact import PressureProfile, RigidPlane
+from .fields import write_fields
 from .interface import ContactLaw
 from .mesh import REQUIRED_BOUNDARIES, boundary_path, check_cup_mesh
 from .postprocess import (BIOT_STRETCH, enclosed_volume, half_maximum_width, inner_contact_radius,
@@ -74,10 +57,11 @@ from .postprocess import (BIOT_STRETCH, enclosed_volume, half_maximum_width, inn
 from .forms import Mechanics
 from .integrity import check_state
 from .kinematics import Kinematics
+from .laws import plane_law
 from .material import NeoHookean
-from .solver import SolverOptions, SolverStats, StepResult, follow_path
+from .solver import ConvergenceError, SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["compress_cup", "CupResponse", "cup_height", "REQUIRED_BOUNDARIES"]
+__all__ = ["compress_cup", "CupResponse", "CupSetup", "cup_height", "REQUIRED_BOUNDARIES"]
 
 
 
@@ -86,7 +70,7 @@ class CupResponse:
     """The cup's response per converged step (module docstring). Arrays are over steps."""
 
     h1_m: float
-    contact: str
+    contact: str                # the law's name (`contact_law`: the law with its mu)
     material: NeoHookean
     u_m: np.ndarray
     F0_N: np.ndarray
@@ -109,6 +93,12 @@ class CupResponse:
     nodal_pressure_Pa: tuple[np.ndarray, ...] = field(repr=False)
     friction: float = 0.0       # Coulomb's mu (contact "coulomb")
     cone_excess: np.ndarray | None = None   # Coulomb: largest excess over the cone / max lambda
+    partial: bool = False       # the converged part of a path that failed later (`compress_cup`)
+
+    @property
+    def contact_law(self) -> ContactLaw:
+        """The contact law of the run, with Coulomb's mu."""
+        return ContactLaw(self.contact, self.friction)
 
     @property
     def h_m(self) -> np.ndarray:
@@ -126,7 +116,6 @@ class CupResponse:
         """Write displacement, Cauchy stress (element means) and contact pressure on the reference
         mesh: one step as VTU (or another format meshio infers from the suffix), or, to an .xdmf,
         one step or every step (step=None) as a time series over u (`fem.fields`)."""
-        from .fields import write_fields
         return write_fields(self, path, step)
 
 
@@ -138,7 +127,7 @@ def cup_height(mesh: Mesh) -> float:
 
 
 def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
-                 contact: Literal["frictionless", "sticking", "coulomb"] = "frictionless",
+                 contact: ContactLaw | str = ContactLaw(),
                  u_max_m: float | None = None, friction: float = 0.0,
                  progress: Callable[[float, str], None] | None = None,
                  admissible_only: bool = True, **solver_opts: Any) -> CupResponse:
@@ -146,15 +135,17 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     reaches the plane; the steep rise of F0 where the wall is squeezed flat lies just below it)
     and return its `CupResponse`.
 
-    contact: the law at the plane (`fem.contact`): frictionless, sticking, or coulomb with
-    Coulomb's coefficient `friction` (mu in [0, 100]; `fem.interface.ContactLaw` checks both; a
-    design file's law is `fem.geometry.load_design(path).contact`).
+    contact: the law at the plane, a `fem.interface.ContactLaw` (frictionless, sticking, or
+    coulomb with Coulomb's mu in [0, 100]; a design file's law is
+    `fem.geometry.load_design(path).contact`); or, the older spelling, the law's name with mu as
+    `friction` (`fem.laws.plane_law` converts either).
     admissible_only: end the path with `fem.integrity.StateRejected` at the first converged state
     that violates contact between the nodes or crosses itself (module docstring); False follows
     the solver's path regardless (for studies of the solver itself).
     solver_opts: fields of `fem.solver.SolverOptions` (rtol, etol, max_iterations, initial_step,
     max_step, min_step, growth). Raises ValueError for bad input, `fem.solver.ConvergenceError`
-    (a RuntimeError) if a step cannot be converged.
+    (a RuntimeError) if a step cannot be converged; it carries the converged part as
+    ``exc.partial`` (a `CupResponse` flagged partial, up to u = exc.t_from).
     """
     h1 = cup_height(mesh)
     cup = CupSetup.of(mesh, material, contact, friction)
@@ -178,13 +169,24 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
             progress(s.t / u_max, f"step {len(steps) - 1}: u = {s.t * 1e3:.4g} mm of {u_max * 1e3:.4g} mm, "
                                   f"{s.iterations} Newton iterations")
 
-    stats = follow_path(mech, cup.plate_at(0.0), u_max, plane=plane, options=options,
-                        on_step=on_step, name="u [m]")
+    try:
+        stats = follow_path(mech, cup.plate_at(0.0), u_max, plane=plane, options=options,
+                            on_step=on_step, name="u [m]")
+    except ConvergenceError as exc:
+        if exc.stats is not None:       # the solver gave up: keep what converged
+            exc.partial = _response(steps, h1, plane, material, exc.stats, mesh, partial=True)
+        raise
+    return _response(steps, h1, plane, material, stats, mesh)
+
+
+def _response(steps: list["_StepOutputs"], h1: float, plane: RigidPlane, material: NeoHookean,
+              stats: SolverStats, mesh: Mesh, partial: bool = False) -> CupResponse:
+    """The `CupResponse` of the converged steps."""
     per_step = {f.name: np.array([getattr(st, f.name) for st in steps])
                 for f in fields(_StepOutputs) if f.name not in _PER_STEP_OBJECTS}
-    return CupResponse(h1_m=h1, contact=contact, friction=friction, material=material, stats=stats, mesh=mesh,
-                       **per_step, **{name: tuple(getattr(st, name) for st in steps)
-                                      for name in _PER_STEP_OBJECTS})
+    return CupResponse(h1_m=h1, contact=plane.law.name, friction=plane.law.mu, material=material,
+                       stats=stats, mesh=mesh, partial=partial, **per_step,
+                       **{name: tuple(getattr(st, name) for st in steps) for name in _PER_STEP_OBJECTS})
 
 
 @dataclass(frozen=True, eq=False)
@@ -198,15 +200,16 @@ class CupSetup:
     path: np.ndarray
 
     @classmethod
-    def of(cls, mesh: Mesh, material: NeoHookean, contact: str, friction: float = 0.0) -> "CupSetup":
-        """Check the contact law, Coulomb's mu (`fem.interface.ContactLaw`) and the material
-        (ValueError) and build the setup."""
-        ContactLaw(contact, friction)
+    def of(cls, mesh: Mesh, material: NeoHookean, contact: ContactLaw | str = ContactLaw(),
+           friction: float = 0.0) -> "CupSetup":
+        """Check the contact law (`fem.laws.plane_law`: a `ContactLaw`, or a name and Coulomb's mu)
+        and the material (ValueError) and build the setup."""
+        law = plane_law(contact, friction)
         if not isinstance(material, NeoHookean):
             raise ValueError(f"material: a fem.material.NeoHookean is required, got {type(material).__name__}")
         kin = Kinematics.of(mesh)
         top = _boundary_nodes(mesh, "top_plate")
-        plane = RigidPlane(kin, mesh.boundary_facets(), law=contact, exclude=top, friction=friction)
+        plane = RigidPlane(kin, mesh.boundary_facets(), law=law, exclude=top)
         return cls(Mechanics(kin, material), plane, top, boundary_path(mesh, "cavity"))
 
     def plate_at(self, u0_m: float, moving: bool = True) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
@@ -267,7 +270,7 @@ def _measure(s: StepResult, mech: Mechanics, plane: RigidPlane, top: np.ndarray,
         penetration_m=plane.largest_penetration(s.u), energy_J=s.energy_J,
         newton_iterations=s.iterations, unstable=s.unstable,
         min_stretch=float(np.min(smallest_stretch(mech.kin.deformation_gradient(s.u)))),
-        cone_excess=plane.cone_excess(s.contact, s.r_int),
+        cone_excess=plane.law.cone_excess(plane, s.contact, s.r_int),
         pressure=prof, displacements=s.u, nodal_pressure_Pa=p_nodes)
 
 

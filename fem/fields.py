@@ -18,19 +18,29 @@ from __future__ import annotations
 import os
 import secrets
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import meshio
 import numpy as np
+from skfem import Mesh
 
 from .forms import Mechanics
 from .kinematics import Kinematics
-from .material import cauchy_stress
+from .material import NeoHookean, cauchy_stress
 
-if TYPE_CHECKING:
-    from .cup import CupResponse
+__all__ = ["write_fields", "element_cauchy_stress", "FieldSeries"]
 
-__all__ = ["write_fields", "element_cauchy_stress"]
+
+class FieldSeries(Protocol):
+    """What the export reads of a path (`fem.cup.CupResponse` is one): the reference mesh, the
+    material, and per step the plate displacement, the displacement and the nodal pressure."""
+
+    mesh: Mesh
+    material: NeoHookean
+    u_m: np.ndarray
+    displacements: tuple[np.ndarray, ...]
+    nodal_pressure_Pa: tuple[np.ndarray, ...]
+
 
 # scikit-fem's Q2 (P2) node order per element equals VTK's biquadratic quad (quadratic triangle)
 # order: corners, then edge midpoints starting with edge 0-1, then the centre
@@ -44,7 +54,7 @@ def element_cauchy_stress(mech: Mechanics, u: np.ndarray) -> np.ndarray:
     return np.sum(s * dV, axis=2) / dV.sum(axis=1)
 
 
-def write_fields(resp: "CupResponse", path: str | Path, step: int | None = -1) -> Path:
+def write_fields(resp: FieldSeries, path: str | Path, step: int | None = -1) -> Path:
     """Write step `step` of `resp` (None: every step, .xdmf only) to `path`, atomically."""
     path = Path(path)
     n_steps = len(resp.u_m)
@@ -77,7 +87,7 @@ def write_fields(resp: "CupResponse", path: str | Path, step: int | None = -1) -
     return path
 
 
-def _step_data(resp: "CupResponse", mech: Mechanics, k: int) -> tuple[dict, dict]:
+def _step_data(resp: FieldSeries, mech: Mechanics, k: int) -> tuple[dict, dict]:
     """Point data (displacement, contact pressure) and cell data (Cauchy stress) of step k."""
     u = resp.displacements[k]
     disp = np.zeros((mech.kin.mesh.doflocs.shape[1], 3))

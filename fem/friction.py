@@ -1,7 +1,7 @@
 """Coulomb friction in the Newton iteration: the linearized frictional contact problem, solved exactly.
 
 The law and its state live in `fem.contact` (`RigidPlane`: held nodes, anchors, slip directions).
-Every Newton iteration of a load step (`fem.solver`) minimizes the quadratic model of the energy
+Every Newton iteration of a load step (`fem.newton`) minimizes the quadratic model of the energy
 subject to the linearized contact and friction conditions at the candidate nodes a:
 
     normal:      g_a + du_z,a >= 0,  lambda_a >= 0,  lambda_a (g_a + du_z,a) = 0
@@ -22,8 +22,7 @@ i.e. node a is pressed where lh > 0, sticks (Delta = 0) where |t - c_t Delta| <=
 of the condensed system; the coupling of a sliding node's friction to its normal reaction (Coulomb's
 law is not associated, the matrix is not symmetric) is in it exactly, so the outer Newton iteration
 keeps its quadratic rate and the stick/slide set is decided with the displacement instead of
-between iterations (that set cycled: 483 Newton iterations and 6 cut-backs on cup A, medium,
-mu = 0.3, against 97 and none so).
+between iterations, where it cycled (docs/fem.md, solver notes).
 
 The augmentation c > 0 (here the node's diagonal stiffness) cannot change a converged state: at a
 zero of the complementarity functions the conditions above hold for any c. In this form it does
@@ -48,7 +47,7 @@ _SSN_ITERATIONS = 30    # active-set guesses per Newton iteration (a cycle ends 
 
 
 class FrictionStep:
-    """The Newton step of one iterate for Coulomb contact (the interface of `fem.solver._Step`).
+    """The Newton step of one iterate for Coulomb contact (the interface of `fem.contact_step.ContactStep`).
 
     The base factor holds every node held at the iterate (z and r) and the prescribed dofs; the
     condensed problem then decides, in one iteration, which nodes are pressed, released, stuck or
@@ -67,7 +66,7 @@ class FrictionStep:
         self.state, self.settled = state, False
 
     def solve(self, solver, K, shift, history, policy, lower=True) -> float:
-        """Factor the base block (`factor`: `fem.solver._factor`, shifted if not positive
+        """Factor the base block (`factor`: `fem.factorization.factor_shifted`, shifted if not positive
         definite), solve the condensed problem, add the free nodes the step penetrates until none
         does. Returns the shift used."""
         plane, old = self.plane, self.old
@@ -119,7 +118,7 @@ class FrictionStep:
         """The merit test of a step that need not descend in the energy: the free residual of
         the new sets, friction included, falls by 1e-4 alpha of the iterate's."""
         base = r_trial - fext0
-        res = base - self.plane.friction_force(self.state, base)
+        res = base - self.plane.law.friction_force(self.plane, self.state, base)
         free = self.free.copy()
         free[self.plane.constraints(self.state)[0]] = False
         now = (self.res0 - self.friction)[self.free]
@@ -141,7 +140,7 @@ class _Condensed:
     def __init__(self, plane: RigidPlane, old: ContactState, u, res0, K: sp.csr_matrix, fac,
                  du0, held: np.ndarray, tol: float):
         self.plane, self.K, self.fac, self.du0, self.res0, self.tol = plane, K, fac, du0, res0, tol
-        self.mu, self.held, self.nodes = plane.friction, held, held.copy()
+        self.mu, self.held, self.nodes = plane.law.mu, held, held.copy()
         rd = 2 * plane.nodes
         self.rows = np.concatenate([rd[held] + 1, rd[held]])
         self.force = np.zeros(len(self.rows), bool)          # the unknown is a force

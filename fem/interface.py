@@ -3,9 +3,9 @@
 A design is its shape (`fem.geometry.CupGeometry`) and its interface (`ContactLaw`), kept apart:
 the same wall may be pressed on soapy glass (frictionless), on a dry plate (coulomb, mu) or held
 where it lands (sticking). This module is the one place that checks a law and its mu, whoever
-gives them: the Python API (`fem.cup.CupSetup.of`), a design file's ``[contact]`` table
-(`contact_from_mapping`), a scene's ``[contact]`` table and the command line's ``--contact`` /
-``--friction``. Each names its fields in its own words (`Spelling`), so every error is one line
+gives them: the Python API (`fem.laws.plane_law`, which turns it into the solver's law object),
+a design file's ``[contact]`` table (`contact_from_mapping`), a scene's ``[contact]`` table and
+the command line's ``--contact`` / ``--friction``. Each names its fields in its own words (`Spelling`), so every error is one line
 that names the field as the user wrote it.
 
 `choose_contact` says which law a run uses: the explicitly given one (command line, scene) wins
@@ -25,7 +25,7 @@ from typing import Any
 __all__ = ["ContactLaw", "ContactChoice", "Spelling", "CONTACT_LAWS", "MAX_FRICTION", "API", "FILE",
            "contact_law", "contact_from_mapping", "choose_contact"]
 
-#: the laws of `fem.contact.RigidPlane` (the same tuple; this module imports no FEM machinery)
+#: the laws of `fem.laws` (`fem.contact` re-exports this tuple; this module imports no FEM machinery)
 CONTACT_LAWS = ("frictionless", "sticking", "coulomb")
 #: largest Coulomb coefficient accepted: far beyond any real pair (mu = 2 already sticks, docs/stiffness.md)
 MAX_FRICTION = 100.0

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 from skfem import Mesh
@@ -30,6 +30,7 @@ from .cavity import CavitySurface, PressurizedMechanics
 from .contact import PressureProfile
 from .cup import CupSetup, _joined, _measure, cup_height
 from .integrity import check_state
+from .interface import ContactLaw
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
@@ -41,7 +42,7 @@ class SuctionGrid:
     """The cup's converged states on the grid (module docstring); arrays are [len(u), len(dp)]."""
 
     h1_m: float
-    contact: str
+    contact: str                # the law's name (`contact_law`: the law with its mu)
     friction: float             # Coulomb's mu (0 for the other laws)
     material: NeoHookean
     u_m: np.ndarray
@@ -56,15 +57,21 @@ class SuctionGrid:
     profiles: tuple[tuple[PressureProfile, ...], ...] = field(repr=False)
     stats: SolverStats = field(repr=False)
 
+    @property
+    def contact_law(self) -> ContactLaw:
+        """The contact law of the grid, with Coulomb's mu."""
+        return ContactLaw(self.contact, self.friction)
+
 
 def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: Sequence[float],
-                 contact: Literal["frictionless", "sticking", "coulomb"] = "frictionless",
+                 contact: ContactLaw | str = ContactLaw(),
                  friction: float = 0.0, wetting_m: float = 0.0,
                  progress: Callable[[float, str], None] | None = None,
                  **solver_opts: Any) -> SuctionGrid:
     """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in (0, h1];
-    dp_Pa: increasing, starting at 0. Raises ValueError for bad input, `fem.solver.ConvergenceError`
-    naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
+    dp_Pa: increasing, starting at 0. contact: a `fem.interface.ContactLaw`, or the law's name
+    with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input,
+    `fem.solver.ConvergenceError` naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
     converged state violates contact between the nodes or folds onto itself."""
     h1 = cup_height(mesh)
     u = np.asarray(u_m, float)
@@ -111,7 +118,7 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
                          f"u = {u_i * 1e3:.4g} mm, dp = {hi / 1e3:.4g} kPa")
     take = np.vectorize(lambda o, k: o[k], otypes=[float])
     return SuctionGrid(
-        h1_m=h1, contact=contact, friction=cup.plane.friction, material=material, u_m=u, dp_Pa=dp,
+        h1_m=h1, contact=cup.plane.law.name, friction=cup.plane.law.mu, material=material, u_m=u, dp_Pa=dp,
         F1_N=take(outputs, 0), contact_force_N=take(outputs, 1), V_m3=take(outputs, 2),
         seal_r_m=take(outputs, 3), cut_r_m=take(outputs, 4), r_c_m=take(outputs, 5),
         potential_J=take(outputs, 6),

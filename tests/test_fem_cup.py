@@ -275,3 +275,21 @@ def test_wall_compression_reaches_the_folding_stretch_only_at_the_steep_end(fric
         assert np.all(np.diff(resp.min_stretch[steep]) < 0)
     assert 0.75 * H1 < sticking.folding_u_m < 0.9 * H1
     assert frictionless.folding_u_m is None or frictionless.folding_u_m > 0.88 * H1
+
+
+def test_a_path_that_fails_late_keeps_its_converged_part(mesh):
+    """A Newton budget of 4 iterations gives up after some steps: the error carries the converged
+    steps as a partial CupResponse up to u = t_from, and its last state is the cup's own
+    (frictionless contact is path independent: a default run to that u ends at the same F0 and
+    r_c, to the solver's tolerance; measured 1e-8 and 2e-11)."""
+    mat = NeoHookean(E_Pa=4e6, nu=0.49)
+    with pytest.raises(ConvergenceError) as info:
+        compress_cup(mesh, mat, max_iterations=4, min_step=0.005)
+    exc, part = info.value, info.value.partial
+    assert part.partial and part.u_m[-1] == exc.t_from > 0.0
+    assert len(part.u_m) == part.stats.steps + 1 >= 3
+    assert part.stats.cutbacks > 0 and np.all(part.newton_iterations < 4)
+    ref = compress_cup(mesh, mat, u_max_m=exc.t_from)
+    assert not ref.partial
+    assert part.F0_N[-1] == pytest.approx(ref.F0_N[-1], rel=1e-6)      # the solver's rtol
+    assert part.r_c_m[-1] == pytest.approx(ref.r_c_m[-1], rel=1e-6)

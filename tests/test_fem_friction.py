@@ -15,6 +15,7 @@ import pytest
 from skfem import MeshQuad, MeshQuad2
 
 from fem.contact import RigidPlane
+from fem.laws import Coulomb
 from fem.cup import CupSetup, compress_cup
 from fem.forms import Mechanics
 from fem.geometry import cup_geometry
@@ -77,7 +78,7 @@ def _press_and_shear(mu, R=2.0, press_m=2e-5, shear_m=2e-4, steps=40):
     outward by shear_m (t in [1, 2]), bottom nodes in Coulomb contact. Returns the states."""
     mesh = _ring(R)
     kin = Kinematics.of(mesh)
-    plane = RigidPlane.on(kin, ["bottom"], law="coulomb", friction=mu)
+    plane = RigidPlane.on(kin, ["bottom"], Coulomb(mu))
     top = np.unique(kin.basis.get_dofs(mesh.boundaries["top"]).all() // 2)
     dofs = np.concatenate([2 * top, 2 * top + 1])
 

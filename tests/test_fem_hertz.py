@@ -44,6 +44,7 @@ import pytest
 
 from fem.blocks import mapped_block
 from fem.contact import RigidPlane
+from fem.laws import Frictionless
 from fem.forms import Mechanics
 from fem.kinematics import Kinematics
 from fem.material import NeoHookean
@@ -87,7 +88,7 @@ def press(cells_per_a: float, nu: float = 0.3, formulation: str = "displacement"
     mesh = hertz_block(cells_per_a)
     kin = Kinematics.of(mesh)
     mat = NeoHookean(4e6, nu, formulation)
-    plane = RigidPlane.on(kin, ["bottom"])
+    plane = RigidPlane.on(kin, ["bottom"], Frictionless())
     axis = np.unique(kin.basis.get_dofs(mesh.boundaries["left"]).all() // 2)
     top = np.unique(kin.basis.get_dofs(mesh.boundaries["top"]).all() // 2)
     dofs = np.concatenate([2 * axis, 2 * top + 1])

@@ -26,7 +26,10 @@ from fem.cup import compress_cup
 from fem.linsolve import BandedCholesky
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
-from fem.solver import SolverOptions, _ShiftPolicy, _balanced, _extrapolate, _factor
+from fem.factorization import ShiftPolicy, factor_shifted
+from fem.linesearch import extrapolate
+from fem.newton import balanced
+from fem.solver import SolverOptions
 from validation.crosscheck.runs import FemRun
 
 
@@ -101,9 +104,9 @@ def test_shift_stays_near_the_critical_one():
     coords = np.vstack([np.arange(n // 2, dtype=float), np.zeros(n // 2)])
     solver = BandedCholesky(K, coords)
     crit = -np.linalg.eigvalsh(A)[0]
-    _, shift = _factor(solver, K, np.ones(n, bool), 0.0, [])
+    _, shift = factor_shifted(solver, K, np.ones(n, bool), 0.0, [])
     assert crit < shift <= 10.0 * crit * (1 + 1e-12) or crit < shift <= 1e-10
-    _, again = _factor(solver, K, np.ones(n, bool), shift, [])
+    _, again = factor_shifted(solver, K, np.ones(n, bool), shift, [])
     assert again == pytest.approx(shift)      # tried tenfold smaller, failed, back
 
 
@@ -111,10 +114,10 @@ def test_round_off_residual_is_accepted_only_with_a_vanishing_correction():
     """||r|| = 1.2 tol is accepted when the Newton correction is below 1e-12 of u (round-off: it
     cannot be reduced), not when the correction is still 1e-9 of u, and never above 100 tol."""
     u = np.full(4, 3e-3)
-    assert _balanced(0.9, 1.0, np.full(4, 1.0), u)
-    assert _balanced(1.2, 1.0, np.full(4, 2e-16), u)
-    assert not _balanced(1.2, 1.0, np.full(4, 3e-12), u)
-    assert not _balanced(101.0, 1.0, np.zeros(4), u)
+    assert balanced(0.9, 1.0, np.full(4, 1.0), u)
+    assert balanced(1.2, 1.0, np.full(4, 2e-16), u)
+    assert not balanced(1.2, 1.0, np.full(4, 3e-12), u)
+    assert not balanced(101.0, 1.0, np.zeros(4), u)
 
 
 def test_jump_options_are_validated():
@@ -143,13 +146,13 @@ def test_shift_search_is_short_and_remembers_the_last_episode():
     one: <= 6 factorizations. Both end within the factor of ten above the critical shift."""
     K, solver, crit = _indefinite(1e-2)
     free = np.ones(K.shape[0], bool)
-    policy = _ShiftPolicy()
-    _, shift = _factor(solver, K, free, 0.0, [], policy)
+    policy = ShiftPolicy()
+    _, shift = factor_shifted(solver, K, free, 0.0, [], policy)
     assert crit < shift <= 10.0 * crit
     assert policy.factorizations <= 8 and policy.failed >= 1
     first = policy.factorizations
     K2, solver2, crit2 = _indefinite(3e-3, seed=5)      # the next episode, a little milder
-    _, shift2 = _factor(solver2, K2, free, 0.0, [], policy)
+    _, shift2 = factor_shifted(solver2, K2, free, 0.0, [], policy)
     assert crit2 < shift2 <= 10.0 * crit2
     assert policy.factorizations - first <= 6
 
@@ -183,7 +186,7 @@ def test_shifted_step_is_extrapolated_down_the_valley(wall, expected):
     Pi, r, _ = mech.evaluate(u)
     trial = np.array([1.0])
     Pi1, r1, K1 = mech.evaluate(trial)
-    alpha, u1, Pi_a, r_a, _ = _extrapolate(mech, _UnitStep(), u, u, Pi, r, np.zeros(1), trial,
+    alpha, u1, Pi_a, r_a, _ = extrapolate(mech, _UnitStep(), u, u, Pi, r, np.zeros(1), trial,
                                            Pi1, r1, K1, 0.0)
     assert alpha == expected and u1[0] == expected
     assert Pi_a == mech.energy(u1) < Pi1 and r_a[0] == expected - 6.0

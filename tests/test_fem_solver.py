@@ -20,7 +20,7 @@ from fem.kinematics import Kinematics
 from fem.linsolve import BandedCholesky, NotPositiveDefinite, _half_bandwidth, wall_ordering
 from fem.material import NeoHookean
 from fem.mesh import FIDELITIES, cup_mesh
-from fem.solver import _lcp
+from fem.contact_step import lcp
 
 GEOMETRY = cup_geometry("A")
 
@@ -88,7 +88,7 @@ def test_lcp_satisfies_complementarity():
     A = rng.normal(size=(12, 12))
     S = A @ A.T + 0.1 * np.eye(12)
     q = rng.normal(size=12)
-    lam = _lcp(S, q)
+    lam = lcp(S, q)
     w = q + S @ lam
     scale = np.max(np.abs(q))
     assert lam.min() >= 0 and w.min() >= -1e-10 * scale
