@@ -178,10 +178,12 @@ class CupWithGas:
 
 @dataclass(frozen=True, eq=False)
 class CupPath:
-    """The states of `cup_path`, in order, and the cost of the whole path."""
+    """The states of `cup_path`, in order, the contact law and the cost of the whole path."""
 
     states: tuple[GasState, ...]
     stats: SolverStats
+    contact: str
+    friction: float
 
     def column(self, name: str) -> np.ndarray:
         """One field of every state as an array, e.g. column("p_b_Pa")."""
@@ -204,4 +206,4 @@ def cup_path(mesh: Mesh, material: NeoHookean, u_press_m: float, u_pulled_m: flo
     pressed = cup.press(u_press_m)
     pulled = cup.move_plate(pressed[-1], u_pulled_m)
     leaked = cup.let_in(pulled[-1], N_end_ratio * pulled[-1].N)
-    return CupPath(tuple(pressed + pulled[1:] + leaked[1:]), cup.stats)
+    return CupPath(tuple(pressed + pulled[1:] + leaked[1:]), cup.stats, contact, cup.cup.plane.friction)
