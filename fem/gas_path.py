@@ -108,7 +108,7 @@ class CupWithGas:
         return self._run(lambda on_step: follow_path(
             mech, self._plate(u0, +1.0), u_m - u0, plane=self.cup.plane, options=self.options,
             on_step=on_step, start=None if start is None else start.state, name="u [m]"),
-            lambda s: (mech, None, u0 + s.t, "pressed"), skip_first=start is not None)
+            lambda s: (mech, u0 + s.t, "pressed"), skip_first=start is not None)
 
     def move_plate(self, start: GasState, u_m: float, N: float | None = None) -> list[GasState]:
         """Move the plate from start's position to u_m (up: u_m smaller) with N molecules sealed
@@ -159,7 +159,7 @@ class CupWithGas:
                    u_at: Callable[[float], float], stage: str) -> list[GasState]:
         return self._run(lambda on_step: follow_gas_path(
             mech, plate, t_max, plane=self.cup.plane, start=start.state, options=self.options,
-            on_step=on_step), lambda s: (mech.at(s.t), None, u_at(s.t), stage), skip_first=True,
+            on_step=on_step), lambda s: (mech.at(s.t), u_at(s.t), stage), skip_first=True,
             first=start)
 
     def _run(self, run, describe, skip_first: bool, first: GasState | None = None) -> list[GasState]:
@@ -171,8 +171,7 @@ class CupWithGas:
         for k, s in enumerate(steps):
             if k == 0 and skip_first:
                 continue
-            mech, _, u_m, stage = describe(s)
-            states.append(self.measure(s, mech, u_m, stage))
+            states.append(self.measure(s, *describe(s)))
         return states
 
 

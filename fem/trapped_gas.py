@@ -20,8 +20,9 @@ formula on the solver's factor of the sparse part (`RankOneFactor`: one more bac
 factor), which keeps the minimization form the solver's line search and contact QP rely on;
 a bordered system with V (or p_b) as an extra unknown is the same elimination written as a
 saddle point, which the energy line search could not use. The gas term is what keeps the path
-stable at fixed N where the wall snaps at fixed dp: N k_B T / V^2 (dV/du)^2 ~ p_b (pi r^2)^2 / V
-is some 30 times the cup's own stiffness for cup A.
+stiff at fixed N: against the plate, N k_B T / V^2 (dV/du)^2 ~ p_b (pi r_k^2)^2 / V is ~4e4 N/m
+for cup A pulled at 1.5 mm, tens of times the pressed cup's own ~7e2 N/m, and it holds the wall
+where at fixed dp it would snap.
 
 `fem.solver.follow_path` builds its linear solver from the tangent's pattern by `make_solver`;
 `follow_gas_path` runs it with that factory wrapped (`RankOneSolver`) for the duration of the
