@@ -1,0 +1,197 @@
+"""The cavity's trapped gas in the FEM (fem/trapped_gas.py) and the sealed cup's path
+(fem/gas_path.py): the rank-one tangent against dense linear algebra and finite differences,
+frictionless (u, N) states against the dp-driven states of fem.suction (path independence),
+global equilibrium of plate, contact and suction, and the sealed cup pulled and leaked into."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from fem.cavity import CavitySurface, PressurizedMechanics
+from fem.condensation import make_solver
+from fem.cup import CupSetup
+from fem.geometry import cup_geometry
+from fem.gas_path import CupWithGas, cup_path
+from fem.material import NeoHookean
+from fem.mesh import cup_mesh
+from fem.solver import SolverOptions, follow_path
+from fem.suction import suction_grid
+from fem.trapped_gas import K_B, GasMechanics, GasTangent, RankOneSolver, TrappedGas
+
+RTOL = 1e-9      # tight solver tolerance: states compared across two paths to ~1e-6
+
+
+@pytest.fixture(scope="module")
+def mesh():
+    return cup_mesh(cup_geometry("A"), "coarse")
+
+
+@pytest.fixture(scope="module", params=["frictionless", "sticking"])
+def path(request, mesh):
+    return cup_path(mesh, NeoHookean(), 3e-3, 1.5e-3, 1.3, contact=request.param, rtol=RTOL)
+
+
+@pytest.fixture(scope="module")
+def frictionless(mesh):
+    return cup_path(mesh, NeoHookean(), 3e-3, 1.5e-3, 1.3, rtol=RTOL)
+
+
+def _gas_mech(mesh, state):
+    cup = CupWithGas.of(mesh, NeoHookean())
+    return cup, GasMechanics(cup.cup.mech, cup.cavity, TrappedGas(state.N))
+
+
+def test_rank_one_factor_solves_the_full_tangent(mesh, frictionless):
+    """The Newton step with the rank-one term (Sherman-Morrison on the sparse part's banded
+    factor) equals a dense solve of K + c g g^T on the free dofs, with prescribed values on the
+    plate and contact dofs, and after freeing some of those (the solver's bordered factor)."""
+    s = next(s for s in frictionless.states if s.stage == "pulled" and s.dp_Pa > 5e3)
+    cup, mech = _gas_mech(mesh, s)
+    _, K = mech.linearize(s.state.u)
+    assert isinstance(K, GasTangent)
+    c, g = K.rank_one
+    dense = K.toarray() + c * np.outer(g, g)
+    n = K.shape[0]
+    rng = np.random.default_rng(3)
+    d = rng.standard_normal(n)
+    assert np.allclose(K @ d, dense @ d, rtol=1e-12, atol=1e-12 * np.abs(dense @ d).max())
+    contact_z = 2 * cup.cup.plane.nodes[s.state.contact.active] + 1
+    fixed = np.concatenate([2 * cup.cup.top, 2 * cup.cup.top + 1, contact_z])
+    free = np.ones(n, bool)
+    free[fixed] = False
+    du_fixed = np.zeros(n)
+    du_fixed[fixed] = 1e-6 * rng.standard_normal(fixed.size)
+    rhs = rng.standard_normal(n)
+    solver = RankOneSolver(make_solver(K.plain(), mech.kin.node_coordinates(), mesh))
+    fac = solver.factor(K, free)
+
+    def reference(free):
+        x = np.where(free, 0.0, du_fixed)
+        b = rhs - dense @ x
+        x[free] = np.linalg.solve(dense[np.ix_(free, free)], b[free])
+        return x
+
+    x = fac.solve(rhs, du_fixed)
+    assert np.linalg.norm(x - reference(free)) <= 1e-8 * np.linalg.norm(x)
+    let_go = contact_z[:2]
+    wider = free.copy()
+    wider[let_go] = True
+    x = fac.freeing(let_go).solve(rhs, du_fixed)
+    assert np.linalg.norm(x - reference(wider)) <= 1e-8 * np.linalg.norm(x)
+
+
+def test_gas_potential_force_and_tangent_are_exact(mesh, frictionless):
+    """Central differences on a deformed, sucked state: dPi/du is the force (with dp = p_a -
+    N k_B T / V), and the derivative of the force is the tangent with its rank-one term. The
+    nodes on the plane keep their height (V_cav is cut there: piecewise smooth, `fem.cavity`)."""
+    s = frictionless.states[-1]
+    _, mech = _gas_mech(mesh, s)
+    u = s.state.u
+    rng = np.random.default_rng(5)
+    d = rng.standard_normal(u.size) * 1e-9
+    on_plane = np.flatnonzero(mech.coordinates(u)[1] <= mech.cavity.tolerance_m)
+    assert on_plane.size > 3
+    d[2 * on_plane + 1] = 0.0
+    E, r, K = mech.evaluate(u)
+    fd_E = (mech.energy(u + d) - mech.energy(u - d)) / 2.0
+    assert fd_E == pytest.approx(r @ d, rel=1e-6)
+    fd_r = (mech.internal_force(u + d) - mech.internal_force(u - d)) / 2.0
+    assert np.linalg.norm(fd_r - K @ d) <= 1e-5 * np.linalg.norm(K @ d)
+    # along the path (the cavity grows as a whole) the rank-one term is most of the stiffness
+    d = 1e-3 * (frictionless.states[-2].state.u - u)
+    d[2 * on_plane + 1] = 0.0
+    fd_r = (mech.internal_force(u + d) - mech.internal_force(u - d)) / 2.0
+    assert np.linalg.norm(fd_r - K @ d) <= 1e-5 * np.linalg.norm(K @ d)
+    assert np.linalg.norm(fd_r - K.plain() @ d) > 0.1 * np.linalg.norm(K @ d)
+    V = mech.volume_m3(u)
+    assert mech.dp_Pa(u) == pytest.approx(1e5 - s.N * K_B * 293.15 / V, rel=1e-12)
+
+
+def test_frictionless_states_equal_the_dp_driven_states(mesh, frictionless):
+    """Frictionless states are path independent: a state reached by pressing, sealing, pulling
+    and letting gas in is an equilibrium of the dp-driven problem at its dp = p_a - N k_B T / V
+    (the dp solver started there moves it by round-off), and equals the state of `suction_grid`
+    (pressed to u, then dp ramped at the held plate). The two paths may leave a node of the
+    outer contact zone, where the reaction is ~0, on the plane or 1e-8..1e-7 m above it (a
+    marginal contact both admit): F1 and N_c agree to 3e-6 of the suction's resultant."""
+    pulled = [s for s in frictionless.states if s.stage == "pulled"]
+    leaked = [s for s in frictionless.states if s.stage == "leaked"]
+    cup = CupSetup.of(mesh, NeoHookean(), "frictionless")
+    cavity = CavitySurface.of(mesh)
+    for s in (pulled[len(pulled) // 2], pulled[-1], leaked[len(leaked) // 2]):
+        again = []
+        follow_path(PressurizedMechanics(cup.mech, cavity, s.dp_Pa), cup.plate_at(s.u_m, moving=False),
+                    1.0, plane=cup.plane, start=s.state, on_step=again.append,
+                    options=SolverOptions(rtol=RTOL, initial_step=1.0, max_step=1.0))
+        assert np.max(np.abs(again[-1].u - s.state.u)) <= 1e-10 * np.max(np.abs(s.state.u))
+        g = suction_grid(mesh, NeoHookean(), u_m=[s.u_m], dp_Pa=[0.0, s.dp_Pa], rtol=RTOL)
+        scale = s.dp_Pa * np.pi * s.seal_r_m**2          # the suction's resultant
+        assert abs(g.F1_N[0, 1] - s.F1_N) <= 3e-6 * scale
+        assert abs(g.contact_force_N[0, 1] - s.contact_force_N) <= 3e-6 * scale
+        assert g.V_m3[0, 1] == pytest.approx(s.V_m3, rel=1e-6)
+        assert g.seal_r_m[0, 1] == pytest.approx(s.seal_r_m, rel=1e-6)
+
+
+def test_plate_contact_and_suction_balance(mesh, path):
+    """Global equilibrium of every sealed state: the pull on the handle (the plate's reaction),
+    the contact resultant (the integral of the contact pressure) and the suction dp pi r_cut^2
+    over the wall's projection up to the end of the loaded chain balance to round-off."""
+    cavity = CavitySurface.of(mesh)
+    X = mesh.doflocs
+    for s in path.states:
+        x = X + np.stack([s.state.u[0::2], s.state.u[1::2]])
+        r_cut = x[0, cavity.nodes[cavity.cut_index(x)]]
+        contact = float(np.sum(s.profile.p_gauss_Pa * s.profile.w_m2))
+        p_b = s.N * K_B * 293.15 / cavity.volume(x)          # the gas law on the geometric volume
+        suction = (1e5 - p_b) * np.pi * r_cut**2
+        assert abs(s.F1_N + contact - suction) <= 1e-7 * max(contact, abs(s.F1_N))
+
+
+def test_sealed_cup_pulled_at_fixed_N_holds_harder(path):
+    """Raising the plate at fixed N enlarges the cavity, so p_b = N k_B T / V falls and the
+    handle's pull rises; letting gas in at the held plate does the opposite (frictionless: the
+    cup relaxes; sticking: the seal held, the same signs)."""
+    pulled = [s for s in path.states if s.stage == "pulled"]
+    assert len(pulled) > 5
+    assert len({s.N for s in pulled}) == 1
+    assert np.all(np.diff([s.V_m3 for s in pulled]) > 0)
+    assert np.all(np.diff([s.p_b_Pa for s in pulled]) < 0)
+    assert np.all(np.diff([s.F1_N for s in pulled]) > 0)
+    assert pulled[-1].F1_N > pulled[0].F1_N + 2.0          # N: a real pull, not round-off
+    sealed = [s for s in path.states if s.stage == "pressed"][-1]
+    assert sealed.p_b_Pa == pytest.approx(1e5, rel=1e-12) and pulled[0].N == sealed.N
+    leaked = [s for s in path.states if s.stage == "leaked"]
+    assert np.all(np.diff([s.N for s in leaked]) > 0)
+    assert np.all(np.diff([s.p_b_Pa for s in leaked]) > 0)
+    assert np.all(np.diff([s.F1_N for s in leaked]) < 0)
+    assert np.allclose([s.u_m for s in leaked], 1.5e-3, rtol=1e-12)
+
+
+def test_path_cost_and_dissipation(mesh, path):
+    """Newton converges quadratically with the rank-one tangent (a few iterations per state),
+    and the path's energy balance (stored energy, plate work, the work of N) closes:
+    frictionless, to the trapezoid's defect, small against the cup's elastic energy; sticking
+    slips dissipate, far more than that and >= 0."""
+    stats = path.stats
+    assert stats.newton_iterations <= 5 * stats.steps
+    body = CupSetup.of(mesh, NeoHookean(), path.contact).mech
+    elastic = body.energy([s for s in path.states if s.stage == "pressed"][-1].state.u)
+    if path.contact == "frictionless":
+        assert abs(stats.dissipated_J) <= 1e-4 * elastic
+    else:
+        assert stats.dissipated_J >= 1e-3 * elastic        # measured: 0.55 %
+
+
+def test_bad_input_is_refused_before_work(mesh):
+    with pytest.raises(ValueError, match="^N: "):
+        TrappedGas(0.0)
+    with pytest.raises(ValueError, match="^T_K: "):
+        TrappedGas(1e20, T_K=-1.0)
+    cup = CupWithGas.of(mesh, NeoHookean())
+    with pytest.raises(ValueError, match="^wetting_m: "):
+        GasMechanics(cup.cup.mech, CavitySurface.of(mesh, 1e-5), TrappedGas(1e20))
+    with pytest.raises(ValueError, match="^N_end_ratio: "):
+        cup_path(mesh, NeoHookean(), 3e-3, 1.5e-3, 0.9)
+    with pytest.raises(ValueError, match="^u_pulled_m: "):
+        cup_path(mesh, NeoHookean(), 3e-3, 3.5e-3, 1.2)
+    assert not cup.costs
