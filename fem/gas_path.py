@@ -31,6 +31,7 @@ from skfem import Mesh
 
 from .cavity import CavitySurface
 from .contact import PressureProfile
+from .interface import ContactLaw
 from .cup import CupSetup, _joined, cup_height
 from .integrity import check_state
 from .material import NeoHookean
@@ -181,8 +182,7 @@ class CupPath:
 
     states: tuple[GasState, ...]
     stats: SolverStats
-    contact: str
-    friction: float
+    contact: ContactLaw
 
     def column(self, name: str) -> np.ndarray:
         """One field of every state as an array, e.g. column("p_b_Pa")."""
@@ -205,4 +205,4 @@ def cup_path(mesh: Mesh, material: NeoHookean, u_press_m: float, u_pulled_m: flo
     pressed = cup.press(u_press_m)
     pulled = cup.move_plate(pressed[-1], u_pulled_m)
     leaked = cup.let_in(pulled[-1], N_end_ratio * pulled[-1].N)
-    return CupPath(tuple(pressed + pulled[1:] + leaked[1:]), cup.stats, contact, cup.cup.plane.friction)
+    return CupPath(tuple(pressed + pulled[1:] + leaked[1:]), cup.stats, cup.cup.plane.law.contact)

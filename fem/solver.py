@@ -128,7 +128,9 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     path. A `mech` with a method ``at(t)`` is a family of potentials Pi_t (a load that is not a
     prescribed displacement or a fixed force, such as a ramped cavity pressure, `fem.cavity`):
     the step to t1 minimizes ``mech.at(t1)``'s energy, and its energy balance counts the work of
-    the parameter, int dPi_t/dt dt at fixed u, by the trapezoid."""
+    the parameter, int dPi_t/dt dt at fixed u, by the trapezoid. A `mech` with a method
+    ``make_solver(pattern, coordinates, mesh)`` builds its own linear solver (a tangent that is
+    not a plain sparse matrix, such as the trapped gas's rank-one term, `fem.trapped_gas`)."""
     begin = time.perf_counter()
     n = mech.kin.ndofs
     f_ext = f_ext or (lambda t: np.zeros(n))
@@ -137,7 +139,8 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     u0 = np.zeros(n) if start is None else start.u
     state = (plane.initial_state() if start is None else start.contact) if plane is not None else None
     r0 = m0.internal_force(u0)
-    solver = make_solver(m0.linearize(u0)[1], m0.kin.node_coordinates(), m0.kin.mesh)
+    build = getattr(m0, "make_solver", make_solver)
+    solver = build(m0.linearize(u0)[1], m0.kin.node_coordinates(), m0.kin.mesh)
     policy = ShiftPolicy()
     t, W0 = 0.0, m0.energy(u0)
     if on_step:

@@ -24,10 +24,8 @@ stiff at fixed N: against the plate, N k_B T / V^2 (dV/du)^2 ~ p_b (pi r_k^2)^2 
 for cup A pulled at 1.5 mm, tens of times the pressed cup's own ~7e2 N/m, and it holds the wall
 where at fixed dp it would snap.
 
-`fem.solver.follow_path` builds its linear solver from the tangent's pattern by `make_solver`;
-`follow_gas_path` runs it with that factory wrapped (`RankOneSolver`) for the duration of the
-call and checks that the wrapper was used (a solver that no longer builds its factor there is an
-error, not a silent inexact Newton). The load parameter t may move N (`GasMechanics.schedule`,
+`fem.solver.follow_path` asks the mechanics for its linear solver (`GasMechanics.make_solver`:
+the body's sparse factor wrapped in `RankOneSolver`). The load parameter t may move N (`GasMechanics.schedule`,
 through `at(t)`, as the cavity's dp ramp does) and the plate (the path's `dirichlet`); the
 contact state, with its sticking anchors and Coulomb slips, is carried from state to state by
 `start`.
@@ -40,15 +38,15 @@ on the contact rows (an inexact tangent there; the energy and the residual stay 
 
 from __future__ import annotations
 
-import contextlib
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
 
 from .cavity import CavitySurface, PressurizedMechanics
+from .condensation import make_solver
 from .contact import RigidPlane
 from .forms import Mechanics
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
@@ -189,6 +187,11 @@ class GasMechanics:
         if self._load is None:
             self._load = PressurizedMechanics(self.body, self.cavity, 0.0)
 
+    def make_solver(self, pattern, coordinates: np.ndarray, mesh=None) -> "RankOneSolver":
+        """The linear solver `follow_path` uses for this mechanics: the body's sparse factor with the
+        gas's rank-one term by Sherman-Morrison (module docstring)."""
+        return RankOneSolver(make_solver(_sparse_part(pattern), coordinates, mesh))
+
     def at(self, t: float) -> "GasMechanics":
         if self.schedule is None:
             return self
@@ -238,28 +241,6 @@ class GasMechanics:
         return W + Pi_gas, r + dp * g, GasTangent.of(K, data, self.gas.NkT_J / V**2, g)
 
 
-@contextlib.contextmanager
-def _rank_one_solver() -> Iterator[list]:
-    """`follow_path` with its linear-solver factory wrapped in `RankOneSolver` (module docstring);
-    yields the list of the solvers it built."""
-    space = follow_path.__globals__
-    original = space.get("make_solver")
-    if original is None:
-        raise RuntimeError("fem.trapped_gas: fem.solver.follow_path no longer builds its linear "
-                           "solver by make_solver; the rank-one gas tangent needs that hook")
-    built: list = []
-
-    def make(pattern, coordinates, mesh=None):
-        built.append(RankOneSolver(original(_sparse_part(pattern), coordinates, mesh)))
-        return built[-1]
-
-    space["make_solver"] = make
-    try:
-        yield built
-    finally:
-        space["make_solver"] = original
-
-
 def follow_gas_path(mech: GasMechanics, dirichlet: Callable[[float], tuple[np.ndarray, np.ndarray]],
                     t_max: float, *, plane: RigidPlane | None, start: StepResult | None,
                     options: SolverOptions = SolverOptions(),
@@ -270,10 +251,5 @@ def follow_gas_path(mech: GasMechanics, dirichlet: Callable[[float], tuple[np.nd
     linear solver through the wrapped factory."""
     if not isinstance(mech, GasMechanics):
         raise TypeError(f"mech: a GasMechanics is required, got {type(mech).__name__}")
-    with _rank_one_solver() as built:
-        stats = follow_path(mech, dirichlet, t_max, plane=plane, start=start, options=options,
-                            on_step=on_step, name=name)
-    if not built:
-        raise RuntimeError("fem.trapped_gas: follow_path did not use the wrapped linear solver; "
-                           "its Newton steps lacked the gas's rank-one tangent")
-    return stats
+    return follow_path(mech, dirichlet, t_max, plane=plane, start=start, options=options,
+                       on_step=on_step, name=name)
