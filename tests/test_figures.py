@@ -164,6 +164,7 @@ def test_a_composed_image_is_placed_pixel_for_pixel_with_a_scale_bar(measured, t
     grey = np.abs(png[r0:r1, c0:c1, 0] - 128 / 255) < 0.02
     assert grey.sum(1).max() == pytest.approx(200, abs=2)                 # the disc's diameter in px
     assert _scale_bar_found(placed.path, placed.view_box_px, placed.scale_bar_m, placed.m_per_px)
+    assert not _scale_bar_found(placed.path, placed.view_box_px, 1.5 * placed.scale_bar_m, placed.m_per_px)
     assert measured[0]["colorbars"] == ["contact pressure (kPa)"] and measured[0]["clipped"] == []
 
 
@@ -218,3 +219,69 @@ def test_nice_length_is_1_2_5_not_above_the_limit():
     for limit, nice in ((0.0123, 0.01), (0.0049, 0.002), (2.6e-4, 2e-4), (0.05, 0.05)):
         assert style.nice_length(limit) == pytest.approx(nice)
     assert style.length_label(0.005) == "5 mm" and style.length_label(2e-4) == "200 \u00b5m"
+
+
+# ------------------------------------------------------------------------------ 3D views (real renders)
+@pytest.fixture(scope="module")
+def frames():
+    """Cup A (coarse, frictionless) at four states from u = 0 to 0.84 h1, all fields."""
+    from validation.render import probe_offscreen_rendering
+
+    probe = probe_offscreen_rendering()
+    if not probe.ok:
+        pytest.skip(probe.message)
+    from fem.cup import compress_cup
+    from fem.geometry import cup_geometry
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+    from validation.render.frames import frame_from_response
+
+    g = cup_geometry("A")
+    resp = compress_cup(cup_mesh(g, "coarse"), NeoHookean(E_Pa=4e6, nu=0.49), u_max_m=0.84 * g.h1_m)
+    steps = [int(np.argmin(np.abs(resp.u_m - t))) for t in np.linspace(0, resp.u_m[-1], 4)]
+    return [frame_from_response(resp, k) for k in steps]
+
+
+@pytest.mark.parametrize("field, unit", [("von_mises", "MPa"), ("contact_pressure", "kPa"), ("min_stretch", "")])
+def test_a_cutaway_has_its_colour_bar_unclipped_and_a_scale_bar(frames, measured, tmp_path, field, unit):
+    from validation.render.views import cutaway
+
+    image = cutaway(frames[-1], field, tmp_path / "c.png", title="cup A, coarse, frictionless, u = 7.6 mm")
+    (m,) = measured
+    label = style.quantity(field).label + (f" ({unit})" if unit else "")
+    assert m["clipped"] == [] and m["colorbars"] == [label]
+    assert _scale_bar_found(image.path, image.view_box_px, image.scale_bar_m, image.m_per_px)
+
+
+def test_the_footprints_scale_is_the_same_for_every_state_of_a_cup(frames, measured, tmp_path):
+    """Two states of cup A drawn as footprints: one pixel size, one axis pixel, a scale bar of the
+    length its label says, the contact pressure bar unclipped."""
+    from validation.render.views import footprint
+
+    a = footprint(frames[-2], tmp_path / "a.png", title="from below, u = 5.2 mm")
+    b = footprint(frames[-1], tmp_path / "b.png", title="from below, u = 7.6 mm")
+    assert a.m_per_px == b.m_per_px and a.centre_px == b.centre_px
+    assert all(m["clipped"] == [] and m["colorbars"] == ["contact pressure (kPa)"] for m in measured)
+    for image in (a, b):
+        assert _scale_bar_found(image.path, image.view_box_px, image.scale_bar_m, image.m_per_px)
+
+
+def test_the_squeeze_of_the_contact_pressure_shows_it_side_on(frames, measured, tmp_path):
+    """The squeeze's default field: side-on, the pressure profile hangs below the plane line, so
+    the last frame has saturated (coloured) pixels below the plane, the first (no contact) none;
+    every frame has its colour bar in kPa and a scale bar."""
+    from validation.render.views import squeeze
+
+    seq = squeeze(frames, "contact_pressure", tmp_path / "sq")
+    c0, r0, c1, r1 = seq.view_box_px
+    first, last = (imread(p)[r0:r1, c0:c1, :3] for p in (seq.frames[0], seq.frames[-1]))
+    plane_row = int(np.argmax((first.max(-1) < 0.2).sum(1)))
+
+    def coloured_below(img):
+        hi, lo = img.max(-1), img.min(-1)
+        return int(((hi - lo) / np.maximum(hi, 1e-9) > 0.4)[plane_row + 2:].sum())
+
+    print(f"coloured pixels below the plane: first {coloured_below(first)}, last {coloured_below(last)}")
+    assert coloured_below(first) == 0 and coloured_below(last) > 500
+    assert all(m["clipped"] == [] and m["colorbars"] == ["contact pressure (kPa)"] for m in measured)
+    assert _scale_bar_found(seq.frames[-1], seq.view_box_px, seq.scale_bar_m, seq.m_per_px)
