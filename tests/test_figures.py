@@ -29,6 +29,7 @@ def measured(monkeypatch):
         seen.append({"path": path, "clipped": style.clipped_texts(fig),
                      "colorbars": [(ax.get_ylabel() or ax.get_xlabel()) for ax in bars],
                      "log_ticks": _log_tick_labels(fig),
+                     "x_overlap": _x_labels_overlap(fig),
                      "axes": [(ax.get_xlabel(), ax.get_ylabel(), [t.get_text() for t in ax.get_xticklabels()])
                               for ax in fig.axes if not hasattr(ax, "_colorbar")]})
         return save(fig, path, **kw)
@@ -48,6 +49,18 @@ def _log_tick_labels(fig) -> list[list[str]]:
                 out.append([t.label1.get_text() for t in axis.get_major_ticks()
                             if lo * (1 - 1e-9) <= t.get_loc() <= hi * (1 + 1e-9) and t.label1.get_text()])
     return out
+
+
+def _x_labels_overlap(fig) -> bool:
+    """Whether any axes of a drawn figure has two x tick labels (inside the view) that overlap."""
+    renderer = fig.canvas.get_renderer()
+    for ax in fig.axes:
+        lo, hi = sorted(ax.xaxis.get_view_interval())
+        boxes = [t.label1.get_window_extent(renderer) for t in ax.xaxis.get_major_ticks()
+                 if lo - 1e-9 * abs(hi) <= t.get_loc() <= hi + 1e-9 * abs(hi) and t.label1.get_text()]
+        if _boxes_overlap(boxes):
+            return True
+    return False
 
 
 def _boxes_overlap(boxes) -> bool:
@@ -201,6 +214,7 @@ def test_sweep_figures_draw_a_categorical_contact_axis_with_named_axes(measured,
     assert [m["colorbars"] for m in maps] == [["lifetime (s)"], ["small-u stiffness (N/mm)"]]
     pareto = next(m for m in measured if m["path"].name.startswith("pareto"))
     assert len(pareto["log_ticks"]) == 2 and all(len(t) >= 3 for t in pareto["log_ticks"])
+    assert not pareto["x_overlap"]
 
 
 def test_sweep_map_labels_are_names_with_units(measured, tmp_path):
@@ -285,3 +299,25 @@ def test_the_squeeze_of_the_contact_pressure_shows_it_side_on(frames, measured, 
     assert coloured_below(first) == 0 and coloured_below(last) > 500
     assert all(m["clipped"] == [] and m["colorbars"] == ["contact pressure (kPa)"] for m in measured)
     assert _scale_bar_found(seq.frames[-1], seq.view_box_px, seq.scale_bar_m, seq.m_per_px)
+
+
+# ------------------------------------------------------------------------------ crosscheck figures
+def test_the_validate_pareto_figure_reads(measured, tmp_path):
+    """The speed section's Pareto figure (wall time 3 ms .. 40 s, errors 1e-7 .. 0.1, the level
+    names annotated at the points): nothing clipped, no overlapping x labels, >= 3 labelled ticks on
+    every log axis."""
+    from types import SimpleNamespace
+
+    from validation.crosscheck import speed
+    from validation.crosscheck.report import Report
+
+    levels = [("Appendix A (d0 2 mm)", 3e-3, 0.1), ("FEM coarse Q2", 0.8, 2e-2), ("FEM medium Q2", 3.0, 5e-3),
+              ("FEM fine Q2", 12.0, 1e-3), ("FEM finest Q2", 40.0, 1e-7)]
+    rows = [{"level": name, "wall_s": t, "errors": {q: e * (1 + k) for k, q in enumerate(speed.QUANTITIES)}}
+            for name, t, e in levels]
+    rrows = [[rtol, 2e-3 / rtol ** 0.1, 10, 100.0, rtol] for rtol in (1e-3, 1e-5, 1e-7)]
+    speed._pareto(SimpleNamespace(report=Report(tmp_path)), {"frictionless": rows, "sticking": rows}, rrows)
+    (m,) = measured
+    print(m["log_ticks"])
+    assert m["clipped"] == [] and not m["x_overlap"]
+    assert len(m["log_ticks"]) == 4 and all(len(t) >= 3 for t in m["log_ticks"])
