@@ -263,8 +263,8 @@ def _side_image(frame: CupFrame, field: str, clim: tuple[float, float], view: _S
                 strip = pv.PolyData(pts, faces=quads)
                 strip.point_data["value"] = np.concatenate([pr, pr])
                 p.add_mesh(strip, scalars="value", cmap=cmap, clim=clim, lighting=False, show_scalar_bar=False)
-    p.add_mesh(pv.Line((-1e3 * view.half_w_m, -1.1e3 * view.half_w_m, 0), (1e3 * view.half_w_m, -1.1e3 * view.half_w_m, 0)),
-               color="black", line_width=1)
+    front = -1.1e3 * view.half_w_m                             # the plane's line, before the profile
+    p.add_mesh(pv.Line((-1e3 * view.half_w_m, front, 0), (1e3 * view.half_w_m, front, 0)), color="black", line_width=1)
     z_centre = 0.5e3 * (view.z_top_m + view.z_bottom_m)
     p.enable_parallel_projection()
     p.camera.position, p.camera.focal_point = (0.0, -1e5, z_centre), (0.0, 0.0, z_centre)
