@@ -94,12 +94,12 @@ def test_footprint_radii_measured_in_pixels_are_the_fem_contact_radii(pressed, t
     from validation.render.views import footprint
 
     image = footprint(frame_from_response(pressed, -1, ("contact_pressure",)), tmp_path / "f.png")
-    img = imread(image.path)[..., :3]
+    c0, r0, c1, r1 = image.view_box_px                                 # the view, not the colour bar
+    img = imread(image.path)[r0:r1, c0:c1, :3]
     hi, lo = img.max(-1), img.min(-1)
     contact = (hi - lo) / np.maximum(hi, 1e-9) > 0.25                 # grey cup, white-blue background: < 0.1
     rows, cols = np.nonzero(contact)
-    keep = np.abs(cols + 0.5 - image.centre_px[0]) < 0.5 * img.shape[0]   # the view, not the colour bar
-    d = np.hypot(cols[keep] + 0.5 - image.centre_px[0], rows[keep] + 0.5 - image.centre_px[1])
+    d = np.hypot(cols + c0 + 0.5 - image.centre_px[0], rows + r0 + 0.5 - image.centre_px[1])
     u = pressed.displacements[-1]
     loaded = np.flatnonzero(pressed.nodal_pressure_Pa[-1] > 0)
     r_outer = float(np.max(pressed.mesh.doflocs[0, loaded] + u[0::2][loaded]))
@@ -125,18 +125,17 @@ def test_squeeze_gif_has_its_frames_and_the_plate_moves_down_by_u(pressed, tmp_p
     seq = squeeze([frame_from_response(pressed, k, ("von_mises",)) for k in steps], "von_mises", tmp_path / "sq")
     with Image.open(seq.gif) as gif:
         assert gif.n_frames == 4
-    first, last = (imread(p)[..., :3] for p in (seq.frames[0], seq.frames[-1]))
+    c0, r0, c1, r1 = seq.view_box_px                                          # the view alone
+    first, last = (imread(p)[r0:r1, c0:c1, :3] for p in (seq.frames[0], seq.frames[-1]))
     plane_row = int(np.argmax((first.max(-1) < 0.2).sum(1)))              # the black plane line
 
     def top(img):
         ink = img.min(-1) < 0.9
-        ink[:30] = False                                                    # the u = ... label
         ink[plane_row - 1:] = False
         return int(np.argmax(ink.any(1)))
 
     drop = top(last) - top(first)
     assert abs(drop - (seq.u_m[-1] - seq.u_m[0]) / seq.m_per_px) <= 2.0
     changed = np.abs(last - first).max(-1) > 0.1
-    changed[:30] = False
     rows = np.flatnonzero(changed[:plane_row - 1].any(1))
     assert rows.size and rows.min() >= top(first) - 1 and changed[:plane_row - 1].sum() > 1000

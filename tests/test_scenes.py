@@ -154,12 +154,12 @@ def test_a_render_runs_the_fem_only_to_its_displacement_and_shows_the_contact(tm
     state = result.products["fem_state_3mm"][-1]
     assert state.u_m == pytest.approx(3e-3, rel=1e-12) and dict(pipeline.COMPUTED) == {"fem_path": 1, "fem_frames": 1}
     img = imread(tmp_path / "out" / "cupA_3mm.png")[..., :3]
-    assert img.shape[:2] == (700, 900) and img.std() > 0.05
-    # viridis' top, shaded by the lights: red and green well above blue (the plane is grey-blue,
-    # the unloaded cup dark purple)
+    assert img.shape[0] >= 700 and img.shape[1] >= 900 and img.std() > 0.05     # the 900 x 700 view, titled
+    # the colour map's top, shaded by the lights: red and green well above blue (the plane is
+    # grey-blue, the unloaded cup dark)
     yellow = (img[..., 0] > 0.6) & (img[..., 1] > 0.55) & (img[..., 2] < 0.3)
-    above_bar = yellow[:600]                   # the colour bar sits at the bottom of the window
-    assert above_bar.sum() > 3                 # the contact strip, coloured by its peak pressure
+    left_of_bar = yellow[:, :900]              # the colour bar sits right of the view
+    assert left_of_bar.sum() > 3               # the contact strip, coloured by its peak pressure
 
 
 def test_a_coulomb_scene_is_the_command_lines_coulomb_curve(tmp_path, capsys):

@@ -58,11 +58,9 @@ class Report:
 
     def figure(self, section: str, name: str, fig, caption: str) -> Path:
         """Save a matplotlib figure as `name`.png and reference it from the section's page."""
-        import matplotlib.pyplot as plt
+        from validation.style import save_figure
 
-        path = self.root / f"{name}.png"
-        fig.savefig(path, dpi=90)
-        plt.close(fig)
+        path = save_figure(fig, self.root / f"{name}.png", dpi=150)
         self.files.append(path.name)
         self.text(section, f"![{caption}]({path.name})\n\n*{caption}*")
         return path
@@ -98,10 +96,13 @@ def _plain(value: Any) -> Any:
 
 
 def new_figure(ncols: int = 1, nrows: int = 1, width: float = 5.0, height: float = 3.6):
-    """A matplotlib figure on the Agg backend (headless)."""
-    import matplotlib
-    matplotlib.use("Agg")
+    """A matplotlib figure in the toolkit's style (`validation.style.apply_style`: the Agg backend,
+    the style sheet for the rest of the run), `width` x `height` inches per panel."""
     import matplotlib.pyplot as plt
+
+    from validation.style import apply_style
+
+    apply_style()
 
     return plt.subplots(nrows, ncols, figsize=(width * ncols, height * nrows), constrained_layout=True,
                         squeeze=False)

@@ -29,7 +29,8 @@ __all__ = ["CupFrame", "frame_from_response", "frame_from_fields_file", "fields_
 @dataclass(frozen=True, eq=False)
 class CupFrame:
     """A deformed state: positions (r, z) [m] of every node, cells (node ids, VTK/skfem order),
-    the boundary loop (node ids, closed), nodal fields [SI] and the contact zones [(r_in, r_out)] [m]."""
+    the boundary loop (node ids, closed), nodal fields [SI], the contact zones [(r_in, r_out)] [m]
+    and the undeformed positions (the cup's own size, for a scale fixed over all states)."""
 
     u_m: float
     points_m: np.ndarray
@@ -37,6 +38,7 @@ class CupFrame:
     loop: np.ndarray
     fields: dict[str, np.ndarray]
     zones_m: tuple[tuple[float, float], ...]
+    rest_points_m: np.ndarray | None = None
 
     @property
     def r_c_m(self) -> float | None:
@@ -140,7 +142,7 @@ def _frame(mesh, u: np.ndarray, u_plate_m: float, p_lumped: np.ndarray, data: di
     from fem.kinematics import Kinematics
     cells = Kinematics.of(mesh).dofs[0::2].T // 2     # node ids per element, VTK's order
     return CupFrame(u_m=u_plate_m, points_m=x.T.copy(), cells=np.asarray(cells), loop=boundary_loop(mesh),
-                    fields=data, zones_m=contact_zones_of(mesh, x, p_lumped))
+                    fields=data, zones_m=contact_zones_of(mesh, x, p_lumped), rest_points_m=mesh.doflocs.T.copy())
 
 
 def boundary_loop(mesh) -> np.ndarray:

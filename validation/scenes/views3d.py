@@ -29,18 +29,19 @@ def write_view(output: dict, products: Products, tmp: Path | None) -> list[dict[
                                      else "")
     files = []
     if kind == "render":
-        png = views.cutaway(frames[-1], output["field"], tmp / f"{name}.png",
-                            title=f"u = {1e3 * frames[-1].u_m:.3g} mm, {law}")
-        files.append(_file(name, kind, png))
+        image = views.cutaway(frames[-1], output["field"], tmp / f"{name}.png",
+                              title=f"u = {1e3 * frames[-1].u_m:.3g} mm, {law}")
+        files.append(_file(name, kind, image.path))
     elif kind == "footprint":
         image = views.footprint(frames[-1], tmp / f"{name}.png",
                                 title=f"from below, u = {1e3 * frames[-1].u_m:.3g} mm, {law}")
         scale = tmp / f"{name}.json"
         scale.write_text(json.dumps({"m_per_px": image.m_per_px, "centre_px": image.centre_px,
+                                     "view_box_px": image.view_box_px, "scale_bar_m": image.scale_bar_m,
                                      "contact_zones_m": image.zones_m, "u_m": frames[-1].u_m}, indent=1) + "\n")
         files += [_file(name, kind, image.path), _file(name, kind, scale)]
     else:
-        seq = views.squeeze(frames, output["field"], tmp / name)
+        seq = views.squeeze(frames, output["field"], tmp / name, title=law)
         files += [_file(name, kind, p) for p in seq.frames] + [_file(name, kind, seq.gif)]
     return files
 
