@@ -10,6 +10,7 @@ from reduced.appendix_a import appendix_a_force
 from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
 from reduced.cup import CUP_A, CUP_B
 from reduced.fast_curve import CurveRangeError
+from reduced.force_balance import force_balance
 from reduced.lifetime import (largest_holdable_force, lifetime, lifetime_by_quadrature,
                               reference_model)
 from reduced.stiffness_curve import StiffnessCurve
@@ -345,9 +346,9 @@ def test_profile_seal_of_a_uniform_strip_is_the_papers_strip_on_an_annulus():
     prof = dataclasses.replace(strip, seal="profile")
     for hh in (0.3 * CUP_A.h1_m, 0.6 * CUP_A.h1_m):
         i = int(np.argmin(np.abs(h - hh)))                   # at a sample: no interpolation between profiles
-        N = 0.5 * strip._core.n_eq(h[i], 1.0, 0.0)[0]
-        q_strip = strip._core.state(h[i], N, 1.0, 4e6, 10.0)[0]
-        q_prof = prof._core.state(h[i], N, 1.0, 4e6, 10.0)[0]
+        N = 0.5 * force_balance(strip).n_eq(h[i], 1.0, 0.0)[0]
+        q_strip = force_balance(strip).state(h[i], N, 1.0, 4e6, 10.0)[0]
+        q_prof = force_balance(prof).state(h[i], N, 1.0, 4e6, 10.0)[0]
         assert q_prof / q_strip == pytest.approx(l[i] / (r[i] * math.log(1 + l[i] / r[i])), rel=1e-9)
     t_strip, t_prof = lifetime(strip, 20.0).lifetime_s, lifetime(prof, 20.0).lifetime_s
     assert 0.85 * t_strip < t_prof < t_strip
