@@ -1,6 +1,6 @@
 """Viscoelastic relaxation in the coupled cavity (`reduced.coupled`): the state (N, phi), eq (10).
 
-As in the paper route (`reduced.lifetime`, Sec. 3) the cup's stiffness follows the contact-time
+As in the paper route (`reduced.lifetime.paper`, Sec. 3) the cup's stiffness follows the contact-time
 state phi, kappa(phi) = kappa E_eff(phi) / E_eff(phi0) (phi0: the contact time of the stiffness
 measurement, the table's cup being the cup as measured), with
 
@@ -30,7 +30,7 @@ at each evaluation the branch at the current kappa is solved for the state holdi
 bisection, warm-started). Differentiating the two equations and eq (10) in time gives a 3 x 3
 linear system for (udot, sdot, phidot); it is singular where its determinant D = 0: with
 phi = 0 or a flat E_eff the static fold (no state holds more gas), otherwise the dynamic
-singularity where rdot diverges (as in `reduced.lifetime._run_relaxed`). End (reason): "fold"
+singularity where rdot diverges (as in the paper route, `reduced.lifetime.paper`). End (reason): "fold"
 (|D| / |D(0)| < 1e-4), "table_edge" (u reaches the table's smallest u), "over_force" (t = 0),
 "sealed" (no leak at t = 0) or "horizon" (still holding at t_max).
 """

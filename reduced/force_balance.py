@@ -16,7 +16,7 @@ first local maximum: that maximum (or its value at r1) is the largest force the 
 at or above it the cup detaches at t = 0.
 
 `ForceBalance` evaluates everything a lifetime needs at one state (h, N, phi) as floats, for the
-ODE right-hand sides of `reduced.lifetime`: N_eq(h), the holding force, the leak state (through
+ODE right-hand sides of `reduced.lifetime.paper`: N_eq(h), the holding force, the leak state (through
 the model's seal, `reduced.seal`: eq 6's strip or the contact-pressure profile), the fold, the
 start and, for a liquid, cavitation.
 """

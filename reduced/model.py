@@ -71,8 +71,8 @@ class LeakageModel:
             raise ValueError(f"E_Pa: modulus must be > 0 Pa, got {self.E_Pa}")
         if not (math.isfinite(self.kappa) and self.kappa > 0):
             raise ValueError(f"kappa: stiffness factor must be > 0, got {self.kappa}")
-        if self.phi0_s is not None and not (math.isfinite(self.phi0_s) and self.phi0_s > 0):
-            raise ValueError(f"phi0_s: measurement contact time must be finite and > 0 s, got {self.phi0_s}")
+        if self.phi0_s is not None and not self.phi0_s > 0:
+            raise ValueError(f"phi0_s: measurement contact time must be > 0 s, got {self.phi0_s}")
         if self.geometry not in ("cone", "curve"):
             raise ValueError(f"geometry: unknown source '{self.geometry}', allowed: cone, curve")
         if self.seal not in SEALS:
@@ -103,7 +103,7 @@ class LeakageModel:
 
 
 def reference_model(cup: CupParameters, u_c: Callable[[float], float]) -> LeakageModel:
-    """The paper's reference conventions (`reduced.lifetime`) for `cup` and `u_c`: Appendix A
+    """The paper's reference conventions (`reduced.lifetime.paper`) for `cup` and `u_c`: Appendix A
     stiffness (d0 = 2 mm, E = 4 MPa), no relaxation, air at 293.15 K, p_a = 1e5 Pa, the rigid cone."""
     return LeakageModel(cup=cup, stiffness=appendix_a_curve(cup, E_Pa=4e6, d0_m=2e-3), u_c=u_c,
                         gas=Gas(T_K=293.15, molecular_mass_u=28.97, viscosity_Pa_s=1.81e-5),

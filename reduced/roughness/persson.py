@@ -21,10 +21,12 @@ Notation (Persson convention, see `reduced.roughness.spectrum`): ``E* = E/(1 - n
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import replace
 
 import numpy as np
 from scipy.special import erfinv
+
+from reduced.critical_gap import UcTable
 
 from .effective_medium import effective_medium_gap
 from .separation import (Moments, contact_area_ratio, effective_modulus, mean_separation,  # noqa: F401
@@ -59,26 +61,8 @@ def critical_junction_gap(mom: Moments, pstar: np.ndarray, gamma: float = 0.45,
 METHODS = ("emt", "critical-junction")
 
 
-@dataclass(frozen=True)
-class GapTable:
-    """u_c and friends on a grid of p/E (plain arrays; the reduced model wraps them in UcTable).
-
-    ``p_over_E`` is the nominal pressure over Young's modulus E (not E*); ``u_c_m`` the gap at the
-    critical constrictions (0 where ``sealed``); ``u_mean_m`` the mean interfacial separation;
-    ``contact_area_ratio`` A/A0 at full magnification.
-    """
-
-    p_over_E: np.ndarray
-    u_c_m: np.ndarray
-    u_mean_m: np.ndarray
-    contact_area_ratio: np.ndarray
-    sealed: np.ndarray
-    E_Pa: float
-    nu: float
-    method: str
-    gamma: float
-    a_c: float
-    provenance: str = ""
+#: the former name of the theory's result, now the one u_c table type (`reduced.critical_gap.UcTable`)
+GapTable = UcTable
 
 
 def check_gap_parameters(p_over_E: np.ndarray, method: str, gamma: float, a_c: float) -> None:
@@ -98,8 +82,10 @@ def check_gap_parameters(p_over_E: np.ndarray, method: str, gamma: float, a_c: f
 def critical_gap_table(spectrum: PowerSpectrum, E_Pa: float, nu: float, p_over_E,
                        *, method: str = "emt", gamma: float = 0.45, a_c: float = 0.42,
                        n_q: int | None = None,
-                       progress: Callable[[float, str], None] | None = None) -> GapTable:
-    """u_c(p/E) of `spectrum` pressed by an elastic half-space (E_Pa, nu) against it.
+                       progress: Callable[[float, str], None] | None = None) -> UcTable:
+    """u_c(p/E) of `spectrum` pressed by an elastic half-space (E_Pa, nu) against it, at the
+    pressures asked for (in their order), with the mean separation, the contact area ratio and
+    where the contact percolates (sealed) as the table's theory columns.
 
     `method`: ``"emt"`` (default; the route the paper used, Sec. 5.1: Bruggeman effective-medium leak
     rate identified with the critical-junction expression, see `effective_medium`) or
@@ -116,8 +102,9 @@ def critical_gap_table(spectrum: PowerSpectrum, E_Pa: float, nu: float, p_over_E
         u_c, sealed = critical_junction_gap(mom, pstar, gamma, a_c)
     u_mean = mean_separation(mom, pstar, None, gamma)
     area = contact_area_ratio(mom.m[-1], pstar)
-    return GapTable(p_over_E, u_c, u_mean, area, sealed, float(E_Pa), float(nu), method,
-                    float(gamma), float(a_c), spectrum.provenance)
+    return UcTable(p_over_E, u_c, provenance=spectrum.provenance, u_mean_m=u_mean, contact_area_ratio=area,
+                   sealed=sealed, theory={"E_Pa": float(E_Pa), "nu": float(nu), "method": method,
+                                          "gamma": float(gamma), "a_c": float(a_c)})
 
 
 #: reference pressure and tolerance of `patch_length`: 1 atm on E = 4 MPa (the presets' calibration
@@ -183,11 +170,9 @@ def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: 
     refinement; eq (10)'s strip is then at least one patch wide, `reduced.seal.ProfileSeal.width`).
     On by default; False: the raw FEM profile (mesh-dependent where the rim corner alone touches).
     """
-    from reduced.critical_gap import UcTable
-
     grid = UC_TABLE_P_OVER_E if p_over_E is None else np.asarray(p_over_E, float)
     table = critical_gap_table(spectrum, 1e6, nu, grid, method=method, gamma=gamma, a_c=a_c)
     note = (f"Persson theory ({method}, gamma {gamma:g}, a_c {a_c:g}, nu {nu:g}) of "
             f"{spectrum.provenance}")
     length = patch_length(spectrum, nu, method=method, gamma=gamma, a_c=a_c) if with_patch_length else None
-    return UcTable(table.p_over_E, table.u_c_m, provenance=note, patch_length_m=length)
+    return replace(table, provenance=note, patch_length_m=length)
