@@ -1,6 +1,7 @@
 """The lifetime's one entry point (reduced.solve_lifetime): registry dispatch, refusals that name
 the field, one result type and one vocabulary of endings on every route, and physics through it
-(the paper route against its quadrature, one model with one kappa on the paper and coupled routes)."""
+(the paper route against its quadrature; one model with one kappa on the paper and coupled routes
+is tests/test_reduced_coupled.py's)."""
 
 import math
 import subprocess
@@ -142,20 +143,6 @@ def test_the_legacy_spelling_of_the_route_is_the_route(profiled):
     curve = replace(profiled, geometry="curve")
     assert solve_lifetime(curve, 10.0).summary() == solve_lifetime(profiled, 10.0, cup_laws="curve").summary()
     assert solve_lifetime(curve, 10.0).summary() != solve_lifetime(profiled, 10.0).summary()
-
-
-def test_one_kappa_means_the_same_on_the_paper_and_coupled_routes(both):
-    """kappa makes the cup kappa times stiffer on every route: the same model with kappa = 2 on the
-    paper route (F0 doubled) and on the coupled route (the table's response scaled, its own
-    eqs 3-7) agrees to the table's interpolation error (1.3e-3 / 2.2e-4 on 21x41 / 41x81 grids)."""
-    stiff = replace(both, kappa=2.0)
-    for F1 in (10.0, 40.0):
-        paper_s = solve_lifetime(stiff, F1, route="paper").lifetime_s
-        coupled_s = solve_lifetime(stiff, F1, route="coupled", radial="strip", samples=1601).lifetime_s
-        assert coupled_s == pytest.approx(paper_s, rel=1e-3)
-        assert paper_s > 1.2 * solve_lifetime(both, F1, route="paper").lifetime_s
-    assert largest_holdable_force(stiff, route="coupled", radial="strip") == pytest.approx(
-        largest_holdable_force(stiff, route="paper"), rel=1e-2)
 
 
 def test_import_reduced_is_cheap_and_exposes_its_nouns():
