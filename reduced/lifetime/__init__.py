@@ -9,9 +9,9 @@ The model (`LeakageModel`) lives in `reduced.model`; the legacy `lifetime(model,
 the paper integrator's own record on the route the model's `geometry` and `seal` name.
 """
 
-from reduced.lifetime.paper import LifetimeResult, lifetime, lifetime_sweep
+from reduced.lifetime.paper import lifetime, lifetime_sweep
 from reduced.lifetime.quadrature import lifetime_by_quadrature
-from reduced.lifetime.result import REASONS, Lifetime
+from reduced.lifetime.result import REASONS, Lifetime, LifetimeResult
 from reduced.lifetime.routes import ROUTES, Route, Run, largest_holdable_force, register_route, solve_lifetime
 from reduced.model import LeakageModel, reference_model
 

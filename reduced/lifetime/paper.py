@@ -46,80 +46,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
-
 import numpy as np
 from scipy.optimize import brentq
 
 from reduced.fast_curve import CurveRangeError
 from reduced.force_balance import ForceBalance, force_balance
 from reduced.model import LeakageModel
+from reduced.lifetime.result import LifetimeResult
 from reduced.ode import dopri5
 
-__all__ = ["LifetimeResult", "lifetime", "lifetime_sweep", "integrate", "start_height",
+__all__ = ["lifetime", "lifetime_sweep", "integrate", "start_height",
            "sealed_on_branch", "check_run"]
 _DYNAMIC_FOLD = 1e-4  # |D| / |D(0)| at which the relaxed dynamics is declared singular
-
-
-@dataclass(frozen=True, eq=False)
-class LifetimeResult:
-    """Lifetime and trajectories (SI). lifetime_s is inf when sealed or beyond the horizon."""
-
-    force_N: float
-    lifetime_s: float
-    reason: str
-    message: str
-    largest_force_N: float
-    N0: float
-    t_s: np.ndarray
-    r_m: np.ndarray
-    h_m: np.ndarray
-    p_b_Pa: np.ndarray
-    p_Pa: np.ndarray
-    u_c_m: np.ndarray
-    N: np.ndarray
-    N_dot_per_s: np.ndarray
-    phi_s: np.ndarray
-    ballistic_share_t: np.ndarray
-    force_residual: np.ndarray
-    steps: int = 0
-    fluid: str = "air"
-
-    @property
-    def sealed(self) -> bool:
-        return self.reason == "sealed"
-
-    @property
-    def ballistic_share(self) -> float:
-        """Share of the leaked molecules that went through eq (19)'s ballistic term."""
-        if self.t_s.size < 2:
-            return float(self.ballistic_share_t[0])
-        total = _trapezoid(self.N_dot_per_s, self.t_s)
-        if total <= 0:
-            return float(self.ballistic_share_t[0])
-        return float(_trapezoid(self.ballistic_share_t * self.N_dot_per_s, self.t_s) / total)
-
-    def summary(self) -> dict:
-        """JSON-ready summary (lifetime_s null when infinite)."""
-        return {"force_N": self.force_N,
-                "lifetime_s": self.lifetime_s if math.isfinite(self.lifetime_s) else None,
-                "reason": self.reason, "sealed": self.sealed,
-                "ballistic_share": self.ballistic_share,
-                "largest_force_N": self.largest_force_N if math.isfinite(self.largest_force_N) else None,
-                "r_final_mm": 1e3 * float(self.r_m[-1]), "p_b_final_Pa": float(self.p_b_Pa[-1]),
-                "steps": self.steps, "message": self.message}
-
-    def trajectory_columns(self) -> dict[str, np.ndarray]:
-        """Trajectory arrays under CSV column names that carry their units."""
-        return {"t_s": self.t_s, "r_mm": 1e3 * self.r_m, "h_mm": 1e3 * self.h_m,
-                "p_b_Pa": self.p_b_Pa, "p_Pa": self.p_Pa, "u_c_nm": 1e9 * self.u_c_m,
-                **({"N": self.N, "N_dot_per_s": self.N_dot_per_s} if self.fluid == "air" else
-                   {"V_liquid_mm3": 1e9 * self.N, "V_dot_mm3_per_s": 1e9 * self.N_dot_per_s}),
-                "phi_s": self.phi_s, "ballistic_share": self.ballistic_share_t}
-
-
-def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
-    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
 
 
 def check_run(force_N: float, t_max_s: float, rtol: float, refine: int) -> float:

@@ -1,4 +1,6 @@
-"""The one result type of every lifetime route, and the one vocabulary of how a lifetime ends."""
+"""The one result type of every lifetime route (`Lifetime`), the one vocabulary of how a lifetime
+ends (`REASONS`), and the paper integrator's own record (`LifetimeResult`, SI arrays) that the
+paper and profile routes turn into a `Lifetime`."""
 
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Lifetime", "REASONS"]
+__all__ = ["Lifetime", "LifetimeResult", "REASONS"]
 
 #: How a lifetime ends, on every route:
 #: "reached_r1"  the contact radius reached r1: the cup let go (paper and profile routes)
@@ -78,3 +80,64 @@ class Lifetime:
     def trajectory_columns(self) -> dict[str, np.ndarray]:
         """Trajectory arrays under CSV column names that carry their units."""
         return dict(self.trajectory)
+
+
+@dataclass(frozen=True, eq=False)
+class LifetimeResult:
+    """Lifetime and trajectories (SI). lifetime_s is inf when sealed or beyond the horizon."""
+
+    force_N: float
+    lifetime_s: float
+    reason: str
+    message: str
+    largest_force_N: float
+    N0: float
+    t_s: np.ndarray
+    r_m: np.ndarray
+    h_m: np.ndarray
+    p_b_Pa: np.ndarray
+    p_Pa: np.ndarray
+    u_c_m: np.ndarray
+    N: np.ndarray
+    N_dot_per_s: np.ndarray
+    phi_s: np.ndarray
+    ballistic_share_t: np.ndarray
+    force_residual: np.ndarray
+    steps: int = 0
+    fluid: str = "air"
+
+    @property
+    def sealed(self) -> bool:
+        return self.reason == "sealed"
+
+    @property
+    def ballistic_share(self) -> float:
+        """Share of the leaked molecules that went through eq (19)'s ballistic term."""
+        if self.t_s.size < 2:
+            return float(self.ballistic_share_t[0])
+        total = _trapezoid(self.N_dot_per_s, self.t_s)
+        if total <= 0:
+            return float(self.ballistic_share_t[0])
+        return float(_trapezoid(self.ballistic_share_t * self.N_dot_per_s, self.t_s) / total)
+
+    def summary(self) -> dict:
+        """JSON-ready summary (lifetime_s null when infinite)."""
+        return {"force_N": self.force_N,
+                "lifetime_s": self.lifetime_s if math.isfinite(self.lifetime_s) else None,
+                "reason": self.reason, "sealed": self.sealed,
+                "ballistic_share": self.ballistic_share,
+                "largest_force_N": self.largest_force_N if math.isfinite(self.largest_force_N) else None,
+                "r_final_mm": 1e3 * float(self.r_m[-1]), "p_b_final_Pa": float(self.p_b_Pa[-1]),
+                "steps": self.steps, "message": self.message}
+
+    def trajectory_columns(self) -> dict[str, np.ndarray]:
+        """Trajectory arrays under CSV column names that carry their units."""
+        return {"t_s": self.t_s, "r_mm": 1e3 * self.r_m, "h_mm": 1e3 * self.h_m,
+                "p_b_Pa": self.p_b_Pa, "p_Pa": self.p_Pa, "u_c_nm": 1e9 * self.u_c_m,
+                **({"N": self.N, "N_dot_per_s": self.N_dot_per_s} if self.fluid == "air" else
+                   {"V_liquid_mm3": 1e9 * self.N, "V_dot_mm3_per_s": 1e9 * self.N_dot_per_s}),
+                "phi_s": self.phi_s, "ballistic_share": self.ballistic_share_t}
+
+
+def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))

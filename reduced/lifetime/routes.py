@@ -24,8 +24,8 @@ from typing import Any, Protocol
 
 from reduced.coupled import CoupledCavity
 from reduced.force_balance import force_balance
-from reduced.lifetime.paper import LifetimeResult, check_run, integrate
-from reduced.lifetime.result import Lifetime
+from reduced.lifetime.paper import check_run, integrate
+from reduced.lifetime.result import Lifetime, LifetimeResult
 from reduced.model import LeakageModel
 from reduced.viscoelastic import measurement_contact_time
 
