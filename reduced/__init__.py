@@ -1,13 +1,47 @@
 """The reduced suction-cup leakage model of Tiwari & Persson (eqs 3-24), and its inputs.
 
-Knows nothing of finite elements: the cup's stiffness arrives as a `StiffnessCurve`, from a CSV,
-the Appendix A formula or anything else that can fill one.
+Knows nothing of finite elements: the cup's stiffness arrives as a `StiffnessCurve` (from a CSV,
+the Appendix A formula or anything else that can fill one), its response to suction as a
+`SuctionTable`. A lifetime on any route:
+
+    import reduced
+    model = reduced.reference_model(reduced.CUP_A, reduced.uc_table(spectrum, 0.5))
+    life = reduced.solve_lifetime(model, 10.0, route="paper")      # a reduced.Lifetime
+
+The nouns are loaded on first use (PEP 562), so `import reduced` stays cheap.
 """
 
-from reduced.stiffness_curve import StiffnessCurve
+from __future__ import annotations
 
-__all__ = ["StiffnessCurve"]
-# The reduced model's nouns live in their modules (import them from there):
-#   reduced.cup (CupParameters, CUP_A, CUP_B), reduced.appendix_a (appendix_a_curve),
-#   reduced.gas (Gas, AIR, leak-rate laws), reduced.viscoelastic (RelaxationModulus),
-#   reduced.critical_gap (UcTable), reduced.lifetime (LeakageModel, reference_model, lifetime).
+import importlib
+from typing import Any
+
+#: public name -> the module that defines it
+_WHERE = {
+    "CupParameters": "reduced.cup", "CUP_A": "reduced.cup", "CUP_B": "reduced.cup", "CUPS": "reduced.cup",
+    "StiffnessCurve": "reduced.stiffness_curve", "appendix_a_curve": "reduced.appendix_a",
+    "Gas": "reduced.gas", "AIR": "reduced.gas",
+    "RelaxationModulus": "reduced.viscoelastic", "default_relaxation": "reduced.viscoelastic",
+    "measurement_contact_time": "reduced.viscoelastic",
+    "UcTable": "reduced.critical_gap", "uc_table": "reduced.roughness", "preset": "reduced.roughness",
+    "ContactProfile": "reduced.profile_leak", "SuctionTable": "reduced.suction_table",
+    "LeakageModel": "reduced.model", "reference_model": "reduced.model",
+    "solve_lifetime": "reduced.lifetime", "largest_holdable_force": "reduced.lifetime",
+    "Lifetime": "reduced.lifetime", "REASONS": "reduced.lifetime", "ROUTES": "reduced.lifetime",
+    "Route": "reduced.lifetime", "Run": "reduced.lifetime", "register_route": "reduced.lifetime",
+}
+
+__all__ = list(_WHERE)
+
+
+def __getattr__(name: str) -> Any:
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'reduced' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + __all__)

@@ -12,14 +12,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 from scipy.optimize import brentq
 
+from reduced.suction_table import SuctionTable
 from reduced.table_surface import TableSurface
-
-if TYPE_CHECKING:
-    from reduced.coupled import CoupledCavity
 
 __all__ = ["Branch", "BranchPoint", "safeguarded_newton"]
 
@@ -39,11 +36,12 @@ class BranchPoint:
 class Branch:
     """The branch of pull F1 at the current kappa: the state that holds N gas (module docstring)."""
 
-    def __init__(self, cc: CoupledCavity, F1: float, surfaces: dict[str, TableSurface]):
-        self.cc, self.F1, self.S = cc, F1, surfaces
-        self.kT, self.pa = cc.gas.kT_J, cc.p_a_Pa
-        self.u_lo, self.u_hi = float(cc.table.u_m[0]), float(cc.table.u_m[-1])
-        self.s_max = float(cc.table.dp_Pa[-1])
+    def __init__(self, table: SuctionTable, kT_J: float, p_a_Pa: float, F1: float,
+                 surfaces: dict[str, TableSurface]):
+        self.F1, self.S = F1, surfaces
+        self.kT, self.pa = kT_J, p_a_Pa
+        self.u_lo, self.u_hi = float(table.u_m[0]), float(table.u_m[-1])
+        self.s_max = float(table.dp_Pa[-1])
         self.last_u, self.last_s = self.u_hi, 0.0
         self._edge: tuple[float | None, BranchPoint | None] = (None, None)
 

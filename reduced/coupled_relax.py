@@ -1,6 +1,6 @@
 """Viscoelastic relaxation in the coupled cavity (`reduced.coupled`): the state (N, phi), eq (10).
 
-As in the paper route (`reduced.lifetime`, Sec. 3) the cup's stiffness follows the contact-time
+As in the paper route (`reduced.lifetime.paper`, Sec. 3) the cup's stiffness follows the contact-time
 state phi, kappa(phi) = kappa E_eff(phi) / E_eff(phi0) (phi0: the contact time of the stiffness
 measurement, the table's cup being the cup as measured), with
 
@@ -30,7 +30,7 @@ at each evaluation the branch at the current kappa is solved for the state holdi
 bisection, warm-started). Differentiating the two equations and eq (10) in time gives a 3 x 3
 linear system for (udot, sdot, phidot); it is singular where its determinant D = 0: with
 phi = 0 or a flat E_eff the static fold (no state holds more gas), otherwise the dynamic
-singularity where rdot diverges (as in `reduced.lifetime._run_relaxed`). End (reason): "fold"
+singularity where rdot diverges (as in the paper route, `reduced.lifetime.paper`). End (reason): "fold"
 (|D| / |D(0)| < 1e-4), "table_edge" (u reaches the table's smallest u), "over_force" (t = 0),
 "sealed" (no leak at t = 0) or "horizon" (still holding at t_max).
 """
@@ -40,21 +40,42 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.polynomial import chebyshev
 
+from reduced.coupled_branch import Branch, BranchPoint
+from reduced.coupled_result import CoupledLifetime
+from reduced.gas import Gas
 from reduced.ode import dopri5
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
-from reduced.coupled_branch import Branch, BranchPoint
+from reduced.suction_table import SuctionTable
 from reduced.table_surface import TableSurface, cell, solid_profile
+from reduced.viscoelastic import RelaxationModulus
 
-if TYPE_CHECKING:
-    from reduced.coupled import CoupledCavity, CoupledLifetime
-    from reduced.suction_table import SuctionTable
+__all__ = ["load_strip", "relaxed_lifetime", "relaxed_parts", "RelaxedParts"]
 
-__all__ = ["load_strip", "relaxed_lifetime"]
+
+class CoupledCavity(Protocol):
+    """What the relaxed dynamics reads of the cavity (`reduced.coupled.CoupledCavity`)."""
+
+    table: SuctionTable
+    u_c: Any
+    gas: Gas
+    p_a_Pa: float
+    kappa: float
+    interface: str
+    radial: str
+    along_u: str
+    relaxation: RelaxationModulus | None
+    phi0_s: float | None
+    patch_length_m: float | None
+
+    @property
+    def _relaxed(self) -> RelaxedParts: ...
+
+    def loaded(self, F1: float, u_start_m: float) -> tuple[float, float | None, float]: ...
 
 _DYNAMIC_FOLD = 1e-4    # |D| / |D(0)| at which the branch is declared folded (static or dynamic)
 _CHEBYSHEV = 7          # p_b points per node (cup A coarse, dp <= 60 kPa: 3e-7 in ln against direct)
@@ -262,7 +283,7 @@ class _Run:
 
     def __init__(self, cc: CoupledCavity, F1: float):
         self.cc, self.F1, self.parts = cc, F1, cc._relaxed
-        self.branch = Branch(cc, F1, self.parts.surfaces)
+        self.branch = Branch(cc.table, cc.gas.kT_J, cc.p_a_Pa, F1, self.parts.surfaces)
         self.dyn = _Dynamics(cc, self.parts, self.branch)
         self.N0 = math.nan
 
@@ -312,7 +333,6 @@ class _Run:
         return (t, P.u, R.kappa * P.s, N, R.N_dot, P.V[0], phi, R.kappa)
 
     def result(self, life: float, reason: str, msg: str, rows: list, steps: int = 0) -> CoupledLifetime:
-        from reduced.coupled import CoupledLifetime
         a = np.array(rows, dtype=float).reshape(-1, 8).T
         return CoupledLifetime(self.F1, life, reason, msg, self.N0, *a[:6], p_a_Pa=self.cc.p_a_Pa,
                                phi_s=a[6], kappa=a[7], steps=steps)

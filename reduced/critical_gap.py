@@ -28,8 +28,11 @@ from __future__ import annotations
 import math
 import os
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
@@ -38,6 +41,25 @@ from reduced.loglog import LogLogPchip, elementwise, read_two_columns
 
 __all__ = ["UcTable", "illustrative_uc_table", "ILLUSTRATIVE_UC_CSV"]
 
+
+def _frozen(values, dtype=float) -> np.ndarray:
+    a = np.array(values, dtype=dtype).reshape(-1)
+    a.flags.writeable = False
+    return a
+
+
+def _sorted_rows(p: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows by increasing p/E, each pressure once (a repeat must repeat its u_c)."""
+    order = np.argsort(p, kind="stable")
+    ps, us = p[order], u[order]
+    same = np.diff(ps) == 0
+    if np.any(same):
+        if np.any(us[1:][same] != us[:-1][same]):
+            raise ValueError("p_over_E: a repeated pressure with a different u_c")
+        keep = np.concatenate([[True], ~same])
+        ps, us = ps[keep], us[keep]
+    return ps, us
+
 ILLUSTRATIVE_UC_CSV = Path(__file__).parent / "data" / "uc_illustrative.csv"
 _HEADER = "p_over_E,u_c_m"
 _PATCH = re.compile(r"\s*patch_length_m\s*=\s*(\S+)\s*")
@@ -45,48 +67,77 @@ _PATCH = re.compile(r"\s*patch_length_m\s*=\s*(\S+)\s*")
 
 @dataclass(frozen=True, eq=False)
 class UcTable:
-    """u_c(p/E) from a table, log-log interpolation and extrapolation; trailing zeros = sealed."""
+    """u_c(p/E) from a table, log-log interpolation and extrapolation; u_c = 0 = sealed.
+
+    The one u_c table type, whether read from a CSV or computed by Persson theory
+    (`reduced.roughness.critical_gap_table`, which also fills the theory's columns: the mean
+    separation `u_mean_m`, the contact area ratio `contact_area_ratio` A/A0 at full magnification,
+    `sealed` where the contact percolates, and `theory`, its settings E_Pa, nu, method, gamma, a_c).
+    Rows keep the order they were given in (the theory answers the pressures it was asked for);
+    the interpolant is built on them sorted, and needs at least 2 open (u_c > 0) rows: a table with
+    fewer can be built and read, not evaluated. A CSV must be sorted and interpolable (`from_csv`).
+    """
 
     p_over_E: np.ndarray
     u_c_m: np.ndarray
     provenance: str = ""
     patch_length_m: float | None = None
-    _open: LogLogPchip = field(init=False, repr=False, compare=False)
+    u_mean_m: np.ndarray | None = None
+    contact_area_ratio: np.ndarray | None = None
+    sealed: np.ndarray | None = None
+    theory: Mapping[str, Any] | None = None
+    _rows: tuple = field(init=False, repr=False, compare=False)
+    _open: LogLogPchip | None = field(init=False, repr=False, compare=False)
     _seal: float = field(init=False, repr=False, compare=False)
     _vec: tuple = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        p = np.array(self.p_over_E, dtype=float).reshape(-1)
-        u = np.array(self.u_c_m, dtype=float).reshape(-1)
+        p = _frozen(self.p_over_E)
+        u = _frozen(self.u_c_m)
         if p.size != u.size:
             raise ValueError(f"u_c_m: {u.size} values for {p.size} pressures")
-        if p.size < 2:
-            raise ValueError(f"p_over_E: a u_c table needs at least 2 rows, got {p.size}")
-        if not (np.all(np.isfinite(p)) and np.all(p > 0) and np.all(np.diff(p) > 0)):
-            raise ValueError("p_over_E: must be finite, > 0 and strictly increasing")
+        if p.size == 0 or not (np.all(np.isfinite(p)) and np.all(p > 0)):
+            raise ValueError(f"p_over_E: need at least one pressure, each finite and > 0, got {p.size} rows")
         if not (np.all(np.isfinite(u)) and np.all(u >= 0)):
             raise ValueError("u_c_m: must be finite and >= 0 (0 = sealed)")
-        open_rows = int(np.count_nonzero(u > 0))
-        if np.any(u[:open_rows] <= 0):
-            raise ValueError("u_c_m: a sealed (0) row may only be followed by sealed rows")
-        if open_rows < 2:
-            raise ValueError("u_c_m: need at least 2 open (u_c > 0) rows to interpolate in log-log")
+        for name in ("u_mean_m", "contact_area_ratio", "sealed"):
+            column = getattr(self, name)
+            if column is not None:
+                column = _frozen(column, bool if name == "sealed" else float)
+                if column.size != p.size:
+                    raise ValueError(f"{name}: {column.size} values for {p.size} pressures")
+                object.__setattr__(self, name, column)
+        if self.sealed is None:
+            object.__setattr__(self, "sealed", _frozen(u == 0.0, bool))
         if self.patch_length_m is not None:
             L = float(self.patch_length_m)
             if not (math.isfinite(L) and L > 0):
                 raise ValueError(f"patch_length_m: must be finite and > 0 (or None), got {self.patch_length_m}")
             object.__setattr__(self, "patch_length_m", L)
-        p.flags.writeable = False
-        u.flags.writeable = False
+        if self.theory is not None:
+            object.__setattr__(self, "theory", MappingProxyType(dict(self.theory)))
         object.__setattr__(self, "p_over_E", p)
         object.__setattr__(self, "u_c_m", u)
-        object.__setattr__(self, "_open", LogLogPchip(p[:open_rows], u[:open_rows]))
-        object.__setattr__(self, "_seal", float(p[open_rows]) if open_rows < p.size else math.inf)
+        ps, us = _sorted_rows(p, u)
+        open_rows = int(np.count_nonzero(us > 0))
+        if np.any(us[:open_rows] <= 0):
+            raise ValueError("u_c_m: a sealed (0) row may only be followed by sealed rows")
+        object.__setattr__(self, "_rows", (ps, us))
+        object.__setattr__(self, "_seal", float(ps[open_rows]) if open_rows < ps.size else math.inf)
+        if open_rows < 2:
+            object.__setattr__(self, "_open", None)
+            object.__setattr__(self, "_vec", ())
+            return
+        object.__setattr__(self, "_open", LogLogPchip(ps[:open_rows], us[:open_rows]))
         # the same interpolant for arrays (`values`): ln u_c PCHIP in ln p/E, power laws beyond
-        lx, ly = np.log(p[:open_rows]), np.log(u[:open_rows])
+        lx, ly = np.log(ps[:open_rows]), np.log(us[:open_rows])
         cubic = PchipInterpolator(lx, ly, extrapolate=False)
         slopes = cubic([lx[0], lx[-1]], 1)
         object.__setattr__(self, "_vec", (cubic, lx[0], ly[0], float(slopes[0]), lx[-1], ly[-1], float(slopes[1])))
+
+    def _interpolable(self) -> None:
+        if self._open is None:
+            raise ValueError("u_c_m: need at least 2 open (u_c > 0) rows to interpolate in log-log")
 
     @property
     def sealing_p_over_E(self) -> float:
@@ -100,14 +151,16 @@ class UcTable:
     def scalar(self, x: float) -> float:
         if not x > 0:
             raise ValueError(f"p_over_E: contact pressure over modulus must be > 0, got {x}")
+        self._interpolable()
         seal = self._seal
         n = self._open.n
-        if seal < math.inf and x > self.p_over_E[n - 1]:
+        ps, us = self._rows
+        if seal < math.inf and x > ps[n - 1]:
             if x >= seal:
                 return 0.0
             # between the last open row and the first sealed row: linear in p/E down to 0
-            p_last = float(self.p_over_E[n - 1])
-            return float(self.u_c_m[n - 1]) * (seal - x) / (seal - p_last)
+            p_last = float(ps[n - 1])
+            return float(us[n - 1]) * (seal - x) / (seal - p_last)
         return self._open.value_and_slope(x)[0]
 
     def values(self, p_over_E: np.ndarray) -> np.ndarray:
@@ -115,6 +168,7 @@ class UcTable:
         x = np.asarray(p_over_E, dtype=float)
         if x.size and not np.all(x > 0):
             raise ValueError(f"p_over_E: contact pressure over modulus must be > 0, got {x[~(x > 0)][0]}")
+        self._interpolable()
         cubic, t_lo, y_lo, s_lo, t_hi, y_hi, s_hi = self._vec
         t = np.log(x)
         inside = np.clip(t, t_lo, t_hi)
@@ -122,7 +176,7 @@ class UcTable:
         out = np.exp(ln_u)
         if self._seal < math.inf:
             n = self._open.n
-            p_last, u_last = float(self.p_over_E[n - 1]), float(self.u_c_m[n - 1])
+            p_last, u_last = float(self._rows[0][n - 1]), float(self._rows[1][n - 1])
             ramp = u_last * (self._seal - x) / (self._seal - p_last)
             out = np.where(x > p_last, np.where(x >= self._seal, 0.0, ramp), out)
         return out
@@ -139,10 +193,18 @@ class UcTable:
             except ValueError:
                 raise ValueError(f"uc-table: '{path}': patch_length_m = {patch.group(1)!r} is not a number") from None
             comments = (comments[:patch.start()] + " " + comments[patch.end():]).strip()
-        return cls(p, u, provenance=comments or f"csv:{Path(path).name}", patch_length_m=length)
+        if p.size != u.size:
+            raise ValueError(f"u_c_m: {u.size} values for {p.size} pressures")
+        if p.size < 2:
+            raise ValueError(f"p_over_E: a u_c table needs at least 2 rows, got {p.size}")
+        if not (np.all(np.isfinite(p)) and np.all(p > 0) and np.all(np.diff(p) > 0)):
+            raise ValueError("p_over_E: must be finite, > 0 and strictly increasing")
+        table = cls(p, u, provenance=comments or f"csv:{Path(path).name}", patch_length_m=length)
+        table._interpolable()
+        return table
 
     def to_csv(self, path: str | os.PathLike) -> Path:
-        """Write the table atomically, provenance as '#' comment lines."""
+        """Write the table atomically (rows by increasing p/E), provenance as '#' comment lines."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(f".{path.name}.tmp")
@@ -152,7 +214,7 @@ class UcTable:
             for line in self.provenance.splitlines():
                 f.write(f"# {line}\n")
             f.write(_HEADER + "\n")
-            for p, u in zip(self.p_over_E, self.u_c_m):
+            for p, u in zip(*self._rows):
                 f.write(f"{p:.10g},{u:.10g}\n")
         os.replace(tmp, path)
         return path

@@ -16,7 +16,7 @@ first local maximum: that maximum (or its value at r1) is the largest force the 
 at or above it the cup detaches at t = 0.
 
 `ForceBalance` evaluates everything a lifetime needs at one state (h, N, phi) as floats, for the
-ODE right-hand sides of `reduced.lifetime`: N_eq(h), the holding force, the leak state (through
+ODE right-hand sides of `reduced.lifetime.paper`: N_eq(h), the holding force, the leak state (through
 the model's seal, `reduced.seal`: eq 6's strip or the contact-pressure profile), the fold, the
 start and, for a liquid, cavitation.
 """
@@ -24,21 +24,19 @@ start and, for a liquid, cavitation.
 from __future__ import annotations
 
 import math
+import weakref
 from functools import cached_property
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from reduced.fast_curve import CurveRangeError, ScalarPchip
 from reduced.geometry import geometry_source
+from reduced.model import LeakageModel
 from reduced.seal import ProfileSeal, StripSeal
 from reduced.viscoelastic import measurement_contact_time
 
-if TYPE_CHECKING:
-    from reduced.lifetime import LeakageModel
-
-__all__ = ["ForceBalance"]
+__all__ = ["ForceBalance", "force_balance"]
 
 _GRID = 1200          # h samples for locating folds (refined by brentq)
 
@@ -46,19 +44,25 @@ _GRID = 1200          # h samples for locating folds (refined by brentq)
 class ForceBalance:
     """Scalar evaluation of eqs (3)-(10), (23) for one model, plus the h grid for folds."""
 
-    def __init__(self, m: LeakageModel):
+    def __init__(self, m: LeakageModel, geometry: str = "cone", seal: str = "strip"):
+        if m.stiffness is None:
+            raise ValueError("stiffness: the force balance of eqs (3)-(8) needs a stiffness curve F0(u)")
+        if m.u_c is None:
+            raise ValueError("u_c: the leak needs a critical gap u_c(p/E)")
         self.m = m
-        self.geo = geometry_source(m.geometry, m.cup, m.stiffness)
+        self.seal_name = seal
+        curve = m.stiffness if m.kappa == 1.0 else m.stiffness.scaled(m.kappa)
+        self.geo = geometry_source(geometry, m.cup, curve)
         self.h1 = self.geo.h_ref_m             # F0 is taken at u = h1 - h
-        self.F0 = ScalarPchip(m.stiffness.u_m, m.stiffness.F0_N, "stiffness curve (u)")
+        self.F0 = ScalarPchip(curve.u_m, curve.F0_N, "stiffness curve (u)")
         self.gas = m.gas
         self.liquid = m.fluid == "water"
         self.kT = m.gas.kT_J
         self.pa = m.p_a_Pa
         self.beta = m.cup.beta
         self.uc = getattr(m.u_c, "scalar", m.u_c)
-        seal = ProfileSeal if m.seal == "profile" else StripSeal
-        self.seal = seal(m.stiffness, m.u_c, m.gas, m.p_a_Pa, m.cup.beta,
+        seal_law = ProfileSeal if seal == "profile" else StripSeal
+        self.seal = seal_law(curve, m.u_c, m.gas, m.p_a_Pa, m.cup.beta,
                          m.liquid_viscosity_Pa_s if self.liquid else None)
         self.relax = m.relaxation
         if self.relax is not None:
@@ -256,3 +260,17 @@ class ForceBalance:
     @cached_property
     def initial(self):
         return self.start()
+
+
+_BALANCES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def force_balance(model: LeakageModel, geometry: str | None = None, seal: str | None = None) -> ForceBalance:
+    """The `ForceBalance` of `model` with the cup laws `geometry` ('cone' | 'curve') and the
+    `seal` ('strip' | 'profile'), by default the model's; built once per model and choice (its
+    start state and fold grid are what every lifetime of the model shares)."""
+    key = (geometry or model.geometry, seal or model.seal)
+    per_model = _BALANCES.setdefault(model, {})
+    if key not in per_model:
+        per_model[key] = ForceBalance(model, *key)
+    return per_model[key]

@@ -32,21 +32,17 @@ contact, separation and percolation at the critical magnification are built up f
 wavelengths down. Wavelengths longer than the patch only tilt and lift it and do not change u_c,
 so the smallest such patch L can be measured from the theory itself
 (`reduced.roughness.persson.patch_length`: cut the spectrum's long wavelengths until u_c at 1 atm on
-4 MPa changes by 2 %): 202 um on pmma-1.89 (99-220 um on the PMMA presets, 1.7 times the roll-off
-wavelength 2 pi / q_r below which their spectra are flat), 140 um on the table preset (its ~0.1 mm
-quasi-periodic structure; its assumed roll-off at 6.3 mm matters only at lower pressures). On
+4 MPa changes by 2 %; the lengths of the presets are in docs/lifetime.md). On
 shorter scales a pressure is not a nominal one, and u_c of it is outside the theory. The FEM's
 pointwise profile has exactly such a feature: at small plate displacement only the sharp rim corner
 touches, one loaded node whose lumped pressure (its force over its tributary length) doubles with
 each mesh refinement (a corner singularity), so u_c(p_max) falls and the leak seals as the mesh is
-refined (cup A on pmma-1.89: 42, 92, 193 kPa at u = 0.39 mm on the coarse, medium, fine meshes; the
-lifetimes at 5 N 154, 184, 608 s). Averaged over patches of width L, the pressure entering u_c is
+refined. Averaged over patches of width L, the pressure entering u_c is
 the force on the annulus [r - L/2, r + L/2] over its area: exact for a uniform pressure, force
 conserving, and a lone loaded node becomes a strip L wide at F / (2 pi r L), independent of the
-element size once the elements are shorter than L (on cup A's rim: coarse 20-140 um, medium
-8-66 um, fine 4-32 um). The length is `UcTable.patch_length_m`, set by `reduced.roughness.uc_table`
-with `with_patch_length=True` (cup A, pmma-1.89, lifetimes at 5-80 N: medium vs fine within 1.8 %,
-coarse vs medium 8.7 %; unaveraged 70 % and 16.5 %; `benchmarks/bench_profile_convergence.py`).
+element size once the elements are shorter than L. The length is `UcTable.patch_length_m`, set by
+`reduced.roughness.uc_table` with `with_patch_length=True` (the convergence it buys is measured by
+`benchmarks/bench_profile_convergence.py`, docs/lifetime.md).
 Eq (6)'s suction share beta (p_a - p_b) is a pressure on the contact, not a load to spread: it is
 added on the nominal contact, the FEM's contact intervals (edges half-way between the last loaded
 node and the first free one) widened by L/2 each side (the patches that hold contact).

@@ -23,9 +23,9 @@ stiffness factor kappa, modulus E for p/E); Ndot is molecules/s for air and m^3/
   The suction's share is a pressure on the contact, as in eq 6, not a load to spread: averaged, a
   lone node's share would be its tributary length over L and vanish under refinement, and added on
   the average's support it would act on L plus the node's two element lengths. The FEM's lumped
-  nodal pressures do not integrate to the contact force where the load is concentrated (a lone
-  loaded corner node: +17 to +27 % on cup A, the vertex and midpoint nodes of a quadratic facet and
-  the off-plane neighbours' radii weigh it wrongly), while F0 is that force by equilibrium; so the
+  nodal pressures do not integrate to the contact force where the load is concentrated (the vertex
+  and midpoint nodes of a quadratic facet and the off-plane neighbours' radii weigh a lone loaded
+  corner node wrongly), while F0 is that force by equilibrium; so the
   profile supplies the shape and F0 the load, as eq (6) takes F0 and the width l. Without a patch
   length (a table from a CSV without the line, a callable) the raw profile is used as before;
   `patch_length_m` overrides the table's (0: off).

@@ -19,7 +19,7 @@ from scipy.interpolate import PchipInterpolator
 from reduced.profile_leak import ContactProfile, patch_average
 from reduced.suction_table import SuctionTable
 
-__all__ = ["TableSurface", "cell", "solid_profile"]
+__all__ = ["INTERFACES", "TableSurface", "cell", "solid_profile"]
 
 
 def cell(x: np.ndarray, y: np.ndarray, a: float, b: float) -> tuple[int, int, float, float]:
@@ -61,6 +61,11 @@ class TableSurface:
     def _lists(self) -> tuple[list, list | None, list]:
         return (self.z.tolist(), None if self.slope is None else self.slope.tolist(),
                 np.diff(self.u).tolist())
+
+
+#: the interface gas law in the contact zone next to the seal (`solid_profile`): the gas pressure
+#: rises linearly from p_b to p_a across the zone, or stays p_b, or is p_a throughout (the bounds)
+INTERFACES = ("linear", "p_b", "p_a")
 
 
 def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,

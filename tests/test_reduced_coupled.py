@@ -13,7 +13,8 @@ from reduced.coupled import CoupledCavity
 from reduced.coupled_relax import load_strip
 from reduced.critical_gap import illustrative_uc_table
 from reduced.cup import cup_by_name
-from reduced.lifetime import lifetime, reference_model
+from reduced.force_balance import force_balance
+from reduced.lifetime import largest_holdable_force, lifetime, reference_model, solve_lifetime
 from reduced.profile_leak import ContactProfile
 from reduced.suction_table import SuctionTable
 from reduced.viscoelastic import RelaxationModulus, default_relaxation, measurement_contact_time
@@ -41,6 +42,16 @@ def paper_table(model, nu: int, ndp: int) -> SuctionTable:
     return SuctionTable(u, dp, F1, V, rk, rcut, tuple(profiles), E_Pa=model.E_Pa)
 
 
+#: the coupled route as the paper's own table needs it: eq (6)'s strip geometry, fine quadrature
+COUPLED = {"route": "coupled", "radial": "strip", "samples": 1601}
+
+
+def on_table(model, n_u: int, n_dp: int, **fields):
+    """`model` with its own eqs (3)-(7) as the suction table and the interface gas at p_b (eq 6):
+    one model for the paper and the coupled route."""
+    return replace(model, suction=paper_table(model, n_u, n_dp), interface="p_b", **fields)
+
+
 @pytest.fixture(scope="module")
 def model():
     return reference_model(cup_by_name("A"), illustrative_uc_table())
@@ -48,16 +59,14 @@ def model():
 
 @pytest.fixture(scope="module")
 def refined(model):
-    """The coupled model on three nested paper tables (21, 41, 81 points per axis)."""
-    return [CoupledCavity(paper_table(model, n, n), model.u_c, model.gas, model.p_a_Pa,
-                          interface="p_b", radial="strip", samples=1601) for n in (21, 41, 81)]
+    """The model on three nested paper tables (21, 41, 81 points per axis)."""
+    return [on_table(model, n, n) for n in (21, 41, 81)]
 
 
 @pytest.mark.parametrize("F1", [5.0, 20.0, 60.0])
 def test_paper_table_reproduces_the_paper_route(model, refined, F1):
-    expected = lifetime(model, F1).lifetime_s
-    u_start = model.cup.h1_m - model.cup.h_start_m
-    errors = [abs(cc.lifetime(F1, u_start).lifetime_s / expected - 1) for cc in refined]
+    expected = solve_lifetime(model, F1, route="paper").lifetime_s
+    errors = [abs(solve_lifetime(m, F1, **COUPLED).lifetime_s / expected - 1) for m in refined]
     assert errors[-1] < 5e-3
     assert errors[2] < errors[0] / 4                     # second order: 4x per halving, twice
 
@@ -65,13 +74,12 @@ def test_paper_table_reproduces_the_paper_route(model, refined, F1):
 def test_start_content_is_the_papers(model):
     cc = CoupledCavity(paper_table(model, 41, 41), model.u_c, model.gas, model.p_a_Pa, interface="p_b")
     dp, N0 = cc.start(model.cup.h1_m - model.cup.h_start_m)
-    assert N0 == pytest.approx(model._core.initial[1], rel=1e-3)
+    assert N0 == pytest.approx(force_balance(model).initial[1], rel=1e-3)
 
 
 def test_over_force_detaches_at_once(model):
-    cc = CoupledCavity(paper_table(model, 21, 21), model.u_c, model.gas, model.p_a_Pa, interface="p_b")
-    res = cc.lifetime(200.0, model.cup.h1_m - model.cup.h_start_m)
-    assert res.reason == "over_force" and res.lifetime_s == 0.0
+    res = solve_lifetime(on_table(model, 21, 21), 200.0, route="coupled")
+    assert res.reason == "over_force" and res.lifetime_s == 0.0 and res.largest_force_N < 200.0
 
 
 def test_suction_table_json_round_trip(model, tmp_path):
@@ -87,25 +95,24 @@ def test_suction_table_json_round_trip(model, tmp_path):
 
 def test_kappa_is_the_papers_stiffness_factor(model):
     """kappa scales the table's response like the paper's kappa scales F0 (eqs 5, 6 with kappa F0,
-    p/E at the same E): the coupled model with kappa = 2 on the unscaled paper table gives the
-    paper route's lifetimes with F0 doubled (measured 1.3e-3 / 2.2e-4 off on 21x41 / 41x81 grids)."""
-    stiffer = replace(model, stiffness=model.stiffness.scaled(2.0))
-    cc = CoupledCavity(paper_table(model, 41, 81), model.u_c, model.gas, model.p_a_Pa, kappa=2.0,
-                       interface="p_b", radial="strip", samples=1601)
-    u_start = model.cup.h1_m - model.cup.h_start_m
+    p/E at the same E): one model with kappa = 2 gives on the coupled route (the unscaled paper
+    table) the paper route's lifetimes with F0 doubled (measured 1.3e-3 / 2.2e-4 off on 21x41 /
+    41x81 grids), and the paper route's kappa is the curve scaled by it."""
+    stiff = on_table(model, 41, 81, kappa=2.0)
+    scaled = replace(model, stiffness=model.stiffness.scaled(2.0))
     for F1 in (10.0, 40.0):
-        assert cc.lifetime(F1, u_start).lifetime_s == pytest.approx(lifetime(stiffer, F1).lifetime_s,
-                                                                    rel=1e-3)
+        paper_s = solve_lifetime(stiff, F1, route="paper").lifetime_s
+        assert paper_s == lifetime(scaled, F1).lifetime_s
+        assert solve_lifetime(stiff, F1, **COUPLED).lifetime_s == pytest.approx(paper_s, rel=1e-3)
+    assert largest_holdable_force(stiff, **COUPLED) == pytest.approx(largest_holdable_force(stiff), rel=1e-2)
 
 
 def test_interface_gas_bounds_the_lifetime(model):
     """The interface gas beyond the seal at p_b (the table's pressure), rising linearly, or at p_a
     (dp taken off the zone): less solid pressure, wider gaps, more leak, so the lifetimes order
     p_a < linear < p_b."""
-    table = paper_table(model, 21, 21)
-    u_start = model.cup.h1_m - model.cup.h_start_m
-    life = {i: CoupledCavity(table, model.u_c, model.gas, model.p_a_Pa, interface=i,
-                             radial="strip").lifetime(10.0, u_start).lifetime_s
+    base = on_table(model, 21, 21)
+    life = {i: solve_lifetime(replace(base, interface=i), 10.0, route="coupled", radial="strip").lifetime_s
             for i in ("p_a", "linear", "p_b")}
     assert life["p_a"] < life["linear"] < life["p_b"]
 
@@ -136,7 +143,7 @@ def test_flat_relaxation_is_the_quadrature(model):
 def relaxed_refined(model):
     """The relaxed coupled model (default law, phi0 of cup A) on paper tables of 21 and 41 points."""
     phi0 = measurement_contact_time(model.cup)
-    return [_relaxed_on_paper_table(model, n, default_relaxation(), phi0) for n in (21, 41)]
+    return [on_table(model, n, n, relaxation=default_relaxation(), phi0_s=phi0) for n in (21, 41)]
 
 
 @pytest.mark.parametrize("F1", [5.0, 20.0, 60.0])
@@ -146,15 +153,13 @@ def test_relaxed_paper_table_reproduces_the_relaxed_paper_route(model, relaxed_r
     paper route's; what remains is the interpolation of the table, second order in the grid as
     unrelaxed (measured 3.1e-3 / 1.9e-3 / 1.9e-3 on 21 x 21 and 7.1e-4 / 4.5e-4 / 3.3e-4 on
     41 x 41, the unrelaxed model's own errors on these grids being the same to 10 %)."""
-    paper = replace(model, relaxation=default_relaxation())
-    expected = lifetime(paper, F1)
-    u_start = model.cup.h1_m - model.cup.h_start_m
-    runs = [cc.lifetime(F1, u_start) for cc in relaxed_refined]
+    expected = solve_lifetime(relaxed_refined[0], F1, route="paper")
+    runs = [solve_lifetime(m, F1, **COUPLED) for m in relaxed_refined]
     errors = [abs(r.lifetime_s / expected.lifetime_s - 1) for r in runs]
     assert errors[1] < 1.5e-3
     assert errors[1] < errors[0] / 3                      # second order: 4x per halving
-    assert runs[1].phi_s[-1] == pytest.approx(expected.phi_s[-1], rel=5e-3)
-    assert runs[1].kappa[0] == pytest.approx(default_relaxation()(0.0) / default_relaxation()(
+    assert runs[1].trajectory["phi_s"][-1] == pytest.approx(expected.trajectory["phi_s"][-1], rel=5e-3)
+    assert runs[1].trajectory["kappa"][0] == pytest.approx(default_relaxation()(0.0) / default_relaxation()(
         measurement_contact_time(model.cup)), rel=1e-12)
 
 

@@ -151,3 +151,40 @@ def test_contact_time_eq10_for_constant_rdot_over_l():
     for t, y in zip(sol.t, sol.y):
         assert y[0] == pytest.approx(tau * (1 - math.exp(-t / tau)), rel=1e-8, abs=1e-10)
     assert contact_time_rate(7.0, 0.0, l) == 1.0          # stationary contact: phi = t
+
+
+def test_persson_theory_gives_the_one_u_c_table_type(tmp_path):
+    """critical_gap_table answers the pressures it was asked for, in their order, as a UcTable
+    with the theory's columns; the interpolant is built on the rows sorted, so an unsorted table
+    interpolates as the sorted one, and a one-row answer can be read but not interpolated."""
+    from reduced.roughness import critical_gap_table, preset, uc_table
+    from reduced.roughness.persson import GapTable
+
+    spectrum = preset("pmma-1.89").spectrum()
+    asked = np.array([0.05, 0.002, 0.01, 0.0005])
+    table = critical_gap_table(spectrum, 4e6, 0.5, asked)
+    assert GapTable is UcTable and isinstance(table, UcTable)
+    np.testing.assert_array_equal(table.p_over_E, asked)
+    assert table.u_mean_m.shape == table.contact_area_ratio.shape == table.sealed.shape == (4,)
+    assert np.all(table.u_mean_m > table.u_c_m) and table.theory["method"] == "emt"
+    order = np.argsort(asked)
+    ordered = UcTable(asked[order], table.u_c_m[order])
+    for x in (3e-4, 0.001, 0.02, 0.3):
+        assert table(x) == ordered(x)
+    back = UcTable.from_csv(table.to_csv(tmp_path / "uc.csv"))          # written sorted
+    np.testing.assert_array_equal(back.p_over_E, asked[order])
+    one = critical_gap_table(spectrum, 4e6, 0.5, [0.025])
+    assert one.u_c_m.size == 1 and one.u_c_m[0] > 0
+    with pytest.raises(ValueError, match="^u_c_m: need at least 2 open"):
+        one(0.025)
+    full = uc_table(spectrum, 0.5, with_patch_length=False)
+    assert full.u_mean_m is not None and full.patch_length_m is None
+
+
+def test_u_c_table_rows_are_checked_in_any_order():
+    with pytest.raises(ValueError, match="^u_c_m: a sealed"):
+        UcTable([0.04, 0.01, 0.02], [1e-7, 1e-6, 0.0])              # sealed below an open row
+    with pytest.raises(ValueError, match="^p_over_E: a repeated pressure"):
+        UcTable([0.01, 0.02, 0.01], [1e-6, 0.5e-6, 2e-6])
+    with pytest.raises(ValueError, match="^sealed: 2 values for 3"):
+        UcTable([0.01, 0.02, 0.04], [1e-6, 0.5e-6, 0.0], sealed=[False, False])

@@ -10,7 +10,8 @@ from reduced.appendix_a import appendix_a_force
 from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
 from reduced.cup import CUP_A, CUP_B
 from reduced.fast_curve import CurveRangeError
-from reduced.lifetime import (largest_holdable_force, lifetime, lifetime_by_quadrature,
+from reduced.force_balance import force_balance
+from reduced.lifetime import (largest_holdable_force, lifetime, lifetime_by_quadrature, solve_lifetime,
                               reference_model)
 from reduced.stiffness_curve import StiffnessCurve
 from reduced.viscoelastic import RelaxationModulus, default_relaxation
@@ -35,7 +36,7 @@ def _fold_model():
     (_fold_model(), 10.0, "fold"), (_fold_model(), 40.0, "fold"),
 ])
 def test_integrator_agrees_with_quadrature_along_the_branch(model, force, reason):
-    r = lifetime(model, force)
+    r = solve_lifetime(model, force)
     t_q = lifetime_by_quadrature(model, force)
     assert r.reason == reason
     # time stepping (rtol 1e-6 on the leaked gas, events) vs adaptive Gauss-Kronrod in h (1e-10)
@@ -52,14 +53,14 @@ def test_vanishing_pull_force_agrees_with_quadrature():
 
     model = reference_model(CUP_A, uc_table(preset("pmma-1.89").spectrum(), 0.5))
     for force in (1e-3, 1e-2):
-        r = lifetime(model, force)
+        r = solve_lifetime(model, force)
         assert r.reason == "reached_r1"
         assert r.lifetime_s == pytest.approx(lifetime_by_quadrature(model, force), rel=1e-5)
 
 
 def test_tighter_tolerance_converges_to_the_quadrature():
     t_q = lifetime_by_quadrature(REF_A, 20.0)
-    errs = [abs(lifetime(REF_A, 20.0, rtol=tol).lifetime_s / t_q - 1) for tol in (1e-5, 1e-7, 1e-9)]
+    errs = [abs(solve_lifetime(REF_A, 20.0, rtol=tol).lifetime_s / t_q - 1) for tol in (1e-5, 1e-7, 1e-9)]
     assert errs[0] > errs[1] > errs[2] and errs[2] < 1e-8
 
 
@@ -95,7 +96,7 @@ def test_mass_balance_and_force_balance_at_every_output(relaxed):
 # ----------------------------------------------------------------- limits in u_c
 def test_lifetime_grows_without_bound_as_u_c_goes_to_zero():
     scales = [30.0, 3.0, 1.0, 0.3, 1e-2, 1e-3, 1e-4]
-    lives = [lifetime(dataclasses.replace(REF_A, u_c=lambda x, s=s: s * UC(x)), 20.0).lifetime_s
+    lives = [solve_lifetime(dataclasses.replace(REF_A, u_c=lambda x, s=s: s * UC(x)), 20.0).lifetime_s
              for s in scales]
     assert all(a < b for a, b in zip(lives, lives[1:]))            # falls as u_c grows
     # small u_c: the flow is ballistic, Ndot ~ u_c^2 (eq 17), so t ~ u_c^-2: x100 per decade, up to
@@ -109,7 +110,7 @@ def test_lifetime_grows_without_bound_as_u_c_goes_to_zero():
 
 def test_sealed_interface_holds_forever():
     sealed = UcTable([1e-4, 1e-3, 2e-3], [1e-6, 1e-7, 0.0])          # seals above p/E = 2e-3
-    r = lifetime(dataclasses.replace(REF_A, u_c=sealed), 20.0)
+    r = solve_lifetime(dataclasses.replace(REF_A, u_c=sealed), 20.0)
     assert r.reason == "sealed" and r.sealed and math.isinf(r.lifetime_s)
     s = r.summary()
     assert s["lifetime_s"] is None and s["sealed"] is True
@@ -117,8 +118,8 @@ def test_sealed_interface_holds_forever():
 
 
 def test_horizon_is_reported_not_a_lifetime():
-    r = lifetime(REF_A, 20.0, t_max_s=10.0)
-    assert r.reason == "horizon" and math.isinf(r.lifetime_s) and r.t_s[-1] == pytest.approx(10.0)
+    r = solve_lifetime(REF_A, 20.0, t_max_s=10.0)
+    assert r.reason == "horizon" and math.isinf(r.lifetime_s) and r.trajectory["t_s"][-1] == pytest.approx(10.0)
 
 
 # ----------------------------------------------------------------- start: over-force
@@ -138,10 +139,11 @@ def test_largest_holdable_force_is_the_maximum_of_the_holding_force():
 
 def test_over_force_detaches_at_t0():
     F = largest_holdable_force(REF_A)
-    r = lifetime(REF_A, 1.0001 * F)
+    r = solve_lifetime(REF_A, 1.0001 * F)
     assert r.reason == "over_force" and r.lifetime_s == 0.0 and "detaches at once" in r.message
+    assert r.largest_force_N == F
     assert lifetime_by_quadrature(REF_A, 1.0001 * F) == 0.0
-    below = lifetime(REF_A, 0.999 * F)
+    below = solve_lifetime(REF_A, 0.999 * F)
     assert below.reason in ("reached_r1", "fold") and below.lifetime_s > 0
 
 
@@ -150,9 +152,9 @@ def test_relaxation_with_a_constant_modulus_is_the_reference_model():
     """A flat E_eff(t) = 4 MPa gives kappa = 1: the 2-D (N, phi) path must reproduce the 1-D one."""
     flat = RelaxationModulus([1.0, 1e12], [4e6, 4e6])
     for F1 in (5.0, 40.0):
-        r = lifetime(dataclasses.replace(REF_A, relaxation=flat), F1)
+        r = solve_lifetime(dataclasses.replace(REF_A, relaxation=flat), F1)
         assert r.lifetime_s == pytest.approx(lifetime_by_quadrature(REF_A, F1), rel=1e-4)
-        assert r.phi_s[-1] > 0
+        assert r.trajectory["phi_s"][-1] > 0
 
 
 def test_relaxation_changes_the_lifetime_and_keeps_the_invariants():
@@ -170,9 +172,10 @@ def test_curve_geometry_sampled_from_the_cone_reproduces_the_cone():
     curve = StiffnessCurve(u, REF_A.stiffness.force(c.h1_m - u), c.h1_m, r_c_m=r,
                            l_m=np.array([c.contact_width(x) for x in r]),
                            V_m3=np.array([c.volume(x) for x in r]), provenance={"source": "cone"})
-    m = dataclasses.replace(REF_A, stiffness=curve, geometry="curve")
+    m = dataclasses.replace(REF_A, stiffness=curve)
     # same physics, r, V, l now PCHIP-interpolated (~1e-7) instead of evaluated
-    assert lifetime(m, 20.0).lifetime_s == pytest.approx(lifetime(REF_A, 20.0).lifetime_s, rel=1e-4)
+    assert solve_lifetime(m, 20.0, cup_laws="curve").lifetime_s == pytest.approx(
+        solve_lifetime(m, 20.0, cup_laws="cone").lifetime_s, rel=1e-4)
 
 
 def test_leaving_the_stiffness_curve_is_an_error_not_a_clamp():
@@ -192,6 +195,8 @@ def test_leaving_the_stiffness_curve_is_an_error_not_a_clamp():
 def test_bad_force_is_rejected(force):
     with pytest.raises(ValueError, match="force_N: pull force must be > 0 N"):
         lifetime(REF_A, force)
+    with pytest.raises(ValueError, match="force_N: pull force must be > 0 N"):
+        solve_lifetime(REF_A, force)
 
 
 def test_initial_state_and_leak_rate_by_hand():
@@ -345,9 +350,9 @@ def test_profile_seal_of_a_uniform_strip_is_the_papers_strip_on_an_annulus():
     prof = dataclasses.replace(strip, seal="profile")
     for hh in (0.3 * CUP_A.h1_m, 0.6 * CUP_A.h1_m):
         i = int(np.argmin(np.abs(h - hh)))                   # at a sample: no interpolation between profiles
-        N = 0.5 * strip._core.n_eq(h[i], 1.0, 0.0)[0]
-        q_strip = strip._core.state(h[i], N, 1.0, 4e6, 10.0)[0]
-        q_prof = prof._core.state(h[i], N, 1.0, 4e6, 10.0)[0]
+        N = 0.5 * force_balance(strip).n_eq(h[i], 1.0, 0.0)[0]
+        q_strip = force_balance(strip).state(h[i], N, 1.0, 4e6, 10.0)[0]
+        q_prof = force_balance(prof).state(h[i], N, 1.0, 4e6, 10.0)[0]
         assert q_prof / q_strip == pytest.approx(l[i] / (r[i] * math.log(1 + l[i] / r[i])), rel=1e-9)
     t_strip, t_prof = lifetime(strip, 20.0).lifetime_s, lifetime(prof, 20.0).lifetime_s
     assert 0.85 * t_strip < t_prof < t_strip

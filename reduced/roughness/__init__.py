@@ -1,19 +1,19 @@
-"""Rough-surface contact: power spectra, Persson theory and the critical gap u_c(p) (issue 4).
+"""Rough-surface contact: power spectra, Persson theory and the critical gap u_c(p).
 
 Public entry points::
 
     from reduced.roughness import critical_gap_table, preset, read_psd_csv, spectrum_from_line_scan
-    table = critical_gap_table(preset("pmma-1.89").spectrum(), 4e6, 0.5, p_over_E)   # GapTable
+    table = critical_gap_table(preset("pmma-1.89").spectrum(), 4e6, 0.5, p_over_E)   # a UcTable
 
-Modules: `spectrum` (convention, parametric spectra, 1D <-> 2D), `line_scan`, `persson` (contact
-area, separation, critical junction), `effective_medium` (Bruggeman leak rate), `surfaces`
+Modules: `spectrum` (convention, parametric spectra, 1D <-> 2D), `line_scan`, `separation` (moments,
+contact area, mean separation), `persson` (critical junction, the u_c table), `effective_medium` (Bruggeman leak rate), `surfaces`
 (calibrated presets), `bem` (a periodic boundary-element check).
 """
 
 from .line_scan import read_line_scan, spectrum_from_line_scan
-from .persson import GapTable, critical_gap_table, uc_table
+from .persson import GapTable, critical_gap_table, uc_table  # noqa: F401  (GapTable: the former name of UcTable)
 from .spectrum import PowerSpectrum, read_psd_csv, self_affine
 from .surfaces import load_presets, preset
 
-__all__ = ["GapTable", "PowerSpectrum", "critical_gap_table", "load_presets", "preset",
+__all__ = ["PowerSpectrum", "critical_gap_table", "load_presets", "preset",
            "read_line_scan", "read_psd_csv", "self_affine", "spectrum_from_line_scan", "uc_table"]

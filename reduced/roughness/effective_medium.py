@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import erf, erfinv
 
-from .persson import Moments, contact_area_ratio, mean_separation
+from .separation import Moments, contact_area_ratio, mean_separation
 
 
 def gap_distribution(mom: Moments, pstar: np.ndarray, gamma: float = 0.45, n_zeta: int = 16,

@@ -1,4 +1,4 @@
-"""Lifetime of a suction cup: the leakage dynamics of Sec. 3 (eqs 3-10) with the flow of Sec. 4.
+"""The paper and profile routes' lifetime: the leakage dynamics of Sec. 3 (eqs 3-10), flow of Sec. 4.
 
 State and equations. The gas content N of the cavity and (with relaxation) the contact-time state
 phi evolve in time; the cup height h is algebraic, fixed by the force balance
@@ -39,191 +39,29 @@ Reference mode (`reference_model`): Appendix A stiffness (x0 = r0, x1 = r1, d0 =
 E = 4 MPa), no relaxation (kappa = 1, E = 4 MPa for p/E), air at 293.15 K (eta = 1.81e-5 Pa s,
 m = 28.97 u), p_a = 1e5 Pa, lambda_a from eq (12) at p_a, u_c from the given table, rigid-cone
 geometry eqs (3)-(5), start and detachment as above. There the state is one-dimensional and
-`lifetime_by_quadrature` gives the lifetime independently as t = int dN_eq/dh / Ndot dh.
+`reduced.lifetime.quadrature` gives the lifetime independently as t = int dN_eq/dh / Ndot dh.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from functools import cached_property
-
 import numpy as np
-from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from reduced.appendix_a import appendix_a_curve
-from reduced.cup import CupParameters
 from reduced.fast_curve import CurveRangeError
-from reduced.gas import AIR, WATER_VISCOSITY_PA_S, Gas
-from reduced.force_balance import ForceBalance
-from reduced.seal import SEALS
+from reduced.force_balance import ForceBalance, force_balance
+from reduced.model import LeakageModel
+from reduced.lifetime.result import LifetimeResult
 from reduced.ode import dopri5
-from reduced.stiffness_curve import StiffnessCurve
-from reduced.viscoelastic import RelaxationModulus
 
-__all__ = ["LeakageModel", "LifetimeResult", "reference_model", "lifetime", "lifetime_sweep",
-           "lifetime_by_quadrature", "largest_holdable_force", "REASONS"]
-
-REASONS = ("reached_r1", "fold", "over_force", "sealed", "horizon")
+__all__ = ["lifetime", "lifetime_sweep", "integrate", "start_height",
+           "sealed_on_branch", "check_run"]
 _DYNAMIC_FOLD = 1e-4  # |D| / |D(0)| at which the relaxed dynamics is declared singular
 
 
-@dataclass(frozen=True, eq=False)
-class LeakageModel:
-    """Everything a lifetime depends on except the pull force F1.
-
-    cup: geometry and Table 1 parameters. stiffness: F0 over u = h1 - h (any `StiffnessCurve`; with
-    the cone geometry h1 is the cup's, eq 3, with the curve geometry the curve's).
-    u_c: critical gap [m] as a function of p/E (e.g. a `UcTable`). gas, p_a_Pa: the gas and the
-    ambient pressure. relaxation: E_eff(t), or None for no relaxation (then kappa = 1 and E_Pa is the
-    modulus in p/E). phi0_s: contact time of the stiffness measurement (default: eq 10 steady state
-    at the paper's 0.12 mm/s, see `measurement_contact_time`). geometry: 'cone' (eqs 3-5) or 'curve'
-    (r, V, l from the stiffness curve). seal: 'strip' (eq 6, the paper's route) or 'profile' (the
-    curve's contact-pressure profiles, `reduced.seal`; needs geometry 'curve'). fluid: 'air' (the gas leaks in, eqs 8, 19) or 'water' (the
-    cavity is full of an incompressible liquid that flows in by eq 24; its "content" is the liquid
-    volume, p_b follows from the force balance and may become negative, i.e. tension, Sec. 6).
-    cavitation_pressure_Pa: water only; None: the liquid sustains any tension (metastable); a value
-    in [0, p_a): below it a vapour bubble at that pressure opens (module docstring).
-    """
-
-    cup: CupParameters
-    stiffness: StiffnessCurve
-    u_c: Callable[[float], float]
-    gas: Gas = AIR
-    p_a_Pa: float = 1e5
-    E_Pa: float = 4e6
-    relaxation: RelaxationModulus | None = None
-    phi0_s: float | None = None
-    geometry: str = "cone"
-    seal: str = "strip"
-    fluid: str = "air"
-    liquid_viscosity_Pa_s: float = WATER_VISCOSITY_PA_S
-    cavitation_pressure_Pa: float | None = None
-    label: str = field(default="", compare=False)
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.p_a_Pa) and self.p_a_Pa > 0):
-            raise ValueError(f"p_a_Pa: ambient pressure must be > 0 Pa, got {self.p_a_Pa}")
-        if not (math.isfinite(self.E_Pa) and self.E_Pa > 0):
-            raise ValueError(f"E_Pa: modulus must be > 0 Pa, got {self.E_Pa}")
-        if self.phi0_s is not None and not self.phi0_s > 0:
-            raise ValueError(f"phi0_s: measurement contact time must be > 0 s, got {self.phi0_s}")
-        if self.geometry not in ("cone", "curve"):
-            raise ValueError(f"geometry: unknown source '{self.geometry}', allowed: cone, curve")
-        if self.seal not in SEALS:
-            raise ValueError(f"seal: unknown seal '{self.seal}', allowed: {', '.join(SEALS)}")
-        if self.seal == "profile" and self.geometry != "curve":
-            raise ValueError("seal: the profile's radii are the FEM's: 'profile' needs geometry 'curve' "
-                             "(r and V from the same curve)")
-        if self.fluid not in ("air", "water"):
-            raise ValueError(f"fluid: unknown fluid '{self.fluid}', allowed: air, water")
-        if self.fluid == "water" and self.relaxation is not None:
-            raise ValueError("fluid: the water-filled cavity is implemented without relaxation only")
-        if not (math.isfinite(self.liquid_viscosity_Pa_s) and self.liquid_viscosity_Pa_s > 0):
-            raise ValueError(f"liquid_viscosity_Pa_s: must be > 0, got {self.liquid_viscosity_Pa_s}")
-        p_cav = self.cavitation_pressure_Pa
-        if p_cav is not None:
-            if self.fluid != "water":
-                raise ValueError("cavitation_pressure_Pa: only for fluid 'water'")
-            if not (math.isfinite(p_cav) and 0.0 <= p_cav < self.p_a_Pa):
-                raise ValueError(f"cavitation_pressure_Pa: must be in [0, p_a) = [0, {self.p_a_Pa:g}) Pa, "
-                                 f"got {p_cav}")
-
-    @property
-    def reference(self) -> bool:
-        return self.relaxation is None
-
-    @cached_property
-    def _core(self) -> ForceBalance:
-        return ForceBalance(self)
-
-
-def reference_model(cup: CupParameters, u_c: Callable[[float], float]) -> LeakageModel:
-    """The reference-mode model of the issue (module docstring) for `cup` and `u_c`."""
-    return LeakageModel(cup=cup, stiffness=appendix_a_curve(cup, E_Pa=4e6, d0_m=2e-3), u_c=u_c,
-                        gas=Gas(T_K=293.15, molecular_mass_u=28.97, viscosity_Pa_s=1.81e-5),
-                        p_a_Pa=1e5, E_Pa=4e6, relaxation=None, geometry="cone", label="reference")
-
-
-@dataclass(frozen=True, eq=False)
-class LifetimeResult:
-    """Lifetime and trajectories (SI). lifetime_s is inf when sealed or beyond the horizon."""
-
-    force_N: float
-    lifetime_s: float
-    reason: str
-    message: str
-    largest_force_N: float
-    N0: float
-    t_s: np.ndarray
-    r_m: np.ndarray
-    h_m: np.ndarray
-    p_b_Pa: np.ndarray
-    p_Pa: np.ndarray
-    u_c_m: np.ndarray
-    N: np.ndarray
-    N_dot_per_s: np.ndarray
-    phi_s: np.ndarray
-    ballistic_share_t: np.ndarray
-    force_residual: np.ndarray
-    steps: int = 0
-    fluid: str = "air"
-
-    @property
-    def sealed(self) -> bool:
-        return self.reason == "sealed"
-
-    @property
-    def ballistic_share(self) -> float:
-        """Share of the leaked molecules that went through eq (19)'s ballistic term."""
-        if self.t_s.size < 2:
-            return float(self.ballistic_share_t[0])
-        total = _trapezoid(self.N_dot_per_s, self.t_s)
-        if total <= 0:
-            return float(self.ballistic_share_t[0])
-        return float(_trapezoid(self.ballistic_share_t * self.N_dot_per_s, self.t_s) / total)
-
-    def summary(self) -> dict:
-        """JSON-ready summary (lifetime_s null when infinite)."""
-        return {"force_N": self.force_N,
-                "lifetime_s": self.lifetime_s if math.isfinite(self.lifetime_s) else None,
-                "reason": self.reason, "sealed": self.sealed,
-                "ballistic_share": self.ballistic_share,
-                "largest_force_N": self.largest_force_N if math.isfinite(self.largest_force_N) else None,
-                "r_final_mm": 1e3 * float(self.r_m[-1]), "p_b_final_Pa": float(self.p_b_Pa[-1]),
-                "steps": self.steps, "message": self.message}
-
-    def trajectory_columns(self) -> dict[str, np.ndarray]:
-        """Trajectory arrays under CSV column names that carry their units."""
-        return {"t_s": self.t_s, "r_mm": 1e3 * self.r_m, "h_mm": 1e3 * self.h_m,
-                "p_b_Pa": self.p_b_Pa, "p_Pa": self.p_Pa, "u_c_nm": 1e9 * self.u_c_m,
-                **({"N": self.N, "N_dot_per_s": self.N_dot_per_s} if self.fluid == "air" else
-                   {"V_liquid_mm3": 1e9 * self.N, "V_dot_mm3_per_s": 1e9 * self.N_dot_per_s}),
-                "phi_s": self.phi_s, "ballistic_share": self.ballistic_share_t}
-
-
-def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
-    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
-
-
-def largest_holdable_force(model: LeakageModel) -> float:
-    """The largest F1 [N] the freshly pressed cup holds at t = 0 (the first maximum of F_hold)."""
-    return float(model._core.initial[3])
-
-
-# ----------------------------------------------------------------------------- lifetime
-def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol: float = 1e-6,
-             refine: int = 1, progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
-    """Lifetime [s] of the cup under the pull force F1 = force_N, with trajectories.
-
-    Integrates N (and phi with relaxation) by an adaptive Dormand-Prince pair with terminal events;
-    h is solved from the force balance at every evaluation. The trajectories hold the accepted
-    steps, or `refine` points per step from the solver's 4th-order dense output (each projected
-    onto the force balance). Raises ValueError for bad input and `CurveRangeError` (a ValueError)
-    if the state leaves the stiffness curve.
-    """
+def check_run(force_N: float, t_max_s: float, rtol: float, refine: int) -> float:
+    """F1 [N] after checking the run's inputs (ValueError naming the field)."""
     F1 = float(force_N)
     if not (math.isfinite(F1) and F1 > 0):
         # F1 = 0 ends only asymptotically at r1, where the contact pressure p -> 0
@@ -232,15 +70,43 @@ def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol
         raise ValueError(f"t_max_s, rtol: need t_max_s > 0 and 0 < rtol < 0.01, got {t_max_s}, {rtol}")
     if not (isinstance(refine, int) and 1 <= refine <= 1000):
         raise ValueError(f"refine: output points per step must be an integer in [1, 1000], got {refine}")
-    core = model._core
+    return F1
+
+
+def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol: float = 1e-6,
+             refine: int = 1, progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
+    """Lifetime [s] of the cup under the pull force F1 = force_N, with trajectories, on the route
+    the model's `geometry` and `seal` name (`integrate`; `reduced.solve_lifetime` takes the route
+    by name and returns the common `Lifetime`)."""
+    return integrate(force_balance(model), force_N, t_max_s=t_max_s, rtol=rtol, refine=refine,
+                     progress=progress)
+
+
+def start_height(core: ForceBalance, F1: float) -> float:
+    """h at t = 0 under F1 < the largest holdable force: F1 applied at the start content N0."""
+    hs, N0, kappa0, Fmax, hm = core.initial
+    return core.liquid_start(F1) if core.liquid else brentq(
+        lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm, xtol=1e-15 * core.h1, rtol=1e-15)
+
+
+def integrate(core: ForceBalance, force_N: float, *, t_max_s: float = 1e12, rtol: float = 1e-6,
+              refine: int = 1, progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
+    """Lifetime [s] of the cup of `core` under the pull force F1 = force_N, with trajectories.
+
+    Integrates N (and phi with relaxation) by an adaptive Dormand-Prince pair with terminal events;
+    h is solved from the force balance at every evaluation. The trajectories hold the accepted
+    steps, or `refine` points per step from the solver's 4th-order dense output (each projected
+    onto the force balance). Raises ValueError for bad input and `CurveRangeError` (a ValueError)
+    if the state leaves the stiffness curve.
+    """
+    F1 = check_run(force_N, t_max_s, rtol, refine)
     hs, N0, kappa0, Fmax, hm = core.initial
     if F1 >= Fmax:
         msg = (f"F1 = {F1:g} N is at or above the largest force the cup can hold at t = 0, "
                f"{Fmax:.4g} N: it detaches at once")
         return _result(core, F1, 0.0, "over_force", msg, Fmax, N0, [0.0], [[N0, 0.0]], [hs], 0)
-    h0 = core.liquid_start(F1) if core.liquid else brentq(
-        lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm, xtol=1e-15 * core.h1, rtol=1e-15)
-    run = _run_reference if model.reference else _run_relaxed
+    h0 = start_height(core, F1)
+    run = _run_reference if core.relax is None else _run_relaxed
     result = run(core, F1, N0, h0, Fmax, t_max_s, rtol, refine)
     if progress:
         progress(1.0, f"F1 = {F1:g} N: {result.reason}")
@@ -268,7 +134,7 @@ def _run_reference(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) ->
     N_end = core.n_eq(h_end, 1.0, F1)[0]
     E = core.m.E_Pa
     # sealed anywhere on the branch? (u_c = 0 makes Ndot vanish; it is never crossed in finite time)
-    sealed_at = _sealed_on_branch(core, h0, h_end, F1)
+    sealed_at = sealed_on_branch(core, h0, h_end, F1)
     if sealed_at is not None:
         line = " (l = 0 there: a line contact, no strip resolved)" if core.geo.at(sealed_at)[4] <= 0 else ""
         return _result(core, F1, math.inf, "sealed",
@@ -433,9 +299,9 @@ def _run_relaxed(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) -> L
     return _result(core, F1, ts[-1], reason, msg, Fmax, N0, ts, sol_y, hs, sol.steps)
 
 
-def _sealed_on_branch(core: ForceBalance, h0: float, h_end: float, F1: float) -> float | None:
+def sealed_on_branch(core: ForceBalance, h0: float, h_end: float, F1: float) -> float | None:
     """First h on [h0, h_end] (checked on the fold-search grid) where u_c = 0, or None."""
-    line = core.geo.line_contact and core.m.seal == "strip"
+    line = core.geo.line_contact and core.seal_name == "strip"
     if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf and not line:
         return None        # a table without sealed rows never seals, unless the strip is a line
     h, _ = core.grid
@@ -480,41 +346,3 @@ def lifetime_sweep(model: LeakageModel, forces_N, progress=None, **kw) -> list[L
         if progress:
             progress((i + 1) / len(forces), f"F1 = {F1:g} N")
     return out
-
-
-# ----------------------------------------------------------------------------- quadrature
-def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 1e-10) -> float:
-    """Reference-mode lifetime as t = int_{h(0+)}^{h_end} (dN_eq/dh) / Ndot(h) dh (no time stepping).
-
-    An independent evaluation for checking `lifetime`: without relaxation the state is
-    one-dimensional and the time to move along the equilibrium branch is a quadrature.
-    Returns inf if u_c vanishes on the branch and 0 for an over-force.
-    """
-    if not model.reference:
-        raise ValueError("lifetime_by_quadrature: only without relaxation (reference mode)")
-    core = model._core
-    F1 = float(force_N)
-    if not (math.isfinite(F1) and F1 > 0):
-        raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")
-    hs, N0, kappa0, Fmax, hm = core.initial
-    if F1 >= Fmax:
-        return 0.0
-    h0 = core.liquid_start(F1) if core.liquid else brentq(
-        lambda x: core.holding_force(x, N0, kappa0)[0] - F1, hs, hm, xtol=1e-15 * core.h1, rtol=1e-15)
-    h_end, _ = core.branch_end(h0, 1.0, F1)
-
-    def integrand(h: float) -> float:
-        N, dN = core.n_eq(h, 1.0, F1)
-        Ndot = core.state(h, N, 1.0, core.m.E_Pa, F1)[0]
-        return math.inf if Ndot <= 0 else dN / Ndot
-
-    if _sealed_on_branch(core, h0, h_end, F1) is not None:
-        return math.inf
-    t_bubble = 0.0
-    if core.liquid and N0 < core.n_eq(h0, 1.0, F1)[0]:    # the vapour bubble refills at h_c
-        t_bubble = (core.n_eq(h0, 1.0, F1)[0] - N0) / core.state(h0, N0, 1.0, core.m.E_Pa, F1)[0]
-    # the PCHIP breakpoints are kinks of higher derivatives: hand them to quad
-    knots = sorted(x for x in (core.h1 - u for u in core.F0.x) if h0 < x < h_end)
-    t, err = quad(integrand, h0, h_end, epsabs=0.0, epsrel=epsrel, limit=4 * len(knots) + 200,
-                  points=knots[:: max(1, len(knots) // 100)] or None)
-    return t_bubble + t
