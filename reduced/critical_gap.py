@@ -91,6 +91,13 @@ class UcTable:
     _seal: float = field(init=False, repr=False, compare=False)
     _vec: tuple = field(init=False, repr=False, compare=False)
 
+    def __reduce__(self):
+        """Pickle by the constructor's fields, the read-only mappings as plain dicts (a
+        MappingProxyType does not pickle; the constructor wraps them again)."""
+        import dataclasses
+        values = [getattr(self, f.name) for f in dataclasses.fields(self) if f.init]
+        return type(self), tuple(dict(v) if isinstance(v, MappingProxyType) else v for v in values)
+
     def __post_init__(self) -> None:
         p = _frozen(self.p_over_E)
         u = _frozen(self.u_c_m)

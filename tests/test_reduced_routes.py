@@ -153,3 +153,20 @@ def test_import_reduced_is_cheap_and_exposes_its_nouns():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.splitlines() == ["", ""]
     assert {"LeakageModel", "solve_lifetime", "Lifetime", "ROUTES", "UcTable", "SuctionTable"} <= set(reduced.__all__)
+
+
+def test_results_and_tables_survive_the_disk_cache():
+    """The scenes' cache pickles u_c tables and lifetimes: a round trip gives the same values
+    (read-only mappings are rebuilt by the constructor)."""
+    import pickle
+
+    from reduced import CUP_A, reference_model, solve_lifetime
+    from reduced.critical_gap import illustrative_uc_table
+
+    table = illustrative_uc_table()
+    again = pickle.loads(pickle.dumps(table))
+    assert (again.u_c_m == table.u_c_m).all() and (again.p_over_E == table.p_over_E).all()
+    result = solve_lifetime(reference_model(CUP_A, table), 10.0)
+    back = pickle.loads(pickle.dumps(result))
+    assert back.summary() == result.summary()
+    assert all((back.trajectory[k] == v).all() for k, v in result.trajectory.items())

@@ -60,6 +60,13 @@ class Lifetime:
     provenance: Mapping[str, Any] = field(default_factory=dict)
     steps: int = 0
 
+    def __reduce__(self):
+        """Pickle by the constructor's fields, the read-only mappings as plain dicts (a
+        MappingProxyType does not pickle; the constructor wraps them again)."""
+        import dataclasses
+        values = [getattr(self, f.name) for f in dataclasses.fields(self) if f.init]
+        return type(self), tuple(dict(v) if isinstance(v, MappingProxyType) else v for v in values)
+
     def __post_init__(self) -> None:
         if self.reason not in REASONS:
             raise ValueError(f"reason: {self.reason!r} is not one of {', '.join(REASONS)}")
