@@ -126,6 +126,38 @@ def check_outputs(files: Mapping[str, object] | None = None, directories: Mappin
                                  f"writing it would destroy the input")
 
 
+#: attributes of a command's arguments that name an input file (label as the user wrote it)
+_INPUT_OPTIONS = {"geometry": "--geometry", "mesh": "--mesh", "psd": "--psd", "line_scan": "--line-scan",
+                  "uc_table": "--uc-table", "stiffness": "--stiffness", "relaxation": "--relaxation",
+                  "suction_table": "--suction-table", "fields": "fields", "scene": "scene", "sweep": "sweep"}
+#: values of those options that name no file
+_NOT_FILES = ("appendix-a", "none", "default")
+
+
+def command_inputs(args: object) -> dict[str, object]:
+    """The input files a command's parsed arguments name, for `check_outputs` (a stiffness
+    curve brings its sidecar)."""
+    found: dict[str, object] = {}
+    for attr, label in _INPUT_OPTIONS.items():
+        value = getattr(args, attr, None)
+        if value is None or (isinstance(value, str) and value in _NOT_FILES):
+            continue
+        found[label] = value
+        if attr == "stiffness" and os.fspath(value).strip():
+            found["--stiffness's sidecar"] = Path(value).with_suffix(".json")
+    return found
+
+
+def check_option_values(argv: list[str]) -> None:
+    """An option given an empty value (``--out ""``, ``--out=``) is refused: an empty path would
+    mean the working directory."""
+    for i, arg in enumerate(argv):
+        if arg.startswith("--") and arg.endswith("=") and len(arg) > 3:
+            raise ValueError(f"{arg[:-1]}: the value is empty")
+        if arg.startswith("--") and "=" not in arg and i + 1 < len(argv) and not argv[i + 1].strip():
+            raise ValueError(f"{arg}: the value is empty")
+
+
 def _failure_records(path: Path) -> list[Path]:
     """Where a failed run into `path` leaves its record (``<out>.failure.json``)."""
     return [path.with_suffix(".failure.json"), path.with_name(f"{path.name}.failure.json")]

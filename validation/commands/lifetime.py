@@ -245,6 +245,8 @@ def run(args: argparse.Namespace) -> int:
     from reduced.lifetime import lifetime_sweep
     from validation.output import atomic_directory, terminal_progress
 
+    from validation.output import check_outputs, command_inputs
+    check_outputs(directories={"--out": args.out}, inputs=command_inputs(args))
     if args.route == "coupled":
         from validation.coupled.route import run_coupled
         return run_coupled(args)
