@@ -57,8 +57,8 @@ def _check_path(label: str, path: str | os.PathLike, kind: str) -> Path:
     if mode is not None:
         special = next((name for test, name in _SPECIAL if test(mode)), None)
         if special is not None:
-            raise ValueError(f"{label}: '{shown}' is a {special}, not a regular "
-                             f"{'file' if kind == 'file' else 'directory'}; cupcheck will not replace it")
+            raise ValueError(f"{label}: '{shown}' is a {special}, not a "
+                             f"{'regular file' if kind == 'file' else 'directory'}; cupcheck will not replace it")
         if kind == "file" and stat.S_ISDIR(mode):
             raise ValueError(f"{label}: '{shown}' is a directory; give a file name")
         if kind != "file" and not stat.S_ISDIR(mode):
@@ -250,7 +250,7 @@ def atomic_directory(out: str | os.PathLike) -> Iterator[Path]:
 
     label = os.fspath(out)
     real = _check_path("out", out, "directory")
-    with _parents(real), exclusive(real):
+    with _parents(real), exclusive(Path(label)):
         _remove_leftovers(real)
         tmp = _temporary_name(real)
         tmp.mkdir(mode=0o777)            # the umask's permissions, unlike mkdtemp's 0700
@@ -283,7 +283,7 @@ def atomic_file(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path next to `path`; on success it is renamed to `path` (through a
     symlink: to the file it names). A special file is refused, not replaced."""
     real = _check_path("out", path, "file")
-    with _parents(real), exclusive(real):
+    with _parents(real), exclusive(Path(path)):
         _remove_leftovers(real)
         # a unique sibling name, created with the normal (umask) permissions, unlike mkstemp's 0600
         tmp = _temporary_name(real, real.suffix)

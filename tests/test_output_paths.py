@@ -1,0 +1,190 @@
+"""Outputs never destroy (issue 26) and own their folder (issue 25): a special file, an input of
+the run or another output of it is refused before any work, exit 2, one line naming both; a
+rerun into an output directory leaves only what its manifest lists."""
+
+import json
+import os
+import stat
+from pathlib import Path
+
+import pytest
+from filelock import FileLock
+
+from tests.cli import run_cli
+from validation.output import atomic_directory, atomic_file, check_outputs
+
+UC = ["uc", "--surface", "pmma-1.89", "--E-MPa", "4", "--p-kPa", "10", "20"]
+GOOD_UC = "p_over_E,u_c_m\n1e-4,2e-6\n1e-3,1e-6\n1e-2,5e-7\n1e-1,1e-7\n"
+
+
+def _tree(directory: Path) -> dict[str, bytes | None]:
+    return {p.relative_to(directory).as_posix(): (p.read_bytes() if p.is_file() and not p.is_fifo() else None)
+            for p in directory.rglob("*")}
+
+
+def _refused(capsys, argv, *names) -> str:
+    code, _, err = run_cli(capsys, *argv)
+    assert code == 2, err
+    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+    for name in names:
+        assert str(name) in err, err
+    return err
+
+
+def test_dev_null_is_refused_and_not_touched(capsys):
+    before = os.stat("/dev/null")
+    err = _refused(capsys, UC + ["--out", "/dev/null"], "--out", "'/dev/null'", "character device")
+    after = os.stat("/dev/null")
+    assert stat.S_ISCHR(after.st_mode) and (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev), err
+
+
+def test_a_fifo_and_a_symlink_to_it_are_refused(tmp_path, capsys):
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    (tmp_path / "link.csv").symlink_to(fifo)
+    before = _tree(tmp_path)
+    _refused(capsys, UC + ["--out", fifo], "FIFO")
+    _refused(capsys, UC + ["--out", tmp_path / "link.csv"], "FIFO")
+    _refused(capsys, ["lifetime", "--out", fifo], "--out", "is a FIFO, not a directory")
+    assert _tree(tmp_path) == before and stat.S_ISFIFO(os.stat(fifo).st_mode)
+
+
+@pytest.mark.parametrize("argv", [["uc", "--surface", "pmma-1.89", "--E-MPa", "4", "--out", ""],
+                                  ["uc", "--surface", "pmma-1.89", "--E-MPa", "4", "--out="],
+                                  ["lifetime", "--out", ""], ["stiffness", "--out", ""],
+                                  ["run", "s.toml", "--out", ""]])
+def test_an_empty_out_is_refused(tmp_path, capsys, monkeypatch, argv):
+    monkeypatch.chdir(tmp_path)
+    _refused(capsys, argv, "--out: the value is empty")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_design_sidecar_would_overwrite_the_design(tmp_path, capsys):
+    """`stiffness --geometry mycup.json --out mycup.csv`: the curve's sidecar is the design file."""
+    design = tmp_path / "mycup.json"
+    design.write_text("r1_mm = 25\n")
+    before = _tree(tmp_path)
+    _refused(capsys, ["stiffness", "--geometry", design, "--out", tmp_path / "mycup.csv"],
+             "--out's sidecar", f"'{design}'", "--geometry")
+    assert _tree(tmp_path) == before
+
+
+def test_an_input_is_not_an_output(tmp_path, capsys):
+    psd = tmp_path / "p.csv"
+    psd.write_text("q_per_m,C_m4\n1e3,1e-28\n1e4,1e-31\n1e5,1e-34\n")
+    (tmp_path / "hard.csv").hardlink_to(psd)             # the same file under another name
+    (tmp_path / "sym.csv").symlink_to(psd)
+    before = _tree(tmp_path)
+    for out in ("p.csv", "hard.csv", "sym.csv"):
+        _refused(capsys, UC[:1] + ["--psd", psd, "--E-MPa", "4", "--out", tmp_path / out], "--out", "--psd")
+    assert _tree(tmp_path) == before
+
+
+def test_an_input_inside_the_output_directory_is_refused(tmp_path, capsys):
+    """The output directory is replaced as a whole: an input inside it would be lost."""
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "manifest.json").write_text('{"files": []}\n')
+    (out / "u.csv").write_text(GOOD_UC)
+    before = _tree(tmp_path)
+    _refused(capsys, ["lifetime", "--uc-table", out / "u.csv", "--out", out], "--out", "holds the input --uc-table")
+    assert _tree(tmp_path) == before
+
+
+def test_a_cache_inside_the_output_is_refused(tmp_path, capsys):
+    scene = tmp_path / "s.toml"
+    scene.write_text('[stiffness]\nsource = "appendix-a"\n[[outputs]]\nkind = "lifetimes"\n')
+    _refused(capsys, ["run", scene, "--out", tmp_path / "out", "--cache-dir", tmp_path / "out" / "c"],
+             "--out", "--cache-dir", "are one output")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_two_outputs_that_are_one_file_are_refused(tmp_path):
+    (tmp_path / "a.csv").write_text("x\n")
+    (tmp_path / "b.csv").symlink_to(tmp_path / "a.csv")
+    with pytest.raises(ValueError, match="--out: .* and --fields-out .* are one output"):
+        check_outputs(files={"--out": tmp_path / "a.csv", "--fields-out": tmp_path / "b.csv"})
+    with pytest.raises(ValueError, match="are one output"):
+        check_outputs(files={"x": tmp_path / "d" / "f.csv"}, directories={"y": tmp_path / "d"})
+    check_outputs(files={"--out": tmp_path / "a.csv", "--fields-out": tmp_path / "c.csv"})
+
+
+def test_a_directory_cupcheck_did_not_write_is_not_replaced(tmp_path, capsys):
+    notes = tmp_path / "notes"
+    notes.mkdir()
+    (notes / "thesis.tex").write_text("months of work\n")
+    before = _tree(tmp_path)
+    _refused(capsys, ["lifetime", "--force", "10", "--out", notes], "--out", "holds files cupcheck did not write")
+    assert _tree(tmp_path) == before
+
+
+def test_a_rerun_leaves_only_what_its_manifest_lists(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert run_cli(capsys, "lifetime", "--force", "10", "20", "--out", out)[0] == 0
+    assert {"trajectory_F1_10N.csv", "trajectory_F1_20N.csv"} <= set(os.listdir(out))
+    assert run_cli(capsys, "lifetime", "--force", "30", "--out", out)[0] == 0
+    listed = {f["path"] for f in json.loads((out / "manifest.json").read_text())["files"]}
+    assert set(os.listdir(out)) == listed | {"manifest.json"}
+    assert listed == {"summary.json", "trajectory_F1_30N.csv"}
+    assert sorted(os.listdir(tmp_path)) == ["run"]               # no temporaries, no lock
+
+
+def test_a_later_success_removes_a_stale_failure_record(tmp_path, capsys):
+    record = tmp_path / "run.failure.json"
+    record.write_text(json.dumps({"error": "did not converge", "residual_history": [1.0]}))
+    other = tmp_path / "other.failure.json"                      # not cupcheck's record: kept
+    other.write_text("{}")
+    assert run_cli(capsys, "lifetime", "--force", "10", "--out", tmp_path / "run")[0] == 0
+    assert not record.exists() and other.exists()
+    curve = tmp_path / "uc.csv"
+    (tmp_path / "uc.failure.json").write_text(record.read_text() if record.exists() else
+                                              json.dumps({"error": "x", "residual_history": []}))
+    assert run_cli(capsys, *UC, "--out", curve)[0] == 0
+    assert curve.is_file() and not (tmp_path / "uc.failure.json").exists()
+
+
+def test_a_lock_through_a_symlink_is_the_same_lock(tmp_path, capsys):
+    real = tmp_path / "real"
+    real.mkdir()
+    (tmp_path / "alias").symlink_to(real)
+    with FileLock(str(tmp_path / ".real.lock")):                 # a first run writing 'real'
+        _refused(capsys, ["lifetime", "--json", "--force", "10", "--out", tmp_path / "alias"], "another cupcheck run")
+    assert list(real.iterdir()) == []
+
+
+def test_leftovers_of_a_killed_run_are_removed_by_the_next(tmp_path):
+    out = tmp_path / "run"
+    stale_dir = tmp_path / ".run.4242.0badcafe.tmp"
+    stale_dir.mkdir()
+    (stale_dir / "big.csv").write_text("1\n" * 1000)
+    old = tmp_path / ".run.4243.deadbeef.old"
+    old.mkdir()
+    stale_file = tmp_path / ".c.csv.77.12345678.tmp.csv"
+    stale_file.write_text("half")
+    keep = tmp_path / ".run.user-notes"                            # not cupcheck's name pattern
+    keep.write_text("mine")
+    with atomic_directory(out) as tmp:
+        (tmp / "a.txt").write_text("a")
+    assert not stale_dir.exists() and not old.exists() and keep.exists() and stale_file.exists()
+    with atomic_file(tmp_path / "c.csv") as tmp:
+        tmp.write_text("x\n")
+    assert not stale_file.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".run.user-notes", "c.csv", "run"]
+
+
+def test_a_refused_run_leaves_no_empty_directories(tmp_path):
+    with pytest.raises(ValueError, match="refused inside"):
+        with atomic_directory(tmp_path / "a" / "b" / "out"):
+            raise ValueError("refused inside the run")
+    with pytest.raises(ValueError, match="refused inside"):
+        with atomic_file(tmp_path / "c" / "d.csv"):
+            raise ValueError("refused inside the run")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_output_directory_gets_the_umask_permissions(tmp_path):
+    with atomic_directory(tmp_path / "out") as tmp:
+        (tmp / "a.txt").write_text("a")
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE(os.stat(tmp_path / "out").st_mode) == 0o777 & ~mask
