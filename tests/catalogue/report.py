@@ -46,7 +46,8 @@ def outcome(argv, files, expected) -> str:
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
         for name, content in files.items():
-            (d / name).write_bytes(content if isinstance(content, bytes) else content.encode())
+            (d / name).parent.mkdir(parents=True, exist_ok=True)
+        (d / name).write_bytes(content if isinstance(content, bytes) else content.encode())
         before = set(d.rglob("*"))
         err = io.StringIO()
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
