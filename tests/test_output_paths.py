@@ -188,3 +188,39 @@ def test_the_output_directory_gets_the_umask_permissions(tmp_path):
     mask = os.umask(0)
     os.umask(mask)
     assert stat.S_IMODE(os.stat(tmp_path / "out").st_mode) == 0o777 & ~mask
+
+
+def test_forces_equal_after_formatting_are_refused(tmp_path, capsys):
+    _refused(capsys, ["lifetime", "--force", "10", "10.0000001", "--out", tmp_path / "run"],
+             "--force 10.0000001: its file 'trajectory_F1_10N.csv' is also written by --force 10.0")
+    assert list(tmp_path.iterdir()) == []
+
+
+APPENDIX = '[stiffness]\nsource = "appendix-a"\n'
+
+
+@pytest.mark.parametrize("scene,message", [
+    (APPENDIX + '[loads]\nF1_N = [10, 10.0000001]\n[[outputs]]\nkind = "trajectories"\nname = "t"\n',
+     "at F1 = 10.0000001 N: its file 't_F1_10N.csv' is also written by outputs[0] (trajectories 't') at F1 = 10.0 N"),
+    (APPENDIX + '[[outputs]]\nkind = "curve"\nname = "manifest"\n',
+     "outputs[0] (curve 'manifest'): its file 'manifest.json' is also written by the scene's manifest"),
+    ('[[outputs]]\nkind = "curve"\nname = "x"\n[[outputs]]\nkind = "footprint"\nname = "x"\nu_mm = 3\n',
+     "outputs[1] (footprint 'x'): its file 'x.json' is also written by outputs[0] (curve 'x')"),
+    ('[[outputs]]\nkind = "squeeze"\nname = "s"\nu_mm = 3\n[[outputs]]\nkind = "figure"\nfigure = "F0_vs_u"\n'
+     'name = "s_00"\n', "outputs[1] (figure 's_00'): its file 's_00.png' is also written by outputs[0] (squeeze 's')"),
+])
+def test_two_scene_outputs_writing_one_file_are_refused_before_any_work(tmp_path, capsys, scene, message):
+    (tmp_path / "s.toml").write_text(scene)
+    _refused(capsys, ["run", tmp_path / "s.toml", "--out", tmp_path / "out", "--no-cache"], message)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_the_planned_files_are_the_files_a_scene_writes(tmp_path):
+    """The plan the collision check reads is what the scene writes (a real run, reduced model)."""
+    from validation.scenes.outputs import planned_files, run_scene
+    from validation.scenes.schema import load_scene
+
+    scene = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "trajectories_cupA.toml")
+    run_scene(scene, tmp_path / "out")
+    planned = {name for names in planned_files(scene).values() for name in names}
+    assert set(os.listdir(tmp_path / "out")) == planned | {"manifest.json"}

@@ -11,7 +11,7 @@ import shutil
 import stat
 import sys
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
@@ -124,6 +124,20 @@ def check_outputs(files: Mapping[str, object] | None = None, directories: Mappin
                 where = "is" if real == ro or ko == "file" else "holds"
                 raise ValueError(f"{lo}: '{po}' {where} the input {label} '{os.fspath(path)}' of this run; "
                                  f"writing it would destroy the input")
+
+
+def check_file_names(planned: Mapping[str, Iterable[str]], reserved: Mapping[str, str] | None = None) -> None:
+    """Refuse, before any work, two outputs of one run that would write one file (a ValueError
+    naming both; one would be lost). `planned` maps each output, as the user named it, to the
+    file names it writes in the run's directory; `reserved`, the names the run writes itself
+    (``manifest.json``) to what writes them. One output naming a file twice is not a conflict."""
+    owner = dict(reserved or {})
+    for label, names in planned.items():
+        for name in names:
+            other = owner.setdefault(name, label)
+            if other != label:
+                raise ValueError(f"{label}: its file '{name}' is also written by {other}; one would be lost "
+                                 f"(give them different names or values)")
 
 
 #: attributes of a command's arguments that name an input file (label as the user wrote it)
