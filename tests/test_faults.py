@@ -115,3 +115,25 @@ def test_a_killed_directory_run_is_cleaned_up_by_the_next(tmp_path):
     assert done.returncode == 0, done.stderr
     assert _manifest_complete(out) and sorted(p.name for p in tmp_path.iterdir()) == ["run"]
     assert len([p for p in out.iterdir() if p.name.startswith("trajectory_")]) == len(forces)
+
+
+def test_a_second_run_through_a_symlink_is_refused_while_the_first_writes(tmp_path):
+    """Two real processes: while the first writes 'real', a second naming it through a symlink is
+    refused at once (the lock is on the resolved path) and the first completes."""
+    real, alias = tmp_path / "real", tmp_path / "alias"
+    alias.symlink_to(real)
+    forces = [f"{f / 2:g}" for f in range(10, 161)]          # 151 relaxed lifetimes: several seconds
+    first = subprocess.Popen([sys.executable, "-m", "validation.cli", "lifetime", "--relaxation", "default", "--force",
+                              *forces, "--out", str(real)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                             text=True)
+    while first.poll() is None and not list(tmp_path.glob(".real.*.tmp")):       # the first is writing
+        time.sleep(0.005)
+    second = subprocess.run([sys.executable, "-m", "validation.cli", "lifetime", "--json", "--force", "10", "--out",
+                             str(alias)], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    _, err = first.communicate(timeout=300)
+    assert first.returncode == 0, err
+    if second.returncode == 0:                 # the first had already finished: nothing to race
+        pytest.skip("the first run ended before the second started")
+    assert second.returncode == 2 and "is being written by another cupcheck run" in second.stderr
+    assert len(second.stderr.splitlines()) == 1 and _manifest_complete(real)
+    assert len([p for p in real.iterdir() if p.name.startswith("trajectory_")]) == len(forces)

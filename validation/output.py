@@ -77,8 +77,9 @@ def _check_path(label: str, path: str | os.PathLike, kind: str) -> Path:
 
 #: the file that lists a directory output's files; a directory holding one is cupcheck's to replace
 MANIFEST = "manifest.json"
-#: what a directory output written before manifests existed holds (lifetime, validate)
-_LEGACY_RECORDS = ("summary.json",)
+#: what a directory output written before manifests existed holds (lifetime and validate: a
+#: summary; example: the FEM curve's sidecar)
+_LEGACY_RECORDS = ("summary.json", "stiffness_fem.json")
 
 
 def _replaceable(directory: Path) -> bool:
