@@ -224,3 +224,62 @@ def test_the_planned_files_are_the_files_a_scene_writes(tmp_path):
     run_scene(scene, tmp_path / "out")
     planned = {name for names in planned_files(scene).values() for name in names}
     assert set(os.listdir(tmp_path / "out")) == planned | {"manifest.json"}
+
+
+# --- property: random file systems and output sets --------------------------------------------------
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+#: what a name in the test's directory is: nothing, a file, a directory (with one file), a FIFO, or
+#: a symlink to another name
+ENTRY = st.sampled_from(["missing", "file", "dir", "fifo", "link0", "link1"])
+
+
+def _build(root: Path, kinds: list[str]) -> list[Path]:
+    paths = [root / f"e{i}" for i in range(len(kinds))]
+    for path, kind in zip(paths, kinds):
+        if kind == "file":
+            path.write_text("x")
+        elif kind == "dir":
+            path.mkdir()
+            (path / "inner.csv").write_text("y")
+        elif kind == "fifo":
+            os.mkfifo(path)
+    for path, kind in zip(paths, kinds):
+        if kind.startswith("link"):
+            path.symlink_to(paths[int(kind[-1])])
+    return paths
+
+
+@settings(max_examples=80, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(kinds=st.lists(ENTRY, min_size=2, max_size=5),
+       outs=st.lists(st.tuples(st.integers(0, 4), st.sampled_from(["file", "directory"]), st.booleans()),
+                     min_size=1, max_size=3),
+       ins=st.lists(st.tuples(st.integers(0, 4), st.booleans()), max_size=2))
+def test_accepted_outputs_destroy_nothing(tmp_path_factory, kinds, outs, ins):
+    """Whatever the file system, check_outputs raises only ValueError; what it accepts is no
+    special file, no existing directory for a file or file for a directory, no directory
+    cupcheck did not write, no two outputs on one path and no input at or inside an output."""
+    root = tmp_path_factory.mktemp("fs")
+    paths = _build(root, kinds)
+    pick = lambda i, inner: paths[i % len(paths)] / "inner.csv" if inner else paths[i % len(paths)]  # noqa: E731
+    files = {f"out{k}": pick(i, inner) for k, (i, kind, inner) in enumerate(outs) if kind == "file"}
+    dirs = {f"out{k}": pick(i, inner) for k, (i, kind, inner) in enumerate(outs) if kind == "directory"}
+    inputs = {f"in{k}": pick(i, inner) for k, (i, inner) in enumerate(ins)}
+    try:
+        check_outputs(files=files, directories=dirs, inputs=inputs)
+    except ValueError as exc:
+        assert "\n" not in str(exc)
+        return
+    real = {label: Path(os.path.realpath(p)) for label, p in {**files, **dirs}.items()}
+    for label, path in real.items():
+        if path.exists():
+            mode = os.stat(path).st_mode
+            assert stat.S_ISREG(mode) if label in files else stat.S_ISDIR(mode)
+            if label in dirs:
+                assert not os.listdir(path) or (path / "manifest.json").exists()
+    assert len(set(real.values())) == len(real)
+    for p in inputs.values():
+        r = Path(os.path.realpath(p))
+        assert all(r != o and not (label in dirs and o in r.parents) for label, o in real.items())

@@ -52,8 +52,10 @@ def _check_path(label: str, path: str | os.PathLike, kind: str) -> Path:
     real = _real(path)
     try:
         mode = os.stat(real).st_mode
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):   # a missing name (or a file on the way: below)
         mode = None
+    except OSError as exc:                              # a symlink loop, a name too long, no access
+        raise ValueError(f"{label}: cannot use '{shown}': {exc.strerror}") from None
     if mode is not None:
         special = next((name for test, name in _SPECIAL if test(mode)), None)
         if special is not None:
