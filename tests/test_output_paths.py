@@ -69,6 +69,23 @@ def test_the_design_sidecar_would_overwrite_the_design(tmp_path, capsys):
     assert _tree(tmp_path) == before
 
 
+def test_a_companion_file_replaces_only_its_own_kind(tmp_path, capsys):
+    """The curve's sidecar and the footprint's scale are files the user did not name: an existing
+    file there is replaced only if cupcheck wrote one of that kind before."""
+    design = tmp_path / "mycup.json"
+    design.write_text('{"r1_mm": 25}')
+    sidecar = tmp_path / "curve.json"
+    sidecar.write_text('{"provenance": {"source": "fem"}}')
+    (tmp_path / "f.vtu").write_text("fields")
+    before = _tree(tmp_path)
+    _refused(capsys, ["stiffness", "--out", tmp_path / "mycup.csv"],
+             f"--out's sidecar: '{design}' exists and is not what cupcheck writes there")
+    _refused(capsys, ["render", tmp_path / "f.vtu", "--view", "footprint", "--out", tmp_path / "curve.png"],
+             f"--out's scale: '{sidecar}' exists and is not what cupcheck writes there (a JSON object with 'm_per_px')")
+    assert _tree(tmp_path) == before
+    check_outputs(files={"--out": tmp_path / "curve.csv"}, companions={"--out's sidecar": (sidecar, "provenance")})
+
+
 def test_an_input_is_not_an_output(tmp_path, capsys):
     psd = tmp_path / "p.csv"
     psd.write_text("q_per_m,C_m4\n1e3,1e-28\n1e4,1e-31\n1e5,1e-34\n")

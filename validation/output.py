@@ -95,8 +95,8 @@ def _inside(path: Path, directory: Path) -> bool:
 
 
 def check_outputs(files: Mapping[str, object] | None = None, directories: Mapping[str, object] | None = None,
-                  inputs: Mapping[str, object] | None = None,
-                  stores: Mapping[str, object] | None = None) -> None:
+                  inputs: Mapping[str, object] | None = None, stores: Mapping[str, object] | None = None,
+                  companions: Mapping[str, tuple[object, str]] | None = None) -> None:
     """Refuse, before any work, outputs that would destroy something (a ValueError naming both).
 
     Each mapping goes from the name the user wrote (``--out``, ``cup.geometry``) to a path (None:
@@ -105,7 +105,11 @@ def check_outputs(files: Mapping[str, object] | None = None, directories: Mappin
     symlink; a file output that is a directory or a directory that is not one; an existing
     directory cupcheck did not write (no manifest); an output that is an input of the same run
     or holds one; two outputs that are one file (or one inside the other's directory).
+    `companions` are files the user did not name (a curve's JSON sidecar beside its CSV), each
+    with the key of its JSON kind: an existing file there is replaced only if it is of that kind.
     """
+    companions = dict(companions or {})
+    files = {**(files or {}), **{label: path for label, (path, _) in companions.items()}}
     outs: list[tuple[str, str, Path, str]] = []
     for kind, given in (("file", files), ("directory", directories), ("store", stores)):
         for label, path in (given or {}).items():
@@ -127,6 +131,21 @@ def check_outputs(files: Mapping[str, object] | None = None, directories: Mappin
                 where = "is" if real == ro or ko == "file" else "holds"
                 raise ValueError(f"{lo}: '{po}' {where} the input {label} '{os.fspath(path)}' of this run; "
                                  f"writing it would destroy the input")
+    for label, (path, key) in companions.items():
+        if path is not None and _real(path).is_file() and not _json_with(_real(path), key):
+            raise ValueError(f"{label}: '{os.fspath(path)}' exists and is not what cupcheck writes there (a JSON "
+                             f"object with '{key}'); move it or choose another output name")
+
+
+def _json_with(path: Path, key: str) -> bool:
+    """True if `path` holds a JSON object with `key` (a file cupcheck wrote there before)."""
+    import json
+
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and key in data
 
 
 def check_file_names(planned: Mapping[str, Iterable[str]], reserved: Mapping[str, str] | None = None) -> None:
