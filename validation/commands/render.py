@@ -53,8 +53,8 @@ def run(args: argparse.Namespace) -> int:
 
     _check(args)
     from validation.output import check_outputs, command_inputs
-    check_outputs(files={"--out": args.out, "--out's scale": args.out.with_suffix(".json") if args.view == "footprint"
-                         else None}, inputs=command_inputs(args))
+    check_outputs(files={"--out": args.out}, inputs=command_inputs(args),
+                  companions={"--out's scale": (args.out.with_suffix(".json") if args.view == "footprint" else None, "m_per_px")})
     from validation.render import views
     from validation.render.frames import fields_file_steps, frame_from_fields_file
 
