@@ -43,7 +43,9 @@ in the atomic writers): exit 2 and one line naming both paths for an empty path 
 special file (`/dev/null`, a FIFO, a socket, also through a symlink; /dev/null is checked untouched),
 an output that is an input of the run (by name, symlink or hard link: `uc --psd p.csv --out
 p.csv`, `stiffness --geometry mycup.json --out mycup.csv` whose sidecar is the design), an input
-or the cache inside an output directory, and an existing directory cupcheck did not write.
+or the cache inside an output directory, an existing directory cupcheck did not write, and a
+file the user did not name (a curve's sidecar, a footprint's scale) over a file of another kind
+(`stiffness --out mycup.csv` beside a design `mycup.json`).
 `check_file_names` refuses two outputs of one run writing one file (a scene curve named
 `manifest`, a curve and a footprint both writing `x.json`, forces 10 and 10.0000001 N sharing a
 trajectory file). A run into an existing output directory replaces it as a whole: afterwards it
