@@ -266,6 +266,8 @@ class StiffnessCurve:
         for required in ("u_mm", "F0_N"):
             if required not in header:
                 raise ValueError(f"stiffness: '{path}' lacks the required column '{required}'")
+        if len(body) < 2:                    # (numpy would warn on a header alone)
+            raise ValueError(f"stiffness: '{path}' has no rows; a stiffness curve needs at least 2 samples")
         try:
             data = np.loadtxt(body[1:], delimiter=",", ndmin=2)
         except ValueError as exc:

@@ -370,3 +370,5 @@ case("output path", ["run", "{d}/o/s.toml", "--out", "{d}/o", "--no-cache"], "--
 case("output path", ["stiffness", "--out", "{d}/mycup.csv"], "--out's sidecar: '{d}/mycup.json' exists and is not what "
      "cupcheck writes there", **{"mycup.json": '{"r1_mm": 25}'})
 # (/dev/null as --out: tests/test_output_paths.py, which also checks that it is left untouched)
+case("stiffness CSV: header only", LIFE + ["--stiffness", "{d}/c.csv"],
+     "stiffness: '{d}/c.csv' has no rows; a stiffness curve needs at least 2 samples", **{"c.csv": "u_mm,h_mm,F0_N\n"})
