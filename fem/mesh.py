@@ -372,6 +372,7 @@ def _volume_mesh(m: meshio.Mesh, scale: float, path: Path) -> Mesh:
                          f"found {sorted(set(kinds)) or 'none'}")
     kind = kinds[0]
     cells = np.concatenate([c.data for c in m.cells if c.type == kind])
+    _check_cells(cells, len(m.points), path, "element")
     if m.points.shape[1] > 2 and np.ptp(m.points[:, 2]) > 1e-9 * np.ptp(m.points[:, :2]):
         raise ValueError(f"mesh: '{path}' is not planar; draw the (r, z) cross-section in the x-y plane")
     points = np.asarray(m.points[:, :2], dtype=float) * scale
@@ -385,6 +386,28 @@ def _volume_mesh(m: meshio.Mesh, scale: float, path: Path) -> Mesh:
         cells = np.column_stack([cells, len(points) + np.arange(len(cells))])
         points = np.vstack([points, centre])
     return (MeshTri2 if kind == "triangle6" else MeshQuad2)(points.T, cells.T)
+
+
+def _check_cells(cells: np.ndarray, n_points: int, path: Path, what: str, repeats: bool = True) -> None:
+    """Every cell names existing nodes, each once, and (`repeats`) no cell is given twice: a
+    ValueError naming the file and the cell (counted from 1 in its kind), never an IndexError."""
+    cells = np.asarray(cells)
+    outside = np.flatnonzero(((cells < 0) | (cells >= n_points)).any(axis=1))
+    if outside.size:
+        k = int(outside[0])
+        node = int(cells[k][(cells[k] < 0) | (cells[k] >= n_points)][0])
+        raise ValueError(f"mesh: '{path}': {what} {k + 1} refers to node {node + 1}, but the file "
+                         f"has nodes 1 .. {n_points}")
+    ordered = np.sort(cells, axis=1)
+    twice = np.flatnonzero((ordered[:, 1:] == ordered[:, :-1]).any(axis=1))
+    if twice.size:
+        raise ValueError(f"mesh: '{path}': {what} {int(twice[0]) + 1} names one node twice")
+    if repeats:
+        seen: dict[bytes, int] = {}
+        for k, row in enumerate(ordered):
+            first = seen.setdefault(row.tobytes(), k)
+            if first != k:
+                raise ValueError(f"mesh: '{path}': {what} {k + 1} repeats {what} {first + 1} (the same nodes)")
 
 
 def _signed_areas(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
@@ -406,6 +429,7 @@ def _tagged_boundaries(m: meshio.Mesh, mesh: Mesh, scale: float, path: Path) -> 
     for i, block in enumerate(m.cells):
         if block.type not in ("line", "line3"):
             continue
+        _check_cells(block.data, len(m.points), path, "boundary edge", repeats=False)
         ends = block.data[:, :2]
         for key, arrays in m.cell_data.items():
             data = np.asarray(arrays[i]).astype(int)

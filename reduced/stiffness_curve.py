@@ -266,6 +266,8 @@ class StiffnessCurve:
         for required in ("u_mm", "F0_N"):
             if required not in header:
                 raise ValueError(f"stiffness: '{path}' lacks the required column '{required}'")
+        if len(body) < 2:                    # (numpy would warn on a header alone)
+            raise ValueError(f"stiffness: '{path}' has no rows; a stiffness curve needs at least 2 samples")
         try:
             data = np.loadtxt(body[1:], delimiter=",", ndmin=2)
         except ValueError as exc:
@@ -290,7 +292,10 @@ class StiffnessCurve:
         steps = side.get("steps", {})
         profiles = None
         if "pressure_r_mm" in steps and "pressure_kPa" in steps:
-            profiles = profiles_from_lists(steps["pressure_r_mm"], steps["pressure_kPa"])
+            try:
+                profiles = profiles_from_lists(steps["pressure_r_mm"], steps["pressure_kPa"])
+            except ValueError as exc:
+                raise ValueError(f"stiffness: the sidecar '{path.with_suffix('.json')}': steps.{exc}") from None
         return cls(h1_m=h1_m, provenance=provenance, profiles=profiles, **si)
 
 
@@ -305,7 +310,39 @@ def _sidecar(csv_path: Path) -> dict[str, Any]:
         raise ValueError(f"stiffness: cannot parse the sidecar '{side}': {exc}") from None
     if not isinstance(data, Mapping) or not isinstance(data.get("provenance"), Mapping):
         raise ValueError(f"stiffness: the sidecar '{side}' has no 'provenance' table")
+    wrong = _sidecar_type_error(data)
+    if wrong:
+        raise ValueError(f"stiffness: the sidecar '{side}': {wrong}")
     return {**data, "provenance": dict(data["provenance"])}
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _sidecar_type_error(data: Mapping) -> str:
+    """What in a sidecar has the wrong type ('' if nothing): the provenance keys the curve reads
+    (geometry, contact, friction, source) and the profiles of ``steps``."""
+    prov = data["provenance"]
+    geometry = prov.get("geometry")
+    if geometry is not None and not isinstance(geometry, Mapping):
+        return f"provenance.geometry: expected a table, got {type(geometry).__name__}"
+    for key in DESIGN_KEYS:
+        if isinstance(geometry, Mapping) and key in geometry and not _is_number(geometry[key]):
+            return f"provenance.geometry.{key}: expected a number, got {geometry[key]!r:.40}"
+    for key, ok, what in (("contact", lambda v: v is None or isinstance(v, str), "a string"),
+                          ("friction", _is_number, "a number"),
+                          ("source", lambda v: v is None or isinstance(v, str), "a string")):
+        if key in prov and not ok(prov[key]):
+            return f"provenance.{key}: expected {what}, got {prov[key]!r:.40}"
+    steps = data.get("steps", {})
+    if not isinstance(steps, Mapping):
+        return f"steps: expected a table, got {type(steps).__name__}"
+    for key in ("pressure_r_mm", "pressure_kPa"):
+        rows = steps.get(key, [])
+        if not isinstance(rows, list) or not all(isinstance(r, list) and all(map(_is_number, r)) for r in rows):
+            return f"steps.{key}: expected one list of numbers per sample"
+    return ""
 
 
 def profiles_from_lists(r_mm: list, p_kPa: list) -> tuple[ContactProfile | None, ...]:

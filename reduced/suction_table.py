@@ -58,7 +58,7 @@ class SuctionTable:
             a = np.array(getattr(self, name), dtype=float)
             if a.shape != (u.size, dp.size) or not np.all(np.isfinite(a)):
                 raise ValueError(f"{name}: expected finite values on the {u.size} x {dp.size} grid, "
-                                 f"got shape {a.shape}")
+                                 f"got {'non-finite values' if a.shape == (u.size, dp.size) else f'shape {a.shape}'}")
             a.flags.writeable = False
             object.__setattr__(self, name, a)
         if np.any(self.V_m3 <= 0):
@@ -94,16 +94,56 @@ class SuctionTable:
 
     @classmethod
     def from_json(cls, path: str | os.PathLike) -> "SuctionTable":
+        """Read a table written by `to_json`; any defect (not JSON, a missing key, a wrong type or
+        shape) is a one-line ValueError naming the file and the key."""
         try:
             data = json.loads(Path(path).read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
             raise ValueError(f"suction table: cannot read {path}: {err}") from None
+        if not isinstance(data, dict):
+            raise ValueError(f"suction table: {path} must hold a JSON object, got a {type(data).__name__}")
         missing = [k for k in ("u_mm", "dp_kPa", "E_Pa", "profiles", *_GRIDS) if k not in data]
         if missing:
             raise ValueError(f"suction table: {path} lacks {', '.join(missing)}")
-        profiles = tuple(tuple(None if p is None else ContactProfile(np.array(p["r_mm"]) * 1e-3,
-                                                                     np.array(p["p_kPa"]) * 1e3)
-                               for p in row) for row in data["profiles"])
-        return cls(u_m=np.array(data["u_mm"]) * 1e-3, dp_Pa=np.array(data["dp_kPa"]) * 1e3,
-                   **{name: np.array(data[key], dtype=float) * scale for key, (name, scale) in _GRIDS.items()},
-                   profiles=profiles, E_Pa=float(data["E_Pa"]), provenance=data.get("provenance", {}))
+        where = f"suction table {path}"
+        provenance = data.get("provenance", {})
+        if not isinstance(provenance, dict) or not isinstance(provenance.get("h1_mm", 0.0), (int, float)):
+            raise ValueError(f"{where}: provenance must be an object whose h1_mm is a number")
+        if not isinstance(data["profiles"], list) or not all(isinstance(row, list) for row in data["profiles"]):
+            raise ValueError(f"{where}: profiles must be a list of rows (lists), one per u")
+        try:
+            profiles = tuple(tuple(_profile(p, f"profiles[{i}][{j}]") for j, p in enumerate(row))
+                             for i, row in enumerate(data["profiles"]))
+            grids = {name: _numbers(data[key], key) * scale for key, (name, scale) in _GRIDS.items()}
+            return cls(u_m=_numbers(data["u_mm"], "u_mm") * 1e-3, dp_Pa=_numbers(data["dp_kPa"], "dp_kPa") * 1e3,
+                       **grids, profiles=profiles, E_Pa=float(_numbers(data["E_Pa"], "E_Pa", scalar=True)),
+                       provenance=provenance)
+        except ValueError as err:
+            field_, _, rest = str(err).partition(": ")
+            spelled = {name: key for key, (name, _) in _GRIDS.items()}.get(field_, field_)   # as the file spells it
+            raise ValueError(f"{where}: {spelled}: {rest}") from None
+
+
+def _numbers(value: Any, key: str, scalar: bool = False) -> np.ndarray:
+    """`value` as floats (a number with `scalar`, else nested lists); ValueError naming `key`."""
+    if scalar and (isinstance(value, bool) or not isinstance(value, (int, float))):
+        raise ValueError(f"{key}: expected a number, got {value!r:.40}")
+    if isinstance(value, (str, bytes, dict)) or (not scalar and not isinstance(value, list)):
+        raise ValueError(f"{key}: expected a list of numbers, got {type(value).__name__}")
+    try:
+        return np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{key}: expected numbers in a regular grid") from None
+
+
+def _profile(value: Any, key: str) -> ContactProfile | None:
+    """One profile of the JSON form ({"r_mm": [...], "p_kPa": [...]} or null)."""
+    if value is None:
+        return None
+    if not isinstance(value, dict) or set(value) != {"r_mm", "p_kPa"}:
+        raise ValueError(f"{key}: expected null or an object with exactly the keys r_mm, p_kPa")
+    r_m, p_Pa = _numbers(value["r_mm"], f"{key}.r_mm") * 1e-3, _numbers(value["p_kPa"], f"{key}.p_kPa") * 1e3
+    try:
+        return ContactProfile(r_m, p_Pa)
+    except ValueError as err:
+        raise ValueError(f"{key}: {err}") from None

@@ -17,6 +17,7 @@ def _files(directory: Path) -> set[str]:
                          ids=[f"{i:03d}-{c[0]}" for i, c in enumerate(CASES)])
 def test_bad_input_is_refused(tmp_path, capsys, category, argv, files, expected):
     for name, content in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / name).write_bytes(content if isinstance(content, bytes) else content.encode())
     before = _files(tmp_path)
     try:

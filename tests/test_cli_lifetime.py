@@ -42,7 +42,7 @@ def test_out_writes_trajectories_atomically(capsys, tmp_path):
                            "--out", str(out))
     assert code == 0 and "reached_r1" in stdout
     files = sorted(p.name for p in out.iterdir())
-    assert files == ["summary.json", "trajectory_F1_10N.csv", "trajectory_F1_20N.csv"]
+    assert files == ["manifest.json", "summary.json", "trajectory_F1_10N.csv", "trajectory_F1_20N.csv"]
     lines = (out / "trajectory_F1_10N.csv").read_text().splitlines()
     assert lines[0] == "cup,t_s,r_mm,h_mm,p_b_Pa,p_Pa,u_c_nm,N,N_dot_per_s,phi_s,ballistic_share"
     assert lines[1].startswith("A,0,")

@@ -84,3 +84,56 @@ def test_the_finite_guard_names_the_column_and_the_stage(tmp_path):
         write_table(tmp_path / "t.csv", {"t_s": [0.0, 1.0], "r_mm": [12.0, float("nan")]}, stage="lifetime")
     write_table(tmp_path / "t.csv", {"lifetime_s": [float("inf"), 3.0]})      # an infinite lifetime means sealed
     assert (tmp_path / "t.csv").read_text().splitlines()[1] == "inf"
+
+
+def _manifest_complete(out: Path) -> bool:
+    """The directory holds exactly what its manifest lists (and the manifest)."""
+    listed = {f["path"] for f in json.loads((out / "manifest.json").read_text())["files"]}
+    return {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()} == listed | {"manifest.json"}
+
+
+def test_a_killed_directory_run_is_cleaned_up_by_the_next(tmp_path):
+    """SIGKILL a lifetime run at several moments (a real process): the output is the previous
+    complete one or absent, never a mix; the next run removes the killed run's temporaries and
+    leaves only what its manifest lists."""
+    out = tmp_path / "run"
+    forces = [str(f) for f in range(5, 85, 5)]
+    cmd = [sys.executable, "-m", "validation.cli", "lifetime", "--relaxation", "default", "--force", *forces,
+           "--out", str(out)]
+    leftovers = 0
+    for extra in (0.0, 0.05, 0.3, 1.0):
+        proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        while proc.poll() is None and not list(tmp_path.glob(".run.*.tmp")):   # the run is writing
+            time.sleep(0.005)
+        time.sleep(extra)
+        proc.kill()
+        proc.wait()
+        assert not out.exists() or _manifest_complete(out)
+        leftovers += len(list(tmp_path.glob(".run.*.tmp")))
+    assert leftovers > 0                       # some kill did land while the run was writing
+    done = subprocess.run(cmd[:-1] + [str(out)], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert _manifest_complete(out) and sorted(p.name for p in tmp_path.iterdir()) == ["run"]
+    assert len([p for p in out.iterdir() if p.name.startswith("trajectory_")]) == len(forces)
+
+
+def test_a_second_run_through_a_symlink_is_refused_while_the_first_writes(tmp_path):
+    """Two real processes: while the first writes 'real', a second naming it through a symlink is
+    refused at once (the lock is on the resolved path) and the first completes."""
+    real, alias = tmp_path / "real", tmp_path / "alias"
+    alias.symlink_to(real)
+    forces = [f"{f / 2:g}" for f in range(10, 161)]          # 151 relaxed lifetimes: several seconds
+    first = subprocess.Popen([sys.executable, "-m", "validation.cli", "lifetime", "--relaxation", "default", "--force",
+                              *forces, "--out", str(real)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                             text=True)
+    while first.poll() is None and not list(tmp_path.glob(".real.*.tmp")):       # the first is writing
+        time.sleep(0.005)
+    second = subprocess.run([sys.executable, "-m", "validation.cli", "lifetime", "--json", "--force", "10", "--out",
+                             str(alias)], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    _, err = first.communicate(timeout=300)
+    assert first.returncode == 0, err
+    if second.returncode == 0:                 # the first had already finished: nothing to race
+        pytest.skip("the first run ended before the second started")
+    assert second.returncode == 2 and "is being written by another cupcheck run" in second.stderr
+    assert len(second.stderr.splitlines()) == 1 and _manifest_complete(real)
+    assert len([p for p in real.iterdir() if p.name.startswith("trajectory_")]) == len(forces)

@@ -65,6 +65,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if hasattr(signal, "SIGXFSZ"):           # a file-size limit: an OSError to report, not a kill
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     try:
+        from validation.output import check_option_values
+        check_option_values(list(sys.argv[1:] if argv is None else argv))
         return int(args._run(args) or 0)
     except OSError as exc:                   # a full disk, a read-only directory, a size limit
         where = f" ('{exc.filename}')" if exc.filename else ""

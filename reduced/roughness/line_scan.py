@@ -14,17 +14,32 @@ of unit width in ln q around q has mean square ``2 q C_1D(q)``; a sinusoid with 
 amplitude ``a(q) = sqrt(4 q C_1D(q))``. The spectrum is cut at the first q (after log-binning) with
 ``a(q) q^2 > 1/R``, and never above half the Nyquist wavevector (the top octave holds window
 leakage and aliasing). It is a scale estimate, not a deconvolution of the tip.
+
+No silent clipping: a quasi-periodic profile (a hump in C_1D) has no isotropic equivalent below
+its hump (the inversion is negative there and is set to zero). How much of the line spectrum the
+isotropic C(q) does not reproduce travels with the spectrum (``misfit``, and its provenance): a
+`SpectrumWarning` where the round trip misses C_1D by more than 2x anywhere, a ValueError when
+more than ``REFUSE_SHARE`` of the mean-square height is not represented.
 """
 
 from __future__ import annotations
 
 import csv
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from .spectrum import PowerSpectrum, line_to_isotropic
+from .spectrum import PowerSpectrum, isotropic_misfit, line_to_isotropic
+
+#: above this share of <h^2> not represented by the isotropic C(q): refused (the isotropic
+#: model would describe another surface)
+REFUSE_SHARE = 0.25
+
+
+class SpectrumWarning(UserWarning):
+    """A spectrum that represents its source only in part (the share is in the message)."""
 
 _UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9}
 
@@ -115,6 +130,13 @@ def spectrum_from_line_scan(x_m: np.ndarray, z_m: np.ndarray, tip_radius_m: floa
     from scipy.signal import savgol_filter   # here: scipy.signal costs 0.3 s to import
     Cs = np.exp(savgol_filter(np.log(Cb), max(win, 3), 2)) if win >= 3 else Cb
     C = line_to_isotropic(qb, Cs)
+    misfit = isotropic_misfit(qb, Cs, C)
+    what = (f"the isotropic C(q) of this line scan: {misfit.describe()} (a quasi-periodic profile, a "
+            f"hump in C_1D, has no isotropic equivalent below it)")
+    if misfit.share > REFUSE_SHARE:
+        raise ValueError(f"line scan: {what}; refusing above {100 * REFUSE_SHARE:g} %")
+    if misfit.decades > 0:
+        warnings.warn(what, SpectrumWarning, stacklevel=2)
     good = C > 0
-    return PowerSpectrum(qb[good], C[good],
-                         provenance=f"line scan, tip radius {tip_radius_m:g} m, {qb.size} bins")
+    return PowerSpectrum(qb[good], C[good], misfit=misfit,
+                         provenance=f"line scan, tip radius {tip_radius_m:g} m, {qb.size} bins, {misfit.describe()}")

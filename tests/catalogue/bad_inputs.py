@@ -270,3 +270,105 @@ for label, text, expected in [
 ]:
     case(f"scene file: {label}", RUN, expected, **{"s.toml": text})
 case("scene file: missing", RUN, "scene: no such file")
+
+# ------------------------------------------------------------------ suction tables (valid JSON, wrong types)
+import json as _json  # noqa: E402
+
+GOOD_TABLE = {"u_mm": [1, 2], "dp_kPa": [0, 10], "F1_N": [[1, 2], [3, 4]], "V_mm3": [[900, 800], [700, 600]],
+              "seal_r_mm": [[10, 10], [11, 11]], "cut_r_mm": [[12, 12], [13, 13]], "E_Pa": 4e6,
+              "profiles": [[None, None], [None, None]], "provenance": {"h1_mm": 9.09}}
+COUPLED = ["lifetime", "--route", "coupled", "--suction-table", "{d}/t.json", "--out", "{d}/out"]
+for label, change, expected in [
+    ("not an object", [1, 2, 3], "must hold a JSON object, got a list"),
+    ("grid is text", {"V_mm3": "lots"}, "V_mm3: expected a list of numbers, got str"),
+    ("ragged grid", {"F1_N": [[1, 2], [3]]}, "F1_N: expected numbers in a regular grid"),
+    ("wrong grid shape", {"seal_r_mm": [1, 2]}, "seal_r_mm: expected finite values on the 2 x 2 grid, got shape (2,)"),
+    ("modulus is text", {"E_Pa": "4e6"}, "E_Pa: expected a number, got '4e6'"),
+    ("modulus is a list", {"E_Pa": [4e6]}, "E_Pa: expected a number"),
+    ("u is a number", {"u_mm": 3}, "u_mm: expected a list of numbers, got int"),
+    ("profiles not rows", {"profiles": {"a": 1}}, "profiles must be a list of rows"),
+    ("profile keys", {"profiles": [[{"r": [1, 2]}, None], [None, None]]}, "profiles[0][0]: expected null or an object"),
+    ("profile radii text", {"profiles": [[{"r_mm": "x", "p_kPa": [1, 2]}, None], [None, None]]},
+     "profiles[0][0].r_mm: expected a list of numbers"),
+    ("profile mismatch", {"profiles": [[{"r_mm": [1, 2, 3], "p_kPa": [1, 2]}, None], [None, None]]},
+     "profiles[0][0]: p_Pa: a contact profile needs >= 2 matching"),
+    ("provenance text", {"provenance": "fem"}, "provenance must be an object"),
+    ("h1 text", {"provenance": {"h1_mm": "9"}}, "provenance must be an object whose h1_mm is a number"),
+]:
+    table = change if isinstance(change, list) else {**GOOD_TABLE, **change}
+    case(f"suction table: {label}", COUPLED, expected, **{"t.json": _json.dumps(table)})
+case("suction table: wrong types (example)", ["example", "--route", "coupled", "--suction-table", "{d}/t.json",
+                                             "--out", "{d}/out"], "E_Pa: expected a number",
+     **{"t.json": _json.dumps({**GOOD_TABLE, "E_Pa": None})})
+
+# ------------------------------------------------------------------ stiffness sidecars (valid JSON, wrong types)
+for label, sidecar, expected in [
+    ("geometry text", {"provenance": {"geometry": "cup A"}}, "provenance.geometry: expected a table, got str"),
+    ("geometry radius text", {"provenance": {"geometry": {"r0_mm": "5", "r1_mm": 19, "alpha_deg": 33, "h1_mm": 9}}},
+     "provenance.geometry.r0_mm: expected a number, got '5'"),
+    ("contact law a number", {"provenance": {"contact": 3}}, "provenance.contact: expected a string"),
+    ("friction text", {"provenance": {"contact": "coulomb", "friction": "0.3"}}, "provenance.friction: expected a number"),
+    ("steps a list", {"provenance": {}, "steps": [1, 2]}, "steps: expected a table, got list"),
+    ("profile radii a number", {"provenance": {}, "steps": {"pressure_r_mm": 5, "pressure_kPa": 5}},
+     "steps.pressure_r_mm: expected one list of numbers per sample"),
+    ("profile pressures text", {"provenance": {}, "steps": {"pressure_r_mm": [[1, 2]], "pressure_kPa": [["a", "b"]]}},
+     "steps.pressure_kPa: expected one list of numbers per sample"),
+    ("profile lengths", {"provenance": {}, "steps": {"pressure_r_mm": [[1, 2]], "pressure_kPa": [[1, 2, 3]]}},
+     "steps.pressure_kPa[0]: 3 pressures for 2 radii"),
+]:
+    case(f"stiffness sidecar: {label}", LIFE + ["--stiffness", "{d}/c.csv"], expected,
+         **{"c.csv": GOOD_CURVE, "c.json": _json.dumps(sidecar)})
+
+# ------------------------------------------------------------------ meshes with broken connectivity
+_LINES = _SHIPPED_MESH.split("\n")
+_AT = _LINES.index("$Elements")
+
+
+def _mesh_with(edit) -> str:
+    lines = list(_LINES)
+    edit(lines)
+    return "\n".join(lines)
+
+
+def _out_of_range(lines):
+    first = lines[_AT + 2].split()
+    lines[_AT + 2] = " ".join(first[:-1] + ["9999"])
+
+
+def _duplicate(lines):
+    lines[_AT + 1] = str(int(lines[_AT + 1]) + 1)
+    second = lines[_AT + 3].split()
+    lines.insert(lines.index("$EndElements"), " ".join([lines[_AT + 1]] + second[1:]))
+
+
+def _node_twice(lines):
+    first = lines[_AT + 2].split()
+    first[-2] = first[-3]
+    lines[_AT + 2] = " ".join(first)
+
+
+case("mesh", MESH, "mesh: cannot read '{d}/m.msh': index 9998 is out of bounds", **{"m.msh": _mesh_with(_out_of_range)})
+case("mesh", MESH, "mesh: '{d}/m.msh': element 145 repeats element 2 (the same nodes)", **{"m.msh": _mesh_with(_duplicate)})
+case("mesh", MESH, "mesh: '{d}/m.msh': element 1 names one node twice", **{"m.msh": _mesh_with(_node_twice)})
+
+# ------------------------------------------------------------------ output paths (validation.output.check_outputs)
+case("output path", ["uc", "--psd", "{d}/p.csv", "--E-MPa", "4", "--p-kPa", "10", "20", "--out", "{d}/p.csv"],
+     "--out: '{d}/p.csv' is the input --psd '{d}/p.csv' of this run", **{"p.csv": "q_per_m,C_m4\n" + PSD_ROWS})
+case("output path", ["stiffness", "--geometry", "{d}/g.json", "--out", "{d}/g.csv"],
+     "--out's sidecar: '{d}/g.json' is the input --geometry '{d}/g.json'", **{"g.json": "r1_mm = 25\n"})
+case("output path", LIFE[:1] + ["--uc-table", "{d}/out/u.csv", "--out", "{d}/out"],
+     "--out: '{d}/out' holds the input --uc-table", **{"out/u.csv": GOOD_UC, "out/manifest.json": "{}"})
+case("output path", LIFE[:1] + ["--out", "{d}/mine"], "holds files cupcheck did not write", **{"mine/notes.txt": "x"})
+case("output path", LIFE[:1] + ["--out", ""], "--out: the value is empty")
+case("output path", ["uc", "--surface", "pmma-1.89", "--E-MPa", "4", "--p-kPa", "10", "20", "--out="],
+     "--out: the value is empty")
+case("output path", ["run", "{d}/s.toml", "--out", "{d}/o", "--cache-dir", "{d}/o/cache"],
+     "--out: '{d}/o' and --cache-dir '{d}/o/cache' are one output",
+     **{"s.toml": "[stiffness]\nsource = \"appendix-a\"\n[[outputs]]\nkind = \"lifetimes\"\n"})
+case("output path", ["run", "{d}/o/s.toml", "--out", "{d}/o", "--no-cache"], "--out: '{d}/o' holds the input scene",
+     **{"o/s.toml": "[stiffness]\nsource = \"appendix-a\"\n[[outputs]]\nkind = \"lifetimes\"\n", "o/manifest.json": "{}"})
+case("output path", ["stiffness", "--out", "{d}/mycup.csv"], "--out's sidecar: '{d}/mycup.json' exists and is not what "
+     "cupcheck writes there", **{"mycup.json": '{"r1_mm": 25}'})
+# (/dev/null as --out: tests/test_output_paths.py, which also checks that it is left untouched)
+case("stiffness CSV: header only", LIFE + ["--stiffness", "{d}/c.csv"],
+     "stiffness: '{d}/c.csv' has no rows; a stiffness curve needs at least 2 samples", **{"c.csv": "u_mm,h_mm,F0_N\n"})

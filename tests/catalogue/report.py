@@ -27,9 +27,45 @@ FAULTS = """
   the output: File too large`, exit status 1, and the output directory is not there.
 - Two runs into the same output: the second is refused at once (an OS file lock on the output,
   `filelock`), so their files never interleave; the lock file is removed on release.
+- A `lifetime` run SIGKILLed while it writes (a real process, killed as soon as its temporary
+  directory appears and 0.05, 0.3, 1 s later): the output is the previous complete one or absent;
+  the next run removes the killed run's temporaries and leaves only what its manifest lists.
+- Two real runs, the second naming the output through a symlink while the first writes it: the
+  second is refused at once (the lock is on the resolved path), the first completes.
 - Every table cupcheck writes passes one guard (`validation.output.check_finite`): NaN is refused
   with the column and the stage that produced it; inf is written only where it means something
   (an infinite lifetime, an unbounded line-contact pressure).
+
+## Outputs never destroy, and own their folder (tests/test_output_paths.py)
+
+One function, `validation.output.check_outputs`, runs in every command before any work (and again
+in the atomic writers): exit 2 and one line naming both paths for an empty path (`--out ""`), a
+special file (`/dev/null`, a FIFO, a socket, also through a symlink; /dev/null is checked untouched),
+an output that is an input of the run (by name, symlink or hard link: `uc --psd p.csv --out
+p.csv`, `stiffness --geometry mycup.json --out mycup.csv` whose sidecar is the design), an input
+or the cache inside an output directory, an existing directory cupcheck did not write, and a
+file the user did not name (a curve's sidecar, a footprint's scale) over a file of another kind
+(`stiffness --out mycup.csv` beside a design `mycup.json`).
+`check_file_names` refuses two outputs of one run writing one file (a scene curve named
+`manifest`, a curve and a footprint both writing `x.json`, forces 10 and 10.0000001 N sharing a
+trajectory file). A run into an existing output directory replaces it as a whole: afterwards it
+holds exactly the files its `manifest.json` lists; a later success removes a stale
+`<out>.failure.json`; a refused or failed run leaves no directories it created.
+
+## Readers that never crash (tests/test_readers.py)
+
+Each wrong JSON type (text, null, bool, number, object, ragged and non-numeric lists) at every key
+path of a suction table and of a stiffness sidecar: a one-line ValueError naming the file and the
+key as the file spells it, or a valid read; meshes with an element naming a node out of range or
+one node twice, or a repeated element: one line naming the file and the element.
+
+## No silent clipping (tests/test_rough_clipping.py)
+
+The 1D -> isotropic inversion of a line scan's spectrum clips where no isotropic C(q) exists (below
+a hump in C_1D); `spectrum.isotropic_misfit` measures it by the forward transform of the result
+(share of <h^2> not reproduced; decades of q where C_1D is missed by > 2x): a power law < 1e-4 and
+0, a 5 % Gaussian hump 6 % and 0.6 decades. A line scan carries it (`PowerSpectrum.misfit`, its
+provenance), says it in one line where C_1D is missed anywhere, and is refused above 25 %.
 
 ## Properties (tests/test_properties.py, hypothesis, derandomized)
 
@@ -46,6 +82,7 @@ def outcome(argv, files, expected) -> str:
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
         for name, content in files.items():
+            (d / name).parent.mkdir(parents=True, exist_ok=True)
             (d / name).write_bytes(content if isinstance(content, bytes) else content.encode())
         before = set(d.rglob("*"))
         err = io.StringIO()

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
+import warnings
 
 
 def add_surface_arguments(parser: argparse.ArgumentParser, group=None) -> None:
@@ -43,4 +45,9 @@ def spectrum_from_args(args: argparse.Namespace):
     if not args.tip_radius_um > 0:
         raise ValueError(f"--tip-radius-um: must be > 0, got {args.tip_radius_um:g}")
     x, z = read_line_scan(args.line_scan)
-    return spectrum_from_line_scan(x, z, args.tip_radius_um * 1e-6)
+    with warnings.catch_warnings(record=True) as caught:         # a spectrum that clips: one line
+        warnings.simplefilter("always")
+        spectrum = spectrum_from_line_scan(x, z, args.tip_radius_um * 1e-6)
+    for w in caught:
+        print(f"note: {w.message}", file=sys.stderr)
+    return spectrum

@@ -215,6 +215,8 @@ def run(args: argparse.Namespace) -> int:
     from fem.mesh import DEFAULT_FIDELITY
 
     t0 = time.perf_counter()
+    from validation.output import check_outputs, command_inputs
+    check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     cup_laws, seal = route_model(args, coupled=True)
     geometry, uc, uc_label = _inputs(args)

@@ -245,6 +245,9 @@ def run(args: argparse.Namespace) -> int:
     from reduced.lifetime import lifetime_sweep
     from validation.output import atomic_directory, terminal_progress
 
+    from validation.output import check_file_names, check_outputs, command_inputs
+    check_outputs(directories={"--out": args.out}, inputs=command_inputs(args))
+    check_file_names({f"--force {f!r}": [f"trajectory_F1_{f:g}N.csv"] for f in args.force_N if args.out})
     if args.route == "coupled":
         from validation.coupled.route import run_coupled
         return run_coupled(args)

@@ -52,6 +52,9 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import atomic_file
 
     _check(args)
+    from validation.output import check_outputs, command_inputs
+    check_outputs(files={"--out": args.out}, inputs=command_inputs(args),
+                  companions={"--out's scale": (args.out.with_suffix(".json") if args.view == "footprint" else None, "m_per_px")})
     from validation.render import views
     from validation.render.frames import fields_file_steps, frame_from_fields_file
 

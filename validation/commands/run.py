@@ -35,6 +35,10 @@ def run(args: argparse.Namespace) -> int:
     from validation.scenes.schema import load_scene
 
     scene = load_scene(args.scene)                    # every check before any work
+    from validation.output import check_outputs, command_inputs
+    check_outputs(directories={"--out": args.out}, stores={"--cache-dir": None if args.no_cache else args.cache_dir},
+                  inputs={**command_inputs(args), "cup.geometry": scene["cup"]["geometry"],
+                          "surface.uc_table": scene["surface"]["uc_table"]})
     if args.out.exists() and not args.out.is_dir():
         raise ValueError(f"--out: '{args.out}' exists and is not a directory")
 

@@ -129,6 +129,9 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
             raise ValueError(f"fields_out: must end in .vtu or .vtk (the last step) or .xdmf (every "
                              f"step), in any case, got '{fields}'")
         _writable(fields, "fields_out")
+    from validation.output import check_outputs, command_inputs
+    check_outputs(files={"--out": out, "--fields-out": args.fields_out}, inputs=command_inputs(args),
+                  companions={"--out's sidecar": (out.with_suffix(".json"), "provenance")})
     from validation.guards import check_design, check_modulus
 
     material = NeoHookean(E_Pa=check_modulus(args.E_MPa) * 1e6,

@@ -89,6 +89,8 @@ def _prepare(args: argparse.Namespace) -> dict:
     if out.suffix.lower() != ".json":
         raise ValueError(f"out: the suction table must be a .json file (any case), got '{out}'")
     _writable(out, "out")
+    from validation.output import check_outputs, command_inputs
+    check_outputs(files={"--out": out}, inputs=command_inputs(args))
     if not (0.0 <= args.nu <= LOCKING_NU):
         raise ValueError(f"nu: Poisson's ratio must be in [0, {LOCKING_NU}], got {args.nu:g}")
     material = NeoHookean(E_Pa=check_modulus(args.E_MPa) * 1e6, nu=args.nu)

@@ -44,6 +44,8 @@ def run(args: argparse.Namespace) -> int:
     from validation.sweeps.spec import load_sweep
 
     spec = load_sweep(args.sweep)
+    from validation.output import check_outputs, command_inputs
+    check_outputs(stores={"--out": args.out}, inputs=command_inputs(args))
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise ValueError(f"--workers: must be in [1, 256], got {args.workers}")
     if args.out.exists() and not args.out.is_dir():

@@ -83,6 +83,8 @@ def run(args) -> int:
         return _list_surfaces()
     from reduced.roughness.persson import check_gap_parameters, critical_gap_table, effective_modulus
 
+    from validation.output import check_outputs, command_inputs
+    check_outputs(files={"--out": args.out}, inputs=command_inputs(args))
     if not has_surface(args):
         raise ValueError("surface: give one of --surface NAME, --psd FILE, --line-scan FILE")
     if args.E_MPa is None:

@@ -48,6 +48,8 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import atomic_directory, terminal_progress
 
     plan = planned_requests(args.quick, args.only)          # validates --only before any work
+    from validation.output import check_outputs, command_inputs
+    check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     if args.out.exists() and not args.out.is_dir():
         raise ValueError(f"--out: {args.out} exists and is not a directory")
     memo = RunMemo(cache_dir=args.cache_dir)

@@ -40,6 +40,8 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
 
     if not isinstance(scene, Scene):
         scene = scene_from_mapping(scene) if isinstance(scene, dict) else load_scene(scene)
+    from validation.output import check_file_names
+    check_file_names(planned_files(scene), reserved={"manifest.json": "the scene's manifest"})
     products = Products(scene, cache_dir=cache_dir, progress=progress)
     t0 = time.perf_counter()
     def each(tmp):
@@ -101,6 +103,27 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
     import matplotlib.pyplot as plt
     plt.close(fig)
     return paths
+
+
+#: the files of each output kind, by suffix (as `_write` and `write_view` name them)
+_SUFFIXES = {"curve": (".csv", ".json"), "lifetimes": (".csv",), "figure": (".png", ".svg"), "render": (".png",),
+             "footprint": (".png", ".json"), "squeeze": (".gif",)}
+
+
+def planned_files(scene: Scene) -> dict[str, list[str]]:
+    """The file names each output will write, before any work (`check_file_names` refuses two
+    outputs writing one file): a trajectory per force, a squeeze's numbered frames."""
+    plan: dict[str, list[str]] = {}
+    for i, o in enumerate(scene.outputs):
+        name, kind = o["name"], o["kind"]
+        label = f"outputs[{i}] ({kind} '{name}')"
+        if kind == "trajectories":
+            for force in scene["loads"]["F1_N"]:
+                plan[f"{label} at F1 = {force!r} N"] = [f"{name}_F1_{force:g}N.csv"]
+            continue
+        frames = [f"{name}_{k:02d}.png" for k in range(o["frames"])] if kind == "squeeze" else []
+        plan[label] = [name + s for s in _SUFFIXES[kind]] + frames
+    return plan
 
 
 def _file(name: str, kind: str, path: Path) -> dict[str, str]:
