@@ -82,7 +82,8 @@ def _prepare(args: argparse.Namespace) -> dict:
     from fem.cup import cup_height
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
-    from validation.commands.stiffness import LOCKING_NU, _writable
+    from validation.commands.stiffness import _writable
+    from validation.pipeline import LOCKING_NU
     from validation.guards import check_design, check_modulus
 
     out = Path(args.out)

@@ -107,8 +107,8 @@ class FemRun:
         return self.alpha_deg if self.alpha_deg is not None else PRESETS[self.cup.upper()]["alpha_deg"]
 
     def material(self):
-        from fem.material import NeoHookean
-        return NeoHookean(E_Pa=self.E_Pa, nu=self.nu, formulation=self.formulation)
+        from validation.pipeline import neo_hookean
+        return neo_hookean(self.E_Pa, self.nu, self.formulation)
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,16 +161,16 @@ class FemResult:
 
 def compute(request: FemRun, progress: Callable[[float, str], None] | None = None) -> FemResult:
     """Run the request: mesh, compress, and keep the plain arrays (raises ValueError/RuntimeError)."""
-    from fem.cup import compress_cup
+    from fem.interface import ContactLaw
     from fem.mesh import cup_mesh
+    from validation.pipeline import fem_path
 
     geometry = request.geometry()
     mesh = cup_mesh(geometry, request.fidelity, element=request.element)
     t0 = time.perf_counter()
-    resp = compress_cup(mesh, request.material(), contact=request.contact,
-                        friction=request.friction or 0.0,
-                        u_max_m=request.u_max_over_h1 * geometry.h1_m, progress=progress,
-                        max_step=request.max_step)
+    resp = fem_path(geometry, request.material(), ContactLaw(request.contact, request.friction or 0.0),
+                    request.fidelity, request.u_max_over_h1 * geometry.h1_m, progress, mesh=mesh,
+                    max_step=request.max_step)
     wall = time.perf_counter() - t0
     r, z, p = deformed_outline(resp)
     return FemResult(request=request, h1_m=resp.h1_m, u_m=resp.u_m, F0_N=resp.F0_N,

@@ -49,9 +49,8 @@ def _uc_table(surface: dict, code: str):
     from reduced.critical_gap import UcTable
     if surface["uc_table"] is not None:
         return UcTable.from_csv(surface["uc_table"])
-    from reduced.roughness import uc_table
-    from reduced.roughness.surfaces import preset
-    return uc_table(preset(surface["preset"]).spectrum(), 0.5)
+    from validation.pipeline import surface_uc_table
+    return surface_uc_table(surface["preset"])
 
 
 def _fem_path(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
@@ -60,17 +59,15 @@ def _fem_path(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: 
     every converged step). Keyed only by what it depends on (cup, material, contact, fidelity,
     u_max), so a curve, a render, a footprint and a squeeze ending at the same u share one run."""
     COMPUTED["fem_path"] += 1
-    from fem.cup import compress_cup
-    from fem.material import NeoHookean
-    from fem.mesh import cup_mesh
+    from validation.pipeline import fem_path, neo_hookean
+    return fem_path(_geometry(cup), neo_hookean(material["E_MPa"] * 1e6, material["nu"]), _contact_law(contact),
+                    fidelity, u_max_m, progress)
 
-    law = contact["law"]
-    return compress_cup(
-        cup_mesh(_geometry(cup), fidelity),
-        NeoHookean(E_Pa=material["E_MPa"] * 1e6, nu=material["nu"],
-                   formulation="mixed" if material["nu"] > 0.495 else "displacement"),
-        contact=law, friction=float(contact["friction"] or 0.0) if law == "coulomb" else 0.0,
-        u_max_m=u_max_m, progress=progress)
+
+def _contact_law(contact: dict):
+    """The scene's [contact] table (checked by the schema) as a `fem.interface.ContactLaw`."""
+    from fem.interface import ContactLaw
+    return ContactLaw(contact["law"], float(contact["friction"] or 0.0) if contact["law"] == "coulomb" else 0.0)
 
 
 def _fem_curve(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str, path=None,
@@ -78,12 +75,8 @@ def _fem_curve(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m:
     """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`, not part of the key);
     its provenance says who chose the contact law (`Scene.contact_source`)."""
     COMPUTED["fem_curve"] += 1
-    from validation import handoff
-
-    response = path()
-    prov = handoff.provenance(response, geometry=_geometry(cup).describe(), mesh={"fidelity": fidelity},
-                              fidelity=fidelity, contact_source=contact_source)
-    return handoff.stiffness_curve(response, prov)
+    from validation.pipeline import fem_curve
+    return fem_curve(path(), _geometry(cup).describe(), fidelity, contact_source)
 
 
 def _fem_frames(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, n_frames: int,
@@ -128,22 +121,22 @@ def _model(tables: dict, curve, uc):
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel
     from reduced.viscoelastic import default_relaxation
+    from validation.pipeline import route_model
 
     loads, route = tables["loads"], tables["stiffness"]["route"]
+    laws, seal = route_model(route)
     if curve.design is None:               # Appendix A of a Table 1 preset: no fem imported
         cup = CUPS[tables["cup"]["preset"]]
         if loads["r_start_mm"] is not None:
             cup = replace(cup, r_start_m=1e-3 * loads["r_start_mm"])
     else:
         from validation.design import resolve_cup
-        cup = resolve_cup(curve, r_start_mm=loads["r_start_mm"],
-                          laws="curve" if route == "profile" else "cone").cup
+        cup = resolve_cup(curve, r_start_mm=loads["r_start_mm"], laws=laws).cup
     stiffness = curve.scaled(loads["kappa"]) if loads["kappa"] != 1.0 else curve
     return LeakageModel(cup=cup, stiffness=stiffness, u_c=uc, gas=Gas(T_K=293.15), p_a_Pa=1e5,
                         E_Pa=tables["material"]["E_MPa"] * 1e6,
                         relaxation=default_relaxation() if tables["material"]["relaxation"] == "default" else None,
-                        geometry="curve" if route == "profile" else "cone",
-                        seal="profile" if route == "profile" else "strip", fluid=tables["fluid"]["kind"])
+                        geometry=laws, seal=seal, fluid=tables["fluid"]["kind"])
 
 
 # ------------------------------------------------------------------ the lazy products
