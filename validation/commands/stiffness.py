@@ -23,13 +23,13 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import os
 import sys
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from validation.commands._cup import add_contact_arguments, add_cup_arguments, contact_choice, load_cup_design
+from validation.commands._paths import check_writable
 from validation.pipeline import LOCKING_NU
 
 NAME = "stiffness"
@@ -118,14 +118,14 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     out = Path(args.out)
     if out.suffix.lower() != ".csv":
         raise ValueError(f"out: the stiffness curve must be a .csv file (any case), got '{out}'")
-    _writable(out, "out")
-    _writable(out.with_suffix(".json"), "out", "its sidecar")
+    check_writable(out, "out")
+    check_writable(out.with_suffix(".json"), "out", "its sidecar")
     if args.fields_out is not None:
         fields = Path(args.fields_out)
         if fields.suffix.lower() not in FIELD_SUFFIXES:
             raise ValueError(f"fields_out: must end in .vtu or .vtk (the last step) or .xdmf (every "
                              f"step), in any case, got '{fields}'")
-        _writable(fields, "fields_out")
+        check_writable(fields, "fields_out")
     from validation.guards import check_design, check_modulus
 
     material = neo_hookean(check_modulus(args.E_MPa) * 1e6, args.nu, args.formulation)
@@ -163,21 +163,6 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
             "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json"),
             "contact": contact}
-
-
-def _writable(path: Path, name: str, what: str = "") -> None:
-    """Refuse, before the solve, an output path that is a directory or whose directory can be
-    neither found nor created (the writers create missing parent directories)."""
-    label = f"{what} '{path}'" if what else f"'{path}'"
-    if path.is_dir():
-        raise ValueError(f"{name}: {label} is a directory; give a file name")
-    ancestor = path.parent
-    while not ancestor.exists() and ancestor != ancestor.parent:
-        ancestor = ancestor.parent
-    if not ancestor.is_dir():
-        raise ValueError(f"{name}: cannot create the directory of {label}: '{ancestor}' is a file")
-    if not os.access(ancestor, os.W_OK | os.X_OK):
-        raise ValueError(f"{name}: cannot write {label}: no write permission in '{ancestor}'")
 
 
 def _positive(value: float, name: str, what: str) -> float:
