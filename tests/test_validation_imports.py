@@ -70,3 +70,15 @@ def test_validation_has_no_import_circles():
     graph = import_graph()
     assert "validation.commands.lifetime" in graph and graph["validation.commands.lifetime"]
     assert circles(graph) == []
+
+
+def test_the_public_nouns_are_lazy():
+    # `import validation` imports no heavy package; each name of __all__ resolves to its noun
+    import subprocess
+    import sys
+
+    code = ("import sys, validation; heavy = [m for m in ('fem', 'skfem', 'matplotlib', 'dask') if m in sys.modules];"
+            "print(heavy, len(validation.__all__));"
+            "[getattr(validation, n) for n in validation.__all__]; print('ok')")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    assert out.splitlines() == [f"[] {len(__import__('validation').__all__)}", "ok"]
