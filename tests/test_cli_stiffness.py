@@ -117,13 +117,24 @@ def test_mixed_formulation_runs_nearly_incompressible(tmp_path, capsys):
 
 def test_displacement_formulation_refuses_nu_where_it_locks(tmp_path, capsys):
     out = tmp_path / "c.csv"
-    assert main(["stiffness", "--nu", "0.4999", "--out", str(out)]) == 2
+    assert main(["stiffness", "--formulation", "displacement", "--nu", "0.4999", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("cupcheck stiffness: error: nu: ") and "--formulation mixed" in err
     assert "\n" not in err and _files(tmp_path) == []
     # the bound itself is allowed (cup A, medium, frictionless, to 0.9 h1: F0 +0.74 % above the
     # mixed formulation at nu = 0.495, +0.60 % at the default 0.49, +1.6 % at 0.4999)
     assert stiffness_prepare(["--nu", "0.495", "--out", str(out)])["material"].nu == 0.495
+
+
+def test_formulation_follows_nu_unless_given(tmp_path):
+    # one rule for the command line, scenes and sweeps (validation.pipeline.neo_hookean): not
+    # given, nu above 0.495 takes the mixed formulation, where the displacement elements lock
+    out = str(tmp_path / "c.csv")
+    assert stiffness_prepare(["--nu", "0.495", "--out", out])["material"].formulation == "displacement"
+    assert stiffness_prepare(["--nu", "0.4999", "--out", out])["material"].formulation == "mixed"
+    assert stiffness_prepare(["--nu", "0.3", "--formulation", "mixed", "--out", out])["material"].formulation == "mixed"
+    from validation.pipeline import neo_hookean
+    assert neo_hookean(4e6, 0.4999).formulation == "mixed" and neo_hookean(4e6, 0.49).formulation == "displacement"
 
 
 def test_output_suffixes_in_any_case_and_a_directory_to_create_are_accepted(tmp_path):
@@ -153,7 +164,7 @@ def stiffness_prepare(argv: list[str]) -> dict:
     (["--mesh", "missing.msh"], "mesh"),
     (["--mesh", "meshes/user_lip.msh", "--fidelity", "fine"], "mesh"),
     (["--mesh", "meshes/user_lip.msh", "--mesh-unit", "m"], "mesh"),
-    (["--nu", "0.496"], "nu"),
+    (["--formulation", "displacement", "--nu", "0.496"], "nu"),
 ])
 def test_bad_input_exits_2_with_one_line_and_no_output(tmp_path, capsys, monkeypatch, argv, field):
     monkeypatch.chdir(REPO)

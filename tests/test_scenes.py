@@ -91,6 +91,44 @@ def test_a_second_run_computes_nothing_and_a_corrupt_entry_is_recomputed(tmp_pat
     assert [r.lifetime_s for r in third.products["lifetimes"]] == [r.lifetime_s for r in first.products["lifetimes"]]
 
 
+def test_the_cache_keys_input_files_by_content(tmp_path, capsys):
+    # an edited design file or u_c table is a new product (the path is the same); unchanged
+    # inputs recompute nothing; the design's curve goes through the cache, the table through the lifetimes
+    import numpy as np
+
+    from reduced.critical_gap import ILLUSTRATIVE_UC_CSV
+    design, table, cache = tmp_path / "cup.toml", tmp_path / "uc.csv", tmp_path / "cache"
+    thick = 'cup = "A"\n[thickness]\nr_mm = [5, 20]\nd_mm = [2.5, 0.3]\n'
+    design.write_text(thick)
+    table.write_bytes(ILLUSTRATIVE_UC_CSV.read_bytes())
+    scene = {"cup": {"geometry": str(design)}, "surface": {"uc_table": str(table)},
+             "loads": {"F1_N": [10]}, "outputs": [{"kind": "curve"}, {"kind": "lifetimes"}]}
+
+    def run(name):
+        pipeline.COMPUTED.clear()
+        result = run_scene(dict(scene), tmp_path / name, cache_dir=cache)
+        return result.products["curve"].F0_N[-1], result.products["lifetimes"][0].lifetime_s, dict(pipeline.COMPUTED)
+
+    F_thick, life, computed = run("a")
+    assert computed == {"fem_path": 1, "fem_curve": 1, "uc_table": 1, "lifetimes": 1}
+    assert run("b") == (F_thick, life, {})                              # nothing recomputed
+    design.write_text(thick.replace("2.5, 0.3", "1.5, 0.3"))            # a thinner wall, same path
+    F_thin, life_thin, computed = run("c")
+    assert computed == {"fem_path": 1, "fem_curve": 1, "lifetimes": 1} and F_thin < 0.8 * F_thick
+    rows = table.read_text().splitlines()
+    head = [r for r in rows if not r[:1].isdigit()]
+    table.write_text("\n".join(head + [f"{p},{2 * float(u)!r}" for p, u in
+                                        (r.split(",") for r in rows if r[:1].isdigit())]) + "\n")
+    F_again, life_wide, computed = run("d")                             # twice the gap: a faster leak
+    assert computed == {"uc_table": 1, "lifetimes": 1} and F_again == F_thin and life_wide < life_thin
+    for entry in cache.rglob("output.pkl"):                             # damage every stored product
+        entry.write_bytes(b"not a pickle")
+    capsys.readouterr()
+    assert run("e")[:2] == (F_again, life_wide)
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and np.all([line.startswith("cupcheck: cache ") for line in err.splitlines()])
+
+
 _LAZY = """
 import sys
 from validation.scenes.outputs import run_scene

@@ -1,1 +1,41 @@
-"""Cross-checks, benchmarks, scenes, figures and the `cupcheck` command line (composes fem and reduced)."""
+"""Cross-checks, benchmarks, scenes, figures and the `cupcheck` command line (composes fem and reduced).
+
+The public nouns, imported on first use (``import validation`` imports no fem, skfem,
+matplotlib or dask): the FEM pipeline (`fem_stiffness`, `fem_path`, `fem_curve`, `neo_hookean`,
+`route_model`, `surface_uc_table`), the cup a curve was computed for (`resolve_cup`,
+`CupChoice`), the hand-off (`stiffness_curve`, `write_sidecar`), the cache (`Cache`), the
+coupled route (`CoupledOptions`, `coupled_model`, `suction_table_for`) and scenes (`run_scene`).
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+#: public name -> the module that defines it
+_WHERE = {
+    "fem_stiffness": "validation.pipeline", "fem_path": "validation.pipeline", "fem_curve": "validation.pipeline",
+    "neo_hookean": "validation.pipeline", "route_model": "validation.pipeline",
+    "surface_uc_table": "validation.pipeline", "DEFAULT_SURFACE": "validation.pipeline",
+    "ROUTES": "validation.pipeline",
+    "resolve_cup": "validation.design", "CupChoice": "validation.design",
+    "stiffness_curve": "validation.handoff", "write_sidecar": "validation.handoff",
+    "Cache": "validation.cache",
+    "CoupledOptions": "validation.coupled.route", "coupled_model": "validation.coupled.route",
+    "suction_table_for": "validation.coupled.build",
+    "run_scene": "validation.scenes.outputs",
+}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _WHERE:
+        raise AttributeError(f"module 'validation' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_WHERE[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

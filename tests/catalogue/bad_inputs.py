@@ -66,7 +66,6 @@ for opt, value, expected in [
     ("--E-MPa", "4e6", "E_MPa = 4e+06: did you give Pa?"),
     ("--E-MPa", "nan", "E_MPa: Young's modulus must be > 0 MPa"),
     ("--nu", "0.6", "nu"),
-    ("--nu", "0.499", "nu: with the displacement formulation Poisson's ratio must be <= 0.495"),
     ("--u-max-mm", "0", "u_max_mm"),
     ("--u-max-mm", "50", "u_max_mm: plate displacement must be in (0, h1]"),
     ("--u-max-mm", "nan", "u_max_mm"),
@@ -74,6 +73,8 @@ for opt, value, expected in [
     ("--cup", "C", "argument --cup: invalid cup 'C'"),
 ]:
     case("CLI option", STIFF + [opt, value], expected)
+case("CLI option", STIFF + ["--formulation", "displacement", "--nu", "0.499"],
+     "nu: with the displacement formulation Poisson's ratio must be <= 0.495")
 case("CLI option", STIFF + ["--contact", "coulomb"], "friction: --contact coulomb needs --friction MU, in [0, 100]")
 case("CLI option", STIFF + ["--contact", "coulomb", "--friction", "-0.2"], "friction: Coulomb's friction coefficient must be in [0, 100]")
 case("CLI option", STIFF + ["--contact", "coulomb", "--friction", "nan"], "friction: Coulomb's friction coefficient must be in [0, 100]")

@@ -19,6 +19,7 @@ if TYPE_CHECKING:                          # building the parser imports no fem
     from fem.interface import ContactChoice
 
 from reduced.cup import CUPS
+from validation.pipeline import ROUTES
 
 
 def cup_name(value: str) -> str:
@@ -55,7 +56,6 @@ def add_cup_arguments(parser: argparse.ArgumentParser, role: str):
     return g
 
 
-ROUTES = {"paper": "strip", "profile": "profile", "coupled": "coupled"}
 
 
 def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = "paper") -> None:
@@ -85,23 +85,14 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = 
 
 
 def route_model(args: argparse.Namespace, coupled: bool = False) -> tuple[str, str]:
-    """(geometry, seal) of the `LeakageModel` the route and cup-law options ask for; fills
-    ``args.cup_laws`` with the route's default. `coupled`: the command runs the coupled route
-    itself (its geometry is the suction table's: --cup-laws does not apply)."""
-    seal = ROUTES[args.route]
-    if seal == "coupled":
-        if not coupled:
-            raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
-        if args.cup_laws is not None:
-            raise ValueError("--cup-laws: the coupled route takes r and V from the FEM suction table; "
-                             "drop --cup-laws")
-        args.cup_laws = "curve"
-        return args.cup_laws, seal
-    if args.cup_laws is None:
-        args.cup_laws = "curve" if seal == "profile" else "cone"
-    if seal == "profile" and args.cup_laws != "curve":
-        raise ValueError("--cup-laws: the profile route takes r and V from the FEM curve whose "
-                         "profiles it crosses; drop --cup-laws cone")
+    """(geometry, seal) of the `LeakageModel` the route and cup-law options ask for
+    (`validation.pipeline.route_model`); fills ``args.cup_laws`` with the route's default.
+    `coupled`: the command runs the coupled route itself (else it is refused here)."""
+    from validation.pipeline import route_model as model_of
+
+    if args.route == "coupled" and not coupled:
+        raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
+    args.cup_laws, seal = model_of(args.route, args.cup_laws)
     return args.cup_laws, seal
 
 

@@ -92,31 +92,17 @@ def _inputs(args: argparse.Namespace):
         table = UcTable.from_csv(args.uc_table)
         check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
         return geometry, table, Path(args.uc_table).name
-    from reduced.roughness import uc_table
-    from reduced.roughness.surfaces import preset
-    name = args.surface or "pmma-1.89"
-    return geometry, uc_table(preset(name).spectrum(), 0.5), name
+    from validation.pipeline import DEFAULT_SURFACE, surface_uc_table
+    name = args.surface or DEFAULT_SURFACE
+    return geometry, surface_uc_table(name), name
 
 
 def fem_stiffness(geometry, contact: ContactChoice, fidelity: str, progress=None):
-    """(CupResponse, StiffnessCurve) of a cup geometry (`fem.geometry.CupGeometry` or a preset
-    name) with the contact law `contact` (`fem.interface.ContactChoice`: the law, and where it
-    came from, which the provenance records): the FEM step of the main job."""
-    from fem.cup import compress_cup
-    from fem.geometry import cup_geometry
-    from fem.material import NeoHookean
-    from fem.mesh import cup_mesh, mesh_spec
-    from validation import handoff
+    """(CupResponse, StiffnessCurve) of the main job's FEM step: the design (`CupGeometry` or a
+    preset name) of E = 4 MPa, nu = 0.49 under `contact` to 0.9 h1 (`validation.pipeline`)."""
+    from validation.pipeline import fem_stiffness as pipeline_stiffness, neo_hookean
 
-    if isinstance(geometry, str):
-        geometry = cup_geometry(geometry)
-    mesh = cup_mesh(geometry, fidelity)
-    response = compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.49), contact=contact.contact.law,
-                            friction=contact.contact.friction, u_max_m=0.9 * geometry.h1_m, progress=progress)
-    prov = handoff.provenance(response, geometry=geometry.describe(),
-                              mesh={"fidelity": fidelity, **vars(mesh_spec(fidelity))}, fidelity=fidelity,
-                              contact_source=contact.source)
-    return response, handoff.stiffness_curve(response, prov)
+    return pipeline_stiffness(geometry, neo_hookean(4e6, 0.49), contact, fidelity, progress=progress)
 
 
 def write_table(results, path: Path, cup: str, route: str) -> None:

@@ -9,7 +9,8 @@ flags and the other widths (lengths in mm). All files appear together or not at 
 
 Every input is checked before the solve: a bad value, an output path that cannot be written, or
 --nu above 0.495 with the displacement formulation (which locks there: use --formulation mixed)
-stops with one line and exit status 2; a solve that fails exits 1. Neither leaves a file behind.
+stops with one line and exit status 2 (without --formulation, nu above 0.495 takes the mixed
+formulation); a solve that fails exits 1. Neither leaves a file behind.
 
 examples:
   cupcheck stiffness --cup A --contact sticking --out out/cupA_sticking.csv
@@ -22,19 +23,18 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import os
 import sys
-from dataclasses import asdict, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from validation.commands._cup import add_contact_arguments, add_cup_arguments, contact_choice, load_cup_design
+from validation.commands._paths import check_writable
+from validation.pipeline import LOCKING_NU
 
 NAME = "stiffness"
 HELP = "FEM stiffness curve F0(h), r_c, l, V of cup A, B or your own design (CSV + JSON sidecar)"
 
-#: above this Poisson's ratio the displacement (Q2) formulation locks: refused without --formulation mixed
-LOCKING_NU = 0.495
 #: --fields-out suffixes (any case): .vtu, .vtk hold the last step, .xdmf every step; meshio's
 #: other formats drop the 9-node cells or the fields
 FIELD_SUFFIXES = (".vtu", ".vtk", ".xdmf")
@@ -54,9 +54,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     m.add_argument("--E-MPa", type=float, default=4.0, dest="E_MPa",
                    help="Young's modulus E [MPa] (default 4)")
     m.add_argument("--nu", type=float, default=0.49, help="Poisson's ratio [-] (default 0.49)")
-    m.add_argument("--formulation", choices=("displacement", "mixed"), default="displacement",
-                   help="displacement (default; nu <= 0.495, it locks above) or mixed u-p (nearly "
-                        "incompressible, nu up to 0.4999)")
+    m.add_argument("--formulation", choices=("displacement", "mixed"), default=None,
+                   help="displacement (nu <= 0.495, it locks above) or mixed u-p (nearly "
+                        "incompressible, nu up to 0.4999) (default: by nu, mixed above 0.495)")
     add_contact_arguments(m, "the soap-lubricated glass on which the paper measured F0, Sec. 5.5")
     r = parser.add_argument_group("run")
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default=None,
@@ -75,24 +75,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     job = _prepare(args)                     # every check happens here, before the solve
-    from fem.cup import compress_cup
     from fem.postprocess import BIOT_STRETCH
     from validation import handoff
     from validation.output import atomic_file, terminal_progress
+    from validation.pipeline import fem_curve, fem_path
 
     from fem.solver import ConvergenceError
     from validation.commands._failure import solver_failure
 
     try:
-        law = job["contact"].contact
-        response = compress_cup(job["mesh"], job["material"], contact=law.law,
-                                friction=law.friction, u_max_m=job["u_max_m"],
-                                progress=terminal_progress("stiffness"))
+        response = fem_path(None, job["material"], job["contact"], job["fidelity"], job["u_max_m"],
+                            terminal_progress("stiffness"), mesh=job["mesh"])
     except ConvergenceError as exc:
         raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
-    prov = handoff.provenance(response, geometry=job["geometry"], mesh=job["mesh_info"],
-                              fidelity=job["fidelity"], contact_source=job["contact"].source)
-    curve = handoff.stiffness_curve(response, prov)
+    curve = fem_curve(response, job["geometry"], job["fidelity"], job["contact"].source, job["mesh_info"])
+    prov = curve.provenance
     with atomic_file(job["sidecar"]) as tmp_json, atomic_file(args.out) as tmp_csv:
         curve.to_csv(tmp_csv, sidecar=False)
         handoff.write_sidecar(handoff.sidecar(response, prov), tmp_json)
@@ -115,31 +112,26 @@ def run(args: argparse.Namespace) -> int:
 def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     """Validate every input and build the mesh and material (cheap); raise ValueError."""
     from fem.cup import cup_height
-    from fem.material import NeoHookean
-    from fem.mesh import DEFAULT_FIDELITY, FIDELITIES, cup_mesh, read_mesh
+    from fem.mesh import DEFAULT_FIDELITY, cup_mesh, read_mesh
+    from validation.pipeline import mesh_record, neo_hookean
 
     out = Path(args.out)
     if out.suffix.lower() != ".csv":
         raise ValueError(f"out: the stiffness curve must be a .csv file (any case), got '{out}'")
-    _writable(out, "out")
-    _writable(out.with_suffix(".json"), "out", "its sidecar")
+    check_writable(out, "out")
+    check_writable(out.with_suffix(".json"), "out", "its sidecar")
     if args.fields_out is not None:
         fields = Path(args.fields_out)
         if fields.suffix.lower() not in FIELD_SUFFIXES:
             raise ValueError(f"fields_out: must end in .vtu or .vtk (the last step) or .xdmf (every "
                              f"step), in any case, got '{fields}'")
-        _writable(fields, "fields_out")
+        check_writable(fields, "fields_out")
     from validation.output import check_outputs, command_inputs
     check_outputs(files={"--out": out, "--fields-out": args.fields_out}, inputs=command_inputs(args),
                   companions={"--out's sidecar": (out.with_suffix(".json"), "provenance")})
     from validation.guards import check_design, check_modulus
 
-    material = NeoHookean(E_Pa=check_modulus(args.E_MPa) * 1e6,
-                          nu=args.nu, formulation=args.formulation)
-    if material.formulation == "displacement" and material.nu > LOCKING_NU:
-        raise ValueError(f"nu: with the displacement formulation Poisson's ratio must be <= "
-                         f"{LOCKING_NU} (above, its elements lock and stiffen F0); use "
-                         f"--formulation mixed for nu up to 0.4999, got {args.nu:g}")
+    material = neo_hookean(check_modulus(args.E_MPa) * 1e6, args.nu, args.formulation)
     fidelity = args.fidelity or DEFAULT_FIDELITY
     if args.mesh is not None:
         given = [o for o, v in (("--geometry", args.geometry), ("--fidelity", args.fidelity), ("--cup", args.cup),
@@ -149,8 +141,8 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         contact = contact_choice(args)
         mesh = read_mesh(args.mesh, unit=args.mesh_unit)
         geometry = {"name": f"mesh file {Path(args.mesh).name}"}
-        mesh_info = {"file": str(args.mesh), "unit": args.mesh_unit,
-                     "sha256": hashlib.sha256(Path(args.mesh).read_bytes()).hexdigest()}
+        mesh_info = mesh_record(mesh, None, {"file": str(args.mesh), "unit": args.mesh_unit,
+                                             "sha256": hashlib.sha256(Path(args.mesh).read_bytes()).hexdigest()})
         fidelity = None
     else:
         design = load_cup_design(args)
@@ -161,9 +153,7 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         geometry = geo.describe()
         check_design(geometry, args.allow_unusual_design, source=geo.name)
         mesh = cup_mesh(geo, fidelity)
-        mesh_info = {"generated": asdict(FIDELITIES[fidelity])}
-    mesh_info.update(element=type(mesh).__name__, elements=int(mesh.t.shape[1]),
-                     nodes=int(mesh.doflocs.shape[1]))
+        mesh_info = mesh_record(mesh, fidelity)
     h1 = cup_height(mesh)
     if args.u_max_mm is None:
         u_max = 0.9 * h1
@@ -176,21 +166,6 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
             "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json"),
             "contact": contact}
-
-
-def _writable(path: Path, name: str, what: str = "") -> None:
-    """Refuse, before the solve, an output path that is a directory or whose directory can be
-    neither found nor created (the writers create missing parent directories)."""
-    label = f"{what} '{path}'" if what else f"'{path}'"
-    if path.is_dir():
-        raise ValueError(f"{name}: {label} is a directory; give a file name")
-    ancestor = path.parent
-    while not ancestor.exists() and ancestor != ancestor.parent:
-        ancestor = ancestor.parent
-    if not ancestor.is_dir():
-        raise ValueError(f"{name}: cannot create the directory of {label}: '{ancestor}' is a file")
-    if not os.access(ancestor, os.W_OK | os.X_OK):
-        raise ValueError(f"{name}: cannot write {label}: no write permission in '{ancestor}'")
 
 
 def _positive(value: float, name: str, what: str) -> float:

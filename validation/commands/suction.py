@@ -82,13 +82,14 @@ def _prepare(args: argparse.Namespace) -> dict:
     from fem.cup import cup_height
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
-    from validation.commands.stiffness import LOCKING_NU, _writable
+    from validation.commands._paths import check_writable
+    from validation.pipeline import LOCKING_NU
     from validation.guards import check_design, check_modulus
 
     out = Path(args.out)
     if out.suffix.lower() != ".json":
         raise ValueError(f"out: the suction table must be a .json file (any case), got '{out}'")
-    _writable(out, "out")
+    check_writable(out, "out")
     from validation.output import check_outputs, command_inputs
     check_outputs(files={"--out": out}, inputs=command_inputs(args))
     if not (0.0 <= args.nu <= LOCKING_NU):

@@ -5,7 +5,7 @@ u = 0 up to 0.8 h1, dp = 0, 1, ..., 100 kPa; halving the u spacing moves cup A's
 <= 0.2 %, the dp spacing by <= 0.8 %, benchmarks/bench_coupled.py) and a coarse one for quick checks
 (`QUICK_GRID`).
 `suction_table_for` runs `fem.suction.suction_grid` on a design and converts it to the reduced
-model's `SuctionTable`; with a cache directory the table goes through `joblib.Memory`, keyed by the
+model's `SuctionTable`; with a cache directory the table goes through `validation.cache`, keyed by the
 design, the law, the grid and a hash of the sources that make it (`fem`, `validation.coupled` and
 the table's data types in `reduced`), so a second call computes nothing and a change to that code
 recomputes (a change to the leak, which reads the table, does not).
@@ -60,15 +60,12 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: str = "fri
     mesh level, contact law and grid (module docstring); `progress(fraction, message)` while the
     FEM runs. Raises `fem.solver.ConvergenceError` where a state does not converge."""
     from fem.geometry import cup_geometry
-    from validation.scenes.pipeline import package_version
+    from validation.cache import Cache, source_hash
 
     if isinstance(geometry, str):
         geometry = cup_geometry(geometry)
-    build = _build
-    if cache_dir is not None:
-        from joblib import Memory
-        build = Memory(str(cache_dir), verbose=0).cache(_build, ignore=["progress"])
-    code = "".join(package_version(p) for p in ("fem", "validation/coupled", *_TABLE_TYPES))
+    build = Cache(cache_dir).cached(_build, ignore=["progress"])
+    code = source_hash("fem", "validation/coupled", *_TABLE_TYPES)
     return build(geometry, fidelity, contact, friction, E_Pa, nu, grid, code, progress=progress)
 
 

@@ -4,7 +4,8 @@ A section of the validation report declares the cup compressions it needs as `Fe
 (frozen, hashable: the memo's key). `RunMemo.get` runs a request the first time it is asked for
 and returns the stored `FemResult` (or re-raises the stored failure) afterwards, so sections share
 runs and a subset of sections runs only what it needs. With `cache_dir`, results also persist on
-disk, keyed by the request and a hash of the `fem` sources (a code change invalidates them).
+disk (`validation.cache`), keyed by the request and a hash of the `fem` sources and the pipeline
+(a code change invalidates them).
 
 Geometry of a request: the preset cup (`fem.geometry.cup_geometry`) with, optionally, another cone
 angle and a root thickness d_root at r0; the thickness line then keeps the preset's shape, scaled
@@ -13,8 +14,6 @@ by d_root / d_preset(r0) (cup A: 2.5 -> 0.3 mm at r = 5 -> 20 mm, so the rim sta
 
 from __future__ import annotations
 
-import hashlib
-import pickle
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -22,10 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["FemRun", "FemResult", "RunMemo", "fem_code_version"]
+__all__ = ["FemRun", "FemResult", "RunMemo"]
 
 _MM = 1e-3
-_FEM_DIR = Path(__file__).resolve().parents[2] / "fem"
 
 
 @dataclass(frozen=True)
@@ -107,8 +105,8 @@ class FemRun:
         return self.alpha_deg if self.alpha_deg is not None else PRESETS[self.cup.upper()]["alpha_deg"]
 
     def material(self):
-        from fem.material import NeoHookean
-        return NeoHookean(E_Pa=self.E_Pa, nu=self.nu, formulation=self.formulation)
+        from validation.pipeline import neo_hookean
+        return neo_hookean(self.E_Pa, self.nu, self.formulation)
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,16 +159,16 @@ class FemResult:
 
 def compute(request: FemRun, progress: Callable[[float, str], None] | None = None) -> FemResult:
     """Run the request: mesh, compress, and keep the plain arrays (raises ValueError/RuntimeError)."""
-    from fem.cup import compress_cup
+    from fem.interface import ContactLaw
     from fem.mesh import cup_mesh
+    from validation.pipeline import fem_path
 
     geometry = request.geometry()
     mesh = cup_mesh(geometry, request.fidelity, element=request.element)
     t0 = time.perf_counter()
-    resp = compress_cup(mesh, request.material(), contact=request.contact,
-                        friction=request.friction or 0.0,
-                        u_max_m=request.u_max_over_h1 * geometry.h1_m, progress=progress,
-                        max_step=request.max_step)
+    resp = fem_path(geometry, request.material(), ContactLaw(request.contact, request.friction or 0.0),
+                    request.fidelity, request.u_max_over_h1 * geometry.h1_m, progress, mesh=mesh,
+                    max_step=request.max_step)
     wall = time.perf_counter() - t0
     r, z, p = deformed_outline(resp)
     return FemResult(request=request, h1_m=resp.h1_m, u_m=resp.u_m, F0_N=resp.F0_N,
@@ -203,17 +201,18 @@ def deformed_outline(resp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x[0, nodes], x[1, nodes], p
 
 
-def fem_code_version() -> str:
-    """A hash of the `fem` package sources (cache key: a code change invalidates cached runs)."""
-    h = hashlib.sha256()
-    for path in sorted(_FEM_DIR.glob("*.py")):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
+def _outcome(request: FemRun, code: str, runner: Callable[[FemRun], FemResult] | None = None) -> FemResult | Exception:
+    """The run's result, or the failure it raised (stored like a result: a failed request is not
+    rerun); `code` (the sources' hash) and `request` are the cache key, `runner` is not."""
+    try:
+        return runner(request)
+    except (ValueError, RuntimeError) as exc:
+        return exc
 
 
 class RunMemo:
-    """Runs each distinct `FemRun` once per memo; optionally persists results in `cache_dir`.
+    """Runs each distinct `FemRun` once per memo; optionally persists results in `cache_dir`
+    (`validation.cache`, keyed by the request and the sources of fem and of this pipeline).
 
     `get(request)` returns the `FemResult` or raises the run's failure (ValueError for an invalid
     geometry or input, RuntimeError for a solver failure), the same one on every call.
@@ -222,12 +221,15 @@ class RunMemo:
 
     def __init__(self, cache_dir: str | Path | None = None,
                  runner: Callable[[FemRun], FemResult] = compute):
+        from validation.cache import Cache, source_hash
+
         self._runner = runner
         self._store: dict[FemRun, FemResult | Exception] = {}
         self.cache_dir = None if cache_dir is None else Path(cache_dir)
         self.computed = 0
         self.cache_hits = 0
-        self._version = fem_code_version() if cache_dir is not None else ""
+        self._cached = Cache(cache_dir).cached(_outcome, ignore=["runner"])
+        self._version = source_hash("fem", "validation/pipeline.py") if cache_dir is not None else ""
 
     def get(self, request: FemRun) -> FemResult:
         if request not in self._store:
@@ -250,33 +252,15 @@ class RunMemo:
             return exc
 
     def _load_or_run(self, request: FemRun) -> FemResult | Exception:
-        path = self._cache_path(request)
-        if path is not None and path.exists():
-            try:
-                with open(path, "rb") as f:
-                    outcome = pickle.load(f)
-                self.cache_hits += 1
-                return outcome
-            except Exception:       # an unreadable cache entry is recomputed
-                pass
-        self.computed += 1
-        try:
-            outcome: FemResult | Exception = self._runner(request)
-        except (ValueError, RuntimeError) as exc:
-            outcome = exc
-        if path is not None:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_suffix(".tmp")
-            with open(tmp, "wb") as f:
-                pickle.dump(outcome, f)
-            tmp.replace(path)
-        return outcome
+        ran: list[FemRun] = []
 
-    def _cache_path(self, request: FemRun) -> Path | None:
-        if self.cache_dir is None:
-            return None
-        fields = asdict(request)
-        if fields["friction"] is None:       # the key of a request from before Coulomb runs
-            del fields["friction"]
-        key = hashlib.sha256(f"{self._version}|{sorted(fields.items())}".encode()).hexdigest()
-        return self.cache_dir / f"fem-{key[:24]}.pkl"
+        def runner(req: FemRun) -> FemResult:
+            ran.append(req)
+            return self._runner(req)
+
+        outcome = self._cached(request, self._version, runner=runner)
+        if ran:
+            self.computed += 1
+        else:
+            self.cache_hits += 1
+        return outcome

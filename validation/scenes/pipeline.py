@@ -7,86 +7,79 @@
 
 `Products` computes each product the first time an output asks for it and keeps it: a scene whose
 outputs need only the u_c table never builds a curve, and a lifetime fed by Appendix A never
-imports `fem`. The expensive products (u_c table, FEM path, frames, lifetimes) go through `joblib.Memory`
-(a kept library: content-addressed by the function's code and arguments, written atomically,
-recomputed when an entry cannot be read); the key includes a hash of the sources of the package
-that computes the product, so a code change invalidates exactly its products. `COMPUTED` counts
-the products actually computed in this process (a second run of the same scene computes none).
+imports `fem`. The expensive products (u_c table, FEM path, frames, lifetimes) go through
+`validation.cache` (joblib.Memory): the key is the function's code, its arguments with every
+input file (design file, u_c table) by the sha256 of its bytes instead of its path, and a hash
+of the sources that compute the product. `COMPUTED` counts the products actually computed in this
+process (a second run of the same scene computes none).
 """
 
 from __future__ import annotations
 
-import hashlib
 import time
 from collections import Counter
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+from validation.cache import Cache, file_digest, source_hash
 from validation.scenes.schema import Scene
 
-__all__ = ["Products", "COMPUTED", "package_version"]
+__all__ = ["Products", "COMPUTED"]
 
 #: products computed (not taken from the cache) in this process, by name
 COMPUTED: Counter = Counter()
-_ROOT = Path(__file__).resolve().parents[2]
 
 
-@lru_cache(maxsize=None)
-def package_version(package: str) -> str:
-    """A hash of a package's sources, or of one source file (part of every cache key of its products)."""
-    h = hashlib.sha256()
-    root = _ROOT / package
-    for path in [root] if root.is_file() else sorted(root.rglob("*.py")):
-        h.update(path.relative_to(_ROOT).as_posix().encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
+def _keyed(table: dict, key: str) -> dict:
+    """A scene table with its input file `key` (a path) replaced by the sha256 of the file's bytes."""
+    return {**table, key: file_digest(table[key])}
+
+
+def _tables_key(tables: dict) -> dict:
+    """The scene's tables as a cache key: every input file by its content, not its path."""
+    return {**tables, "cup": _keyed(tables["cup"], "geometry"), "surface": _keyed(tables["surface"], "uc_table")}
 
 
 # ------------------------------------------------------------------ the cached computations
-def _uc_table(surface: dict, code: str):
+def _uc_table(surface_key: dict, code: str, surface: dict | None = None):
+    """u_c(p/E) of the scene's surface (`surface`, not part of the key: `surface_key` has the
+    table file's content hash)."""
     COMPUTED["uc_table"] += 1
     from reduced.critical_gap import UcTable
     if surface["uc_table"] is not None:
         return UcTable.from_csv(surface["uc_table"])
-    from reduced.roughness import uc_table
-    from reduced.roughness.surfaces import preset
-    return uc_table(preset(surface["preset"]).spectrum(), 0.5)
+    from validation.pipeline import surface_uc_table
+    return surface_uc_table(surface["preset"])
 
 
-def _fem_path(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
-              progress=None):
+def _fem_path(cup_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
+              cup: dict | None = None, progress=None):
     """The FEM path: the scene's cup pressed onto the plane to u_max_m (a `fem.cup.CupResponse`,
-    every converged step). Keyed only by what it depends on (cup, material, contact, fidelity,
-    u_max), so a curve, a render, a footprint and a squeeze ending at the same u share one run."""
+    every converged step). Keyed only by what it depends on (the cup with its design file by
+    content, material, contact, fidelity, u_max), so a curve, a render, a footprint and a
+    squeeze ending at the same u share one run."""
     COMPUTED["fem_path"] += 1
-    from fem.cup import compress_cup
-    from fem.material import NeoHookean
-    from fem.mesh import cup_mesh
-
-    law = contact["law"]
-    return compress_cup(
-        cup_mesh(_geometry(cup), fidelity),
-        NeoHookean(E_Pa=material["E_MPa"] * 1e6, nu=material["nu"],
-                   formulation="mixed" if material["nu"] > 0.495 else "displacement"),
-        contact=law, friction=float(contact["friction"] or 0.0) if law == "coulomb" else 0.0,
-        u_max_m=u_max_m, progress=progress)
+    from validation.pipeline import fem_path, neo_hookean
+    return fem_path(_geometry(cup), neo_hookean(material["E_MPa"] * 1e6, material["nu"]), _contact_law(contact),
+                    fidelity, u_max_m, progress)
 
 
-def _fem_curve(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str, path=None,
-               contact_source: str | None = None):
+def _contact_law(contact: dict):
+    """The scene's [contact] table (checked by the schema) as a `fem.interface.ContactLaw`."""
+    from fem.interface import ContactLaw
+    return ContactLaw(contact["law"], float(contact["friction"] or 0.0) if contact["law"] == "coulomb" else 0.0)
+
+
+def _fem_curve(cup_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
+               cup: dict | None = None, path=None, contact_source: str | None = None):
     """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`, not part of the key);
     its provenance says who chose the contact law (`Scene.contact_source`)."""
     COMPUTED["fem_curve"] += 1
-    from validation import handoff
-
-    response = path()
-    prov = handoff.provenance(response, geometry=_geometry(cup).describe(), mesh={"fidelity": fidelity},
-                              fidelity=fidelity, contact_source=contact_source)
-    return handoff.stiffness_curve(response, prov)
+    from validation.pipeline import fem_curve
+    return fem_curve(path(), _geometry(cup).describe(), fidelity, contact_source)
 
 
-def _fem_frames(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, n_frames: int,
+def _fem_frames(cup_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, n_frames: int,
                 code: str, path=None) -> list:
     """The deformed states (`validation.render.frames.CupFrame`, every field) at n_frames plate
     displacements evenly spaced up to u_max_m (1 frame: u_max_m itself; more: from 0, each the
@@ -103,7 +96,7 @@ def _fem_frames(cup: dict, material: dict, contact: dict, fidelity: str, u_max_m
     return [frame_from_response(response, k) for k in steps]
 
 
-def _lifetimes(tables: dict, curve, uc, code: str, progress=None):
+def _lifetimes(tables_key: dict, curve, uc, code: str, tables: dict | None = None, progress=None):
     COMPUTED["lifetimes"] += 1
     from reduced.lifetime import lifetime_sweep
     model = _model(tables, curve, uc)
@@ -128,22 +121,22 @@ def _model(tables: dict, curve, uc):
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel
     from reduced.viscoelastic import default_relaxation
+    from validation.pipeline import route_model
 
     loads, route = tables["loads"], tables["stiffness"]["route"]
+    laws, seal = route_model(route)
     if curve.design is None:               # Appendix A of a Table 1 preset: no fem imported
         cup = CUPS[tables["cup"]["preset"]]
         if loads["r_start_mm"] is not None:
             cup = replace(cup, r_start_m=1e-3 * loads["r_start_mm"])
     else:
         from validation.design import resolve_cup
-        cup = resolve_cup(curve, r_start_mm=loads["r_start_mm"],
-                          laws="curve" if route == "profile" else "cone").cup
+        cup = resolve_cup(curve, r_start_mm=loads["r_start_mm"], laws=laws).cup
     stiffness = curve.scaled(loads["kappa"]) if loads["kappa"] != 1.0 else curve
     return LeakageModel(cup=cup, stiffness=stiffness, u_c=uc, gas=Gas(T_K=293.15), p_a_Pa=1e5,
                         E_Pa=tables["material"]["E_MPa"] * 1e6,
                         relaxation=default_relaxation() if tables["material"]["relaxation"] == "default" else None,
-                        geometry="curve" if route == "profile" else "cone",
-                        seal="profile" if route == "profile" else "strip", fluid=tables["fluid"]["kind"])
+                        geometry=laws, seal=seal, fluid=tables["fluid"]["kind"])
 
 
 # ------------------------------------------------------------------ the lazy products
@@ -153,13 +146,13 @@ class Products:
     def __init__(self, scene: Scene, cache_dir: str | Path | None = None, progress=None):
         self.scene, self.timings, self._done = scene, {}, {}
         self._progress = progress or (lambda message: None)
-        self._memory = None
-        if cache_dir is not None:
-            from joblib import Memory
-            self._memory = Memory(str(cache_dir), verbose=0)
+        self._cache = Cache(cache_dir)
 
     def _cached(self, func, ignore: list[str] | None = None):
-        return self._memory.cache(func, ignore=ignore) if self._memory is not None else func
+        return self._cache.cached(func, ignore=ignore)
+
+    def _cup_key(self) -> dict:
+        return _keyed(self.scene["cup"], "geometry")
 
     def _fem_progress(self, fraction: float, message: str) -> None:
         self._progress(f"FEM {message.split(': ', 1)[-1].split(',')[0]}")     # FEM u = .. mm of .. mm
@@ -173,16 +166,17 @@ class Products:
         return self._done[name]
 
     def uc_table(self):
-        return self._get("uc_table", lambda: self._cached(_uc_table)(self.scene["surface"],
-                                                                      package_version("reduced")))
+        surface = self.scene["surface"]
+        return self._get("uc_table", lambda: self._cached(_uc_table, ignore=["surface"])(
+            _keyed(surface, "uc_table"), source_hash("reduced"), surface=surface))
 
     def curve(self):
         if self.scene["stiffness"]["source"] == "appendix-a":
             return self._get("curve", self._appendix_a)
         s, u_max_m = self.scene, self._u_max_m(None)
-        return self._get("curve", lambda: self._cached(_fem_curve, ignore=["path"])(
-            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m,
-            package_version("fem") + package_version("validation"), path=lambda: self.fem_path(None),
+        return self._get("curve", lambda: self._cached(_fem_curve, ignore=["cup", "path"])(
+            self._cup_key(), s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m,
+            source_hash("fem", "validation"), cup=s["cup"], path=lambda: self.fem_path(None),
             contact_source=s.contact_source))
 
     def _appendix_a(self):
@@ -203,9 +197,9 @@ class Products:
     def fem_path(self, u_mm: float | None):
         """The FEM path to u_mm (None: 0.9 h1), computed once per end point and scene (`_fem_path`)."""
         s, u_max_m = self.scene, self._u_max_m(u_mm)
-        return self._get(f"fem_path_{1e3 * u_max_m:.6g}mm", lambda: self._cached(_fem_path, ignore=["progress"])(
-            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m, package_version("fem"),
-            progress=self._fem_progress))
+        return self._get(f"fem_path_{1e3 * u_max_m:.6g}mm", lambda: self._cached(_fem_path, ignore=["cup", "progress"])(
+            self._cup_key(), s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m,
+            source_hash("fem", "validation/pipeline.py"), cup=s["cup"], progress=self._fem_progress))
 
     def fem_frames(self, u_mm: float, n_frames: int = 1) -> list:
         """The deformed states at n_frames plate displacements up to u_mm (`_fem_frames`), drawn from
@@ -213,13 +207,13 @@ class Products:
         s, u_max_m = self.scene, self._u_max_m(u_mm)
         name = f"fem_state_{u_mm:g}mm" + (f"_{n_frames}frames" if n_frames > 1 else "")
         return self._get(name, lambda: self._cached(_fem_frames, ignore=["path"])(
-            s["cup"], s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m, n_frames,
-            package_version("fem") + package_version("validation"), path=lambda: self.fem_path(u_mm)))
+            self._cup_key(), s["material"], s["contact"], s["stiffness"]["fidelity"], u_max_m, n_frames,
+            source_hash("fem", "validation"), path=lambda: self.fem_path(u_mm)))
 
     def lifetimes(self):
-        return self._get("lifetimes", lambda: self._cached(_lifetimes, ignore=["progress"])(
-            self.scene.tables, self.curve(), self.uc_table(),
-            package_version("reduced") + package_version("validation"), progress=self._progress))
+        return self._get("lifetimes", lambda: self._cached(_lifetimes, ignore=["tables", "progress"])(
+            _tables_key(self.scene.tables), self.curve(), self.uc_table(), source_hash("reduced", "validation"),
+            tables=self.scene.tables, progress=self._progress))
 
     def appendix_a(self) -> "Products | None":
         """For a FEM scene of a Table 1 preset: the same scene fed by Appendix A's F0 through the
@@ -243,7 +237,7 @@ class Products:
         return self._get("variants", compute)
 
     def _share(self, parent: "Products") -> "Products":
-        self._memory = parent._memory
+        self._cache = parent._cache
         return self
 
     def computed(self) -> dict[str, Any]:

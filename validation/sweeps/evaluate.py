@@ -18,7 +18,6 @@ cause, so one bad design never stops a sweep. Quantities (units in the names):
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 from typing import Any
@@ -81,21 +80,11 @@ def evaluate_design(design: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def _stiffness(geometry, design: dict[str, Any]):
-    from fem.cup import compress_cup
-    from fem.material import NeoHookean
-    from fem.mesh import cup_mesh
-    from validation import handoff
+    from fem.interface import ContactLaw
+    from validation.pipeline import fem_stiffness, neo_hookean
 
-    mesh = cup_mesh(geometry, design["fidelity"])
-    nu = design["nu"]
-    material = NeoHookean(E_Pa=design["E_MPa"] * 1e6, nu=nu,
-                          formulation="mixed" if nu > 0.495 else "displacement")
-    friction = design.get("friction", 0.0) if design["contact"] == "coulomb" else 0.0
-    response = compress_cup(mesh, material, contact=design["contact"], friction=friction,
-                            u_max_m=0.9 * geometry.h1_m)
-    prov = handoff.provenance(response, geometry=geometry.describe(), mesh={"fidelity": design["fidelity"]},
-                              fidelity=design["fidelity"])
-    return response, handoff.stiffness_curve(response, prov)
+    contact = ContactLaw(design["contact"], design.get("friction", 0.0) if design["contact"] == "coulomb" else 0.0)
+    return fem_stiffness(geometry, neo_hookean(design["E_MPa"] * 1e6, design["nu"]), contact, design["fidelity"])
 
 
 def _fem_quantities(response, curve, geometry, design) -> dict[str, Any]:
@@ -116,6 +105,7 @@ def _fem_quantities(response, curve, geometry, design) -> dict[str, Any]:
 def _lifetimes(curve, design, common) -> list[dict[str, Any]]:
     from reduced.lifetime import LeakageModel, largest_holdable_force, lifetime
     from validation.design import resolve_cup
+    from validation.pipeline import surface_uc_table
 
     from reduced.cup import CUPS
 
@@ -123,7 +113,7 @@ def _lifetimes(curve, design, common) -> list[dict[str, Any]]:
     l0 = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
     l1 = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
     choice = resolve_cup(curve, r_start_mm=design.get("r_start_mm"), l0_mm=l0, l1_mm=l1)
-    model = LeakageModel(cup=choice.cup, stiffness=curve, u_c=_uc_table(design["surface"]),
+    model = LeakageModel(cup=choice.cup, stiffness=curve, u_c=surface_uc_table(design["surface"]),
                          E_Pa=design["E_MPa"] * 1e6, geometry="cone")
     h_start = choice.cup.h_start_m
     common = {**common, "r_start_mm": choice.cup.r_start_m / _MM, "l0_mm": l0, "l1_mm": l1,
@@ -136,11 +126,3 @@ def _lifetimes(curve, design, common) -> list[dict[str, Any]]:
         rows.append({**common, "F1_N": F, "lifetime_s": r.lifetime_s if math.isfinite(r.lifetime_s) else None,
                      "reason": r.reason, "failure": None})
     return rows
-
-
-@functools.lru_cache(maxsize=8)
-def _uc_table(surface: str):
-    """u_c(p/E) of a calibrated surface (Persson theory, EMT, nu = 0.5), once per worker."""
-    from reduced.roughness import uc_table
-    from reduced.roughness.surfaces import preset
-    return uc_table(preset(surface).spectrum(), 0.5)

@@ -1,0 +1,99 @@
+"""`cupcheck lifetime --route coupled`: the options read into `validation.coupled.route.CoupledOptions`,
+the lifetimes from the FEM suction table, printed and written as for the other routes."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+from validation.commands._reduced_options import build_uc, check_run_options, relaxation_law
+
+#: lifetime options that the coupled route replaces or does not model: (option, value, default)
+_NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--fluid", "fluid", "air"),
+             ("--cavitation-kPa", "cavitation_kPa", None), ("--cup-laws", "cup_laws", None),
+             ("--d0-mm", "d0_mm", 2.0), ("--l0-mm", "l0_mm", None), ("--l1-mm", "l1_mm", None))
+
+
+def coupled_options(args: argparse.Namespace):
+    """The typed options of the command line (every check; ValueError naming the option)."""
+    from validation.coupled.route import CoupledOptions
+
+    if args.reference_mode:
+        raise ValueError("--reference-mode: the reference conventions are the paper route's; "
+                         "drop it with --route coupled")
+    given = [opt for opt, name, default in _NOT_HERE if getattr(args, name) != default]
+    if given:
+        raise ValueError(f"--route: coupled takes F1, V, r and the contact profile from the suction "
+                         f"table and does not model water; drop {', '.join(given)}")
+    if args.suction_table is None:
+        raise ValueError("--suction-table: --route coupled needs the FEM table of `cupcheck suction` (.json)")
+    if not Path(args.suction_table).is_file():
+        raise ValueError(f"--suction-table: no such file '{args.suction_table}'")
+    check_run_options(args)
+    relaxation = _relaxation(args)
+    return CoupledOptions(suction_table=Path(args.suction_table), cup=args.cup,
+                          geometry_file=args.geometry, r_start_mm=args.r_start_mm, interface=args.interface,
+                          kappa=args.kappa, T_K=args.T_K, p_a_Pa=args.p_a_Pa, relaxation=relaxation,
+                          phi0_s=args.phi0_s)
+
+
+def _relaxation(args: argparse.Namespace):
+    """The `RelaxationModulus` of --relaxation (none, default or a CSV), as the paper route reads
+    it; --phi0-s checked here so that its error names the option."""
+    if args.relaxation == "none":
+        if args.phi0_s is not None:
+            raise ValueError("--phi0-s: the measurement contact time applies with --relaxation only")
+        return None
+    if args.phi0_s is not None and not (math.isfinite(args.phi0_s) and args.phi0_s > 0):
+        raise ValueError(f"--phi0-s: measurement contact time must be finite and > 0 s, got {args.phi0_s:g}")
+    return relaxation_law(args.relaxation)
+
+
+def run_coupled(args: argparse.Namespace) -> int:
+    """The coupled route of `cupcheck lifetime` (its table, --json and --out as for the others)."""
+    from validation.coupled.route import coupled_model
+    from validation.output import atomic_directory, write_table
+
+    options = coupled_options(args)
+    model, u_start, choice, cup = coupled_model(options, build_uc(args))
+    for note in choice.notes:
+        print(f"note: {note}", file=sys.stderr)
+    if args.out:
+        with atomic_directory(args.out) as tmp:
+            results = [_lifetime(model, F, u_start, args) for F in args.force_N]
+            for r in results:
+                write_table(tmp / f"trajectory_F1_{r.force_N:g}N.csv",
+                            {"cup": cup["name"], **r.trajectory_columns()},
+                            stage=f"lifetime at F1 = {r.force_N:g} N")
+            (tmp / "summary.json").write_text(json.dumps([{**r.summary(), "cup": cup} for r in results],
+                                                         indent=2, allow_nan=False) + "\n")
+    else:
+        results = [_lifetime(model, F, u_start, args) for F in args.force_N]
+    if args.json:
+        print(json.dumps([{**r.summary(), "cup": cup} for r in results], indent=2))
+        return 0
+    print(f"cup: {choice.label}; released at u = {1e3 * u_start:.4g} mm (r_start "
+          f"{cup['r_start_mm']:.4g} mm by eq 3); route coupled: F1, V and the contact profile from "
+          f"{args.suction_table}, interface gas {args.interface}{_relaxation_note(cup)}; largest "
+          f"holdable force {model.largest_holdable_force(u_start):.4g} N")
+    print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'u_end_mm':>8} {'p_b_end_kPa':>11}")
+    for r in results:
+        life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"
+        u_end = f"{1e3 * r.u_m[-1]:8.3f}" if r.u_m.size else f"{'-':>8}"
+        pb = f"{r.p_b_Pa[-1] / 1e3:11.4g}" if r.dp_Pa.size else f"{'-':>11}"
+        print(f"{r.force_N:8.4g} {life:>12} {r.reason:>11} {u_end} {pb}")
+    return 0
+
+
+def _lifetime(model, F1: float, u_start: float, args: argparse.Namespace):
+    return model.lifetime(F1, u_start, t_max_s=args.t_max_s, rtol=args.rtol)
+
+
+def _relaxation_note(cup: dict[str, Any]) -> str:
+    if "relaxation" not in cup:
+        return ""
+    return f", relaxation {cup['relaxation']} (phi0 = {cup['phi0_s']:.4g} s)"

@@ -1,0 +1,51 @@
+"""The reduced model's options shared by the routes of `cupcheck lifetime`: the critical gap
+u_c(p/E) the surface options ask for, the run options every route checks, and --relaxation."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+
+from validation.commands._surface import has_surface, spectrum_from_args
+
+__all__ = ["build_uc", "check_run_options", "relaxation_law"]
+
+
+def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
+    """The critical gap u_c(p/E) [m] the options ask for (the one place that builds it)."""
+    from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
+    from validation.guards import check_spectrum, check_uc_table
+    if has_surface(args):
+        from reduced.roughness import uc_table
+        from reduced.roughness.persson import check_gap_parameters, effective_modulus
+        import numpy as np
+        effective_modulus(1e6, args.nu)                                   # validates nu
+        check_gap_parameters(np.array([1.0]), args.uc_method, args.gamma, args.a_c)
+        spectrum = spectrum_from_args(args)
+        check_spectrum(spectrum.h_rms_m(), "surface")
+        return uc_table(spectrum, args.nu, method=args.uc_method, gamma=args.gamma, a_c=args.a_c)
+    table = UcTable.from_csv(args.uc_table if args.uc_table else ILLUSTRATIVE_UC_CSV)
+    check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
+    return table
+
+
+def check_run_options(args: argparse.Namespace) -> None:
+    """The options every route checks before its model: the forces, the integration's t_max and
+    rtol, and kappa (ValueError naming the option)."""
+    for F in args.force_N:
+        if not (math.isfinite(F) and F > 0):
+            raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
+    if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
+        raise ValueError("--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
+    if not (math.isfinite(args.kappa) and args.kappa > 0):
+        raise ValueError(f"--kappa: stiffness factor must be > 0, got {args.kappa:g}")
+
+
+def relaxation_law(value: str):
+    """The `RelaxationModulus` of --relaxation: None (none), the default power law, or a CSV."""
+    from reduced.viscoelastic import RelaxationModulus, default_relaxation
+
+    if value == "none":
+        return None
+    return default_relaxation() if value == "default" else RelaxationModulus.from_csv(value)

@@ -1,0 +1,142 @@
+"""The FEM pipeline, written once: design -> mesh -> material -> contact law -> compress_cup ->
+the hand-off curve with its provenance.
+
+Every command, scene, sweep and report section that needs an FEM path or a stiffness curve calls
+`fem_path` (the `fem.cup.CupResponse`) and `fem_curve` (the `StiffnessCurve` of a response), or
+`fem_stiffness` (both). The rules that used to be spelled at each call site live here, once:
+
+* the formulation by nu (`neo_hookean`): not given, nu above `LOCKING_NU` takes the mixed u-p
+  formulation (the displacement elements lock there); the displacement formulation given with
+  nu above it is refused;
+* the route -> (geometry, seal) of `reduced.lifetime.LeakageModel` (`route_model`);
+* the default surface and its u_c table (`DEFAULT_SURFACE`, `surface_uc_table`: Persson theory,
+  EMT, nu = 0.5);
+* the contact law: a `fem.interface.ContactLaw` (or a `ContactChoice`, which also says who chose
+  it) travels unchanged from the caller to `compress_cup`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import asdict
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:                          # importing this module imports no fem
+    from fem.cup import CupResponse
+    from fem.geometry import CupGeometry
+    from fem.interface import ContactChoice, ContactLaw
+    from fem.material import NeoHookean
+    from reduced.critical_gap import UcTable
+    from reduced.stiffness_curve import StiffnessCurve
+
+__all__ = ["LOCKING_NU", "DEFAULT_SURFACE", "ROUTES", "neo_hookean", "route_model", "surface_uc_table",
+           "mesh_record", "fem_path", "fem_curve", "fem_stiffness"]
+
+#: above this Poisson's ratio the displacement (Q2) formulation locks (F0 stiffens)
+LOCKING_NU = 0.495
+#: the calibrated surface used where none is named: sandblasted PMMA, 1.89 um rms (the paper's Figs.)
+DEFAULT_SURFACE = "pmma-1.89"
+#: route -> (geometry, seal) of `reduced.lifetime.LeakageModel`; "coupled" runs `reduced.coupled`
+ROUTES: dict[str, tuple[str, str]] = {"paper": ("cone", "strip"), "profile": ("curve", "profile"),
+                                      "coupled": ("curve", "coupled")}
+
+Progress = Callable[[float, str], None]
+
+
+def neo_hookean(E_Pa: float, nu: float, formulation: str | None = None) -> NeoHookean:
+    """The wall's compressible neo-Hookean material; `formulation` None: mixed above LOCKING_NU,
+    else displacement. ValueError (field ``nu``) for the displacement formulation above LOCKING_NU."""
+    from fem.material import NeoHookean
+
+    if formulation is None:
+        formulation = "mixed" if nu > LOCKING_NU else "displacement"
+    elif formulation == "displacement" and nu > LOCKING_NU:
+        raise ValueError(f"nu: with the displacement formulation Poisson's ratio must be <= "
+                         f"{LOCKING_NU} (above, its elements lock and stiffen F0); use "
+                         f"--formulation mixed for nu up to 0.4999, got {nu:g}")
+    return NeoHookean(E_Pa=E_Pa, nu=nu, formulation=formulation)
+
+
+def route_model(route: str, cup_laws: str | None = None) -> tuple[str, str]:
+    """(geometry, seal) of a route: paper -> the cone laws (or the curve's with cup_laws "curve")
+    and eq (6)'s strip; profile -> the curve's laws and its profiles; coupled -> the suction
+    table's (cup_laws refused). ValueError names --cup-laws."""
+    geometry, seal = ROUTES[route]
+    if seal == "coupled":
+        if cup_laws is not None:
+            raise ValueError("--cup-laws: the coupled route takes r and V from the FEM suction table; "
+                             "drop --cup-laws")
+        return geometry, seal
+    if cup_laws is None:
+        return geometry, seal
+    if seal == "profile" and cup_laws != "curve":
+        raise ValueError("--cup-laws: the profile route takes r and V from the FEM curve whose "
+                         "profiles it crosses; drop --cup-laws cone")
+    return cup_laws, seal
+
+
+@lru_cache(maxsize=8)
+def surface_uc_table(name: str | None = None) -> UcTable:
+    """u_c(p/E) of a calibrated surface preset (default `DEFAULT_SURFACE`): Persson theory, EMT,
+    nu = 0.5 (the paper's route); once per process and name."""
+    from reduced.roughness import uc_table
+    from reduced.roughness.surfaces import preset
+
+    return uc_table(preset(name or DEFAULT_SURFACE).spectrum(), 0.5)
+
+
+def mesh_record(mesh: Any, fidelity: str | None, file: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """The provenance of a mesh: a generated level's parameters (or the file it was read from) and
+    its size."""
+    from fem.mesh import FIDELITIES
+
+    record: dict[str, Any] = dict(file) if file is not None else {"generated": asdict(FIDELITIES[fidelity])}
+    record.update(element=type(mesh).__name__, elements=int(mesh.t.shape[1]), nodes=int(mesh.doflocs.shape[1]))
+    return record
+
+
+def fem_path(geometry: CupGeometry | str | None, material: NeoHookean, contact: ContactLaw | ContactChoice,
+             fidelity: str | None, u_max_m: float | None = None, progress: Progress | None = None, *,
+             mesh: Any = None, element: str = "quad", **solver_opts: Any) -> CupResponse:
+    """The cup (a `CupGeometry`, a preset name, or None with a given `mesh`) meshed at `fidelity`
+    and pressed onto the plane to u_max_m (default 0.9 h1) under `contact`."""
+    from fem.cup import compress_cup
+    from fem.geometry import cup_geometry
+    from fem.mesh import cup_mesh
+
+    law = getattr(contact, "contact", contact)
+    if mesh is None:
+        if isinstance(geometry, str):
+            geometry = cup_geometry(geometry)
+        mesh = cup_mesh(geometry, fidelity, element=element)
+    if u_max_m is None and geometry is not None and not isinstance(geometry, str):
+        u_max_m = 0.9 * geometry.h1_m
+    return compress_cup(mesh, material, contact=law.law, friction=law.friction, u_max_m=u_max_m,
+                        progress=progress, **solver_opts)
+
+
+def fem_curve(response: CupResponse, geometry: Mapping[str, Any], fidelity: str | None,
+              contact_source: str | None = None, mesh: Mapping[str, Any] | None = None) -> StiffnessCurve:
+    """The hand-off `StiffnessCurve` of an FEM path, with its provenance (`validation.handoff`):
+    the design's description, the mesh (`mesh_record` of the path's mesh unless given) and who
+    chose the contact law."""
+    from validation import handoff
+
+    record = dict(mesh) if mesh is not None else mesh_record(response.mesh, fidelity)
+    prov = handoff.provenance(response, geometry=geometry, mesh=record, fidelity=fidelity,
+                              contact_source=contact_source)
+    return handoff.stiffness_curve(response, prov)
+
+
+def fem_stiffness(geometry: CupGeometry | str, material: NeoHookean, contact: ContactLaw | ContactChoice,
+                  fidelity: str, u_max_m: float | None = None,
+                  progress: Progress | None = None) -> tuple[CupResponse, StiffnessCurve]:
+    """(CupResponse, StiffnessCurve) of a generated cup: `fem_path`, then `fem_curve`; the contact
+    source is recorded when `contact` is a `ContactChoice`."""
+    from fem.geometry import cup_geometry
+
+    if isinstance(geometry, str):
+        geometry = cup_geometry(geometry)
+    response = fem_path(geometry, material, contact, fidelity, u_max_m, progress)
+    return response, fem_curve(response, geometry.describe(), fidelity, getattr(contact, "source", None))
