@@ -80,6 +80,10 @@ class StripSeal:
         """Whether `flow` reports u_c <= 0 (a line contact, or eq 6's pressure at or above sealing)."""
         return l <= 0.0 or self.uc((kappa * F / (2.0 * math.pi * r * l) + self.beta * (self.pa - pb)) / E) <= 0.0
 
+    def cannot_seal(self, kappa: float, E: float) -> bool:
+        """Never known in advance: eq (6)'s pressure is unbounded as l -> 0."""
+        return False
+
 
 class ProfileSeal:
     """The contact-pressure profile of the curve's samples (module docstring)."""
@@ -92,6 +96,7 @@ class ProfileSeal:
                              f"'{curve.provenance.get('source', '?')}' has none (an FEM curve's sidecar "
                              f"carries them)")
         self.u, self.profiles, self.F0 = curve.u_m, curve.profiles, curve.F0_N
+        self._u_list = [float(x) for x in curve.u_m]
         self.uc, self.gas, self.pa, self.beta, self.mu = u_c, gas, p_a, beta, liquid_viscosity
         L = getattr(u_c, "patch_length_m", None) if patch_length_m is None else patch_length_m
         if L is not None and not (math.isfinite(L) and L >= 0.0):
@@ -111,8 +116,9 @@ class ProfileSeal:
 
     def _ends(self, u: float) -> tuple[list[int], list[float]]:
         """The samples around u that have a profile, and their weights (linear in u)."""
-        k = int(np.clip(np.searchsorted(self.u, u, side="right") - 1, 0, self.u.size - 2))
-        w = min(max((u - self.u[k]) / (self.u[k + 1] - self.u[k]), 0.0), 1.0)
+        us = self._u_list
+        k = min(max(bisect_right(us, u) - 1, 0), len(us) - 2)
+        w = min(max((u - us[k]) / (us[k + 1] - us[k]), 0.0), 1.0)
         ends = [j for j in (k, k + 1) if self.profiles[j] is not None]
         if not ends:
             raise ValueError(f"seal: no contact-pressure profile at u = {1e3 * u:.4g} mm (neither "
@@ -156,6 +162,17 @@ class ProfileSeal:
         no_drive = pb >= self.pa if self.mu is None else pb == self.pa
         stopped = all(a == 0.0 or c or no_drive for a, c in zip(weights, closed))
         return stopped and any(closed)
+
+    def cannot_seal(self, kappa: float, E: float) -> bool:
+        """True if no state with 0 <= p_b can seal any sample (a UcTable's sealing p/E above every
+        ring's pressure under the full suction share beta p_a); rounding is monotone, so the bound
+        holds exactly."""
+        seal = getattr(self.uc, "sealing_p_over_E", None)
+        if seal is None or not hasattr(self.uc, "values"):
+            return False
+        top = max(self._peak(k)[2] if self.patch_length_m is None else max(self._peak(k)[:2])
+                  for k, p in enumerate(self.profiles) if p is not None)
+        return (kappa * top + self.beta * self.pa) / E < seal
 
     def _closed(self, k: int, pb: float, kappa: float, E: float) -> bool:
         """min over sample k's rings of the gap <= 0."""
@@ -273,10 +290,12 @@ class PbTable:
     The ring gaps follow p_b through eq (6)'s beta (p_a - p_b) and u_c's log-log table, so the flow
     is smooth in tau (the rings loaded by the suction alone have power-law gaps as p_b -> p_a),
     C1 at u_c's rows. The grid is fine where the cup lives (p_b up to 99.3 % of p_a: tau >= -5) and
-    coarser down to tau = -21 (p_a - p_b = 1e-4 Pa); outside it the flow is solved directly.
+    coarser down to tau = -14 (p_a - p_b = 0.08 Pa, where the direct solution's round-off reaches
+    1e-4 of the flow); it stops at p_b = 0.1 % of p_a (at p_b = 0 the flow chokes, P_in(Q) has an
+    infinite slope and the root search bisects). Outside the grid the flow is solved directly.
     """
 
-    TAU = np.unique(np.concatenate([np.arange(-21.0, -5.0, 0.1), np.linspace(-5.0, 0.0, 251)]))
+    TAU = np.unique(np.concatenate([np.arange(-14.0, -5.0, 0.1), np.linspace(-5.0, math.log(0.999), 251)]))
 
     def __init__(self, tau: np.ndarray, log_ratio: np.ndarray, p_a: float):
         spline = CubicSpline(tau, log_ratio)

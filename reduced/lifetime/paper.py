@@ -304,6 +304,8 @@ def sealed_on_branch(core: ForceBalance, h0: float, h_end: float, F1: float) -> 
     line = core.geo.line_contact and core.seal_name == "strip"
     if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf and not line:
         return None        # a table without sealed rows never seals, unless the strip is a line
+    if not core.liquid and core.seal.cannot_seal(1.0, core.m.E_Pa):
+        return None        # no ring's pressure reaches sealing even at p_b = 0
     h, _ = core.grid
     for x in [h0] + [float(x) for x in h[(h > h0) & (h < h_end)]] + [h_end]:
         if core.sealed(x, core.n_eq(x, 1.0, F1)[0], 1.0, core.m.E_Pa, F1):
