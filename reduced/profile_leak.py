@@ -294,7 +294,8 @@ def _march(p_a: float, u3: np.ndarray, b: np.ndarray, c: np.ndarray, q: float) -
 def _series_flows(p_a: float, p_b: np.ndarray, u3: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """`_series_flow` for the columns of u3, b (rings x states) with the rings' c, each column
     solved to the same tolerances by the same safeguarded Newton; a column's search stops when it
-    has converged."""
+    has converged, and the last few (a march costs the same for one column as for hundreds) are
+    finished one by one on Python floats."""
     k = c[:, None] / u3
     with np.errstate(over="ignore", invalid="ignore"):
         q_hi = np.min(u3 * ((p_a + b) ** 2 - (p_b + b) ** 2) / (2.0 * c[:, None]), axis=0)
@@ -305,6 +306,10 @@ def _series_flows(p_a: float, p_b: np.ndarray, u3: np.ndarray, b: np.ndarray, c:
     out = np.full(q.size, math.nan)
     todo = np.arange(q.size)
     for _ in range(100):
+        if todo.size <= 8:
+            for j in todo:
+                out[j] = _series_flow(p_a, float(p_b[j]), u3[:, j], b[:, j], c)
+            return out
         p_in, dp_dq = _march_columns(p_a, k[:, todo], b[:, todo], q)
         f = p_in - p_b[todo]
         done = np.abs(f) <= noise[todo]

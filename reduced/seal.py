@@ -106,7 +106,12 @@ class ProfileSeal:
         # the flow tables need a vectorised u_c (a UcTable) and one (kappa, E) for every evaluation
         self.tabulate_at = tabulate_at if hasattr(u_c, "values") else None
         self._tables: dict[int, PbTable | None] = {}
-        self._peaks: dict[int, tuple[float, float, float, bool]] = {}
+        self._peaks: dict[int, tuple[float, float, float, bool, float]] = {}
+        if self.tabulate_at is not None:      # u_c falls with p everywhere (a PCHIP keeps the rows' order)
+            rows = np.asarray(u_c.u_c_m)[np.argsort(u_c.p_over_E)]
+            self._monotone = bool(np.all(np.diff(rows[rows > 0]) < 0)) and hasattr(u_c, "scalar")
+        else:
+            self._monotone = False
 
     def width(self, l: float) -> float:
         """The width of the strip a point of the cup crosses (eq 10's l): the FEM's strip, at least
@@ -134,12 +139,21 @@ class ProfileSeal:
 
     def flow(self, F: float, r: float, l: float, pb: float, kappa: float, E: float, u: float):
         ends, weights = self._ends(u)
-        states = [self._rings(j, pb, kappa, E) for j in ends]
-        q = [self._tabulated(j, pb, kappa, E) for j in ends]
-        q = [self._direct(prof, gaps, pb) if x is None else x for x, (prof, gaps, _) in zip(q, states)]
+        q, peak, gap = [], [], []
+        for j in ends:
+            x = self._tabulated(j, pb, kappa, E)
+            top = self._top_x(j, pb, kappa, E) if x is not None and self._monotone else None
+            if top is None:
+                prof, gaps, p = self._rings(j, pb, kappa, E)
+                q.append(self._direct(prof, gaps, pb) if x is None else x)
+                peak.append(p)
+                gap.append(float(np.min(gaps)))
+            else:        # u_c falls with p: the narrowest gap is at the highest ring pressure
+                q.append(x)
+                peak.append(kappa * self._peak(j)[4] + self.beta * (self.pa - pb))
+                gap.append(self.uc.scalar(top))
         Ndot = self._combine(weights, q)
-        gap = [float(np.min(gaps)) for _, gaps, _ in states]
-        p = sum(a * e[2] for a, e in zip(weights, states))
+        p = sum(a * x for a, x in zip(weights, peak))
         uc = min(gap) if Ndot == 0 else sum(a * g for a, g in zip(weights, gap))
         share = 0.0 if self.mu is not None or uc <= 0 else ballistic_share(self.gas, self.pa, pb, uc)
         return Ndot, p, uc, share
@@ -177,25 +191,31 @@ class ProfileSeal:
     def _closed(self, k: int, pb: float, kappa: float, E: float) -> bool:
         """min over sample k's rings of the gap <= 0."""
         seal = getattr(self.uc, "sealing_p_over_E", None)
-        extra = self.beta * (self.pa - pb)
-        if seal is not None and hasattr(self.uc, "values") and extra >= 0.0:
-            if seal == math.inf:
-                return False
-            top_contact, top_free, top_touching, any_contact = self._peak(k)
-            if self.patch_length_m is None:
-                x = (kappa * top_touching + extra) / E if top_touching > 0 else -math.inf
-            elif extra > 0.0:       # rounding is monotone: the largest pressure is at the largest mid
-                x = max((kappa * top_contact + extra) / E if any_contact else -math.inf,
-                        (kappa * top_free) / E if top_free > 0 else -math.inf)
-            else:
-                x = (kappa * top_touching) / E if top_touching > 0 else -math.inf
-            if x > -math.inf:
+        if seal is not None and hasattr(self.uc, "values"):
+            x = self._top_x(k, pb, kappa, E)
+            if x is not None:
                 return x >= seal
         return float(np.min(self._rings(k, pb, kappa, E)[1])) <= 0.0
 
-    def _peak(self, k: int) -> tuple[float, float, float, bool]:
+    def _top_x(self, k: int, pb: float, kappa: float, E: float) -> float | None:
+        """The largest p/E of sample k's touching rings, as `ring_gaps` forms it (rounding is
+        monotone: it is at the largest ring-middle pressure); None for p_b > p_a or no touching ring."""
+        extra = self.beta * (self.pa - pb)
+        if extra < 0.0:
+            return None
+        top_contact, top_free, top_touching, any_contact, _ = self._peak(k)
+        if self.patch_length_m is None:
+            x = (kappa * top_touching + extra) / E if top_touching > 0 else -math.inf
+        elif extra > 0.0:
+            x = max((kappa * top_contact + extra) / E if any_contact else -math.inf,
+                    (kappa * top_free) / E if top_free > 0 else -math.inf)
+        else:
+            x = (kappa * top_touching) / E if top_touching > 0 else -math.inf
+        return x if x > -math.inf else None
+
+    def _peak(self, k: int) -> tuple[float, float, float, bool, float]:
         """Sample k's largest ring-middle pressure on the nominal contact, off it (touching) and on
-        all touching rings, and whether any ring is in the nominal contact."""
+        all touching rings, whether any ring is in the nominal contact, and the profile's peak."""
         if k not in self._peaks:
             prof, contact = self.averaged(k) if self.patch_length_m is not None else (self.profiles[k], None)
             p = prof.p_Pa
@@ -204,7 +224,7 @@ class ProfileSeal:
             contact = np.zeros(mid.size, dtype=bool) if contact is None else contact
             top = lambda m: float(m.max()) if m.size else 0.0       # noqa: E731
             self._peaks[k] = (top(mid[contact]), top(mid[touching & ~contact]), top(mid[touching]),
-                              bool(contact.any()))
+                              bool(contact.any()), float(p.max()))
         return self._peaks[k]
 
     def _rings(self, k: int, pb: float, kappa: float, E: float) -> tuple[ContactProfile, np.ndarray, float]:

@@ -108,6 +108,19 @@ def test_the_flow_table_follows_the_direct_flow(pmma, fluid):
     assert worst < 2e-6
 
 
+def test_the_tabulated_flows_outputs_are_the_direct_ones(pmma):
+    """Where the table gives Ndot, the peak pressure is the same and u_c (the narrowest gap, at the
+    highest ring pressure since u_c falls with p) the same to round-off; the share follows u_c."""
+    model = _model(pmma)
+    fast, direct = force_balance(model).seal, force_balance(model, exact=True).seal
+    for u in (0.7e-3, 2.5e-3, 4.1e-3, 6e-3):
+        for pb in (3e3, 5e4, 9.5e4):
+            a, b = fast.flow(0.0, 0.0, 0.0, pb, 1.0, E, u), direct.flow(0.0, 0.0, 0.0, pb, 1.0, E, u)
+            assert a[0] == pytest.approx(b[0], rel=2e-6) and a[1] == b[1]
+            assert a[2] == pytest.approx(b[2], rel=1e-12) and a[3] == pytest.approx(b[3], rel=1e-12)
+            assert fast.rate(0.0, 0.0, 0.0, pb, 1.0, E, u) == a[0]
+
+
 def test_the_rate_is_the_flows_first_entry_on_the_direct_path(pmma):
     seal = force_balance(_model(pmma), exact=True).seal
     assert seal.tabulate_at is None
