@@ -22,6 +22,9 @@ Rings in series: P is marched from p_a at r_n inwards, P_i = -a/u + ((P_i+1 + a/
 and Q is the root of P_0(Q) = p_b (monotone; Newton with bracketing). A ring with u = 0 (the
 contact area percolates: sealed) stops the flow; a ring with no contact (p = 0) costs nothing.
 
+`profile_leak_rates` solves many states of the same rings at once (the march vectorised over the
+states), for tabulating a profile's flow against p_b (`reduced.seal.PbTable`).
+
 Water (eq 24 locally): j_V = -(u^3 / (12 eta)) dP/dr, so p_a - p_b = Q_V sum_i 12 eta g_i / (2 pi u_i^3).
 
 Patch-averaged pressure (`patch_average`, `patch_contact`; the profile route uses it when the u_c

@@ -29,6 +29,12 @@ stiffness factor kappa, modulus E for p/E); Ndot is molecules/s for air and m^3/
   profile supplies the shape and F0 the load, as eq (6) takes F0 and the width l. Without a patch
   length (a table from a CSV without the line, a callable) the raw profile is used as before;
   `patch_length_m` overrides the table's (0: off).
+
+  Flow tables (`tabulate_at=(kappa, E)`, set by the force balance without relaxation): at one
+  (kappa, E) a sample's flow depends on p_b alone, so it is tabulated once per sample (`PbTable`)
+  and the ODE's right-hand side (`rate`) reads it; states off the table's grid, another (kappa, E)
+  or a u_c without a vectorised form are solved directly, as every state is without the tables.
+  `sealed` answers whether `flow` would report u_c <= 0 without solving the flow.
 """
 
 from __future__ import annotations
