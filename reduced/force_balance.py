@@ -44,7 +44,7 @@ _GRID = 1200          # h samples for locating folds (refined by brentq)
 class ForceBalance:
     """Scalar evaluation of eqs (3)-(10), (23) for one model, plus the h grid for folds."""
 
-    def __init__(self, m: LeakageModel, geometry: str = "cone", seal: str = "strip"):
+    def __init__(self, m: LeakageModel, geometry: str = "cone", seal: str = "strip", exact: bool = False):
         if m.stiffness is None:
             raise ValueError("stiffness: the force balance of eqs (3)-(8) needs a stiffness curve F0(u)")
         if m.u_c is None:
@@ -61,10 +61,13 @@ class ForceBalance:
         self.pa = m.p_a_Pa
         self.beta = m.cup.beta
         self.uc = getattr(m.u_c, "scalar", m.u_c)
-        seal_law = ProfileSeal if seal == "profile" else StripSeal
-        self.seal = seal_law(curve, m.u_c, m.gas, m.p_a_Pa, m.cup.beta,
-                         m.liquid_viscosity_Pa_s if self.liquid else None)
         self.relax = m.relaxation
+        mu = m.liquid_viscosity_Pa_s if self.liquid else None
+        if seal == "profile":    # without relaxation every leak is at (kappa, E) = (1, E): tabulated
+            fixed = None if exact or self.relax is not None else (1.0, m.E_Pa)
+            self.seal = ProfileSeal(curve, m.u_c, m.gas, m.p_a_Pa, m.cup.beta, mu, tabulate_at=fixed)
+        else:
+            self.seal = StripSeal(curve, m.u_c, m.gas, m.p_a_Pa, m.cup.beta, mu)
         if self.relax is not None:
             self.phi0 = m.phi0_s if m.phi0_s is not None else measurement_contact_time(m.cup)
             self.E_ref = self.relax.modulus_and_log_slope(self.phi0)[0]
@@ -121,6 +124,22 @@ class ForceBalance:
             pb = N * self.kT / V
         Ndot, p, uc, share = self.seal.flow(F, r, l, pb, kappa, E, self.h1 - h)
         return Ndot, pb, p, uc, share, r, rp, l, V, Vp, F, Fh
+
+    def _seal_args(self, h: float, N: float, kappa: float, F1: float) -> tuple:
+        r, _, V, _, l = self.geo.at(h)
+        F = self.spring(h)[0]
+        pb = self.pa - (kappa * F + F1) / (math.pi * r * r) if self.liquid else N * self.kT / V
+        return F, r, self.seal.width(l), pb
+
+    def leak_rate(self, h: float, N: float, kappa: float, E: float, F1: float) -> float:
+        """`state`'s Ndot alone (the ODE's right-hand side): the seal's cheapest evaluation of it."""
+        F, r, l, pb = self._seal_args(h, N, kappa, F1)
+        return self.seal.rate(F, r, l, pb, kappa, E, self.h1 - h)
+
+    def sealed(self, h: float, N: float, kappa: float, E: float, F1: float) -> bool:
+        """Whether `state` reports u_c <= 0 here (the interface seals), without the flow."""
+        F, r, l, pb = self._seal_args(h, N, kappa, F1)
+        return self.seal.sealed(F, r, l, pb, kappa, E, self.h1 - h)
 
     # ------------------------------------------------------------------ the h grid
     def spring_array(self, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -265,11 +284,14 @@ class ForceBalance:
 _BALANCES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def force_balance(model: LeakageModel, geometry: str | None = None, seal: str | None = None) -> ForceBalance:
+def force_balance(model: LeakageModel, geometry: str | None = None, seal: str | None = None,
+                  exact: bool = False) -> ForceBalance:
     """The `ForceBalance` of `model` with the cup laws `geometry` ('cone' | 'curve') and the
     `seal` ('strip' | 'profile'), by default the model's; built once per model and choice (its
-    start state and fold grid are what every lifetime of the model shares)."""
-    key = (geometry or model.geometry, seal or model.seal)
+    start state, fold grid and the profile seal's flow tables are what every lifetime of the model
+    shares). exact: the profile seal solves every flow directly instead of from its tables."""
+    seal = seal or model.seal
+    key = (geometry or model.geometry, seal, bool(exact) and seal == "profile")
     per_model = _BALANCES.setdefault(model, {})
     if key not in per_model:
         per_model[key] = ForceBalance(model, *key)

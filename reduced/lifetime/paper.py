@@ -153,13 +153,13 @@ def _run_reference(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) ->
         last[:] = h, N, slope
         return h
 
-    Ndot_end = core.state(h_end, N_end, 1.0, E, F1)[0]
+    Ndot_end = core.leak_rate(h_end, N_end, 1.0, E, F1)
 
     # The integrated variable is the leaked content Q = N - N0, so that the error control is
     # relative to what leaks (N itself hardly changes at large F1).
     def rhs(t, y):     # beyond the end of the branch: continued with the end value (event there)
         N = N0 + y[0]
-        return [core.state(h_of(N), N, 1.0, E, F1)[0] if N < N_end else Ndot_end]
+        return [core.leak_rate(h_of(N), N, 1.0, E, F1) if N < N_end else Ndot_end]
 
     Ndot0 = rhs(0.0, [0.0])[0]
     Q_end = N_end - N0
@@ -304,10 +304,11 @@ def sealed_on_branch(core: ForceBalance, h0: float, h_end: float, F1: float) -> 
     line = core.geo.line_contact and core.seal_name == "strip"
     if getattr(core.m.u_c, "sealing_p_over_E", 0.0) == math.inf and not line:
         return None        # a table without sealed rows never seals, unless the strip is a line
+    if not core.liquid and core.seal.cannot_seal(1.0, core.m.E_Pa):
+        return None        # no ring's pressure reaches sealing even at p_b = 0
     h, _ = core.grid
     for x in [h0] + [float(x) for x in h[(h > h0) & (h < h_end)]] + [h_end]:
-        N = core.n_eq(x, 1.0, F1)[0]
-        if core.state(x, N, 1.0, core.m.E_Pa, F1)[3] <= 0.0:
+        if core.sealed(x, core.n_eq(x, 1.0, F1)[0], 1.0, core.m.E_Pa, F1):
             return x
     return None
 

@@ -17,16 +17,18 @@ from reduced.model import LeakageModel
 __all__ = ["lifetime_by_quadrature"]
 
 
-def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 1e-10) -> float:
+def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 1e-10,
+                           exact: bool = False) -> float:
     """Reference-mode lifetime as t = int_{h(0+)}^{h_end} (dN_eq/dh) / Ndot(h) dh (no time stepping).
 
     An independent evaluation for checking `lifetime`: without relaxation the state is
     one-dimensional and the time to move along the equilibrium branch is a quadrature.
-    Returns inf if u_c vanishes on the branch and 0 for an over-force.
+    Returns inf if u_c vanishes on the branch and 0 for an over-force. exact: the profile seal
+    solves every flow directly (`force_balance`).
     """
     if not model.reference:
         raise ValueError("lifetime_by_quadrature: only without relaxation (reference mode)")
-    core = force_balance(model)
+    core = force_balance(model, exact=exact)
     F1 = float(force_N)
     if not (math.isfinite(F1) and F1 > 0):
         raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")

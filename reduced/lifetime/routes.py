@@ -5,7 +5,7 @@ A route turns a `LeakageModel` and a pull force into a `Lifetime`. Registered:
 - "paper":   eqs (3)-(10) with eq 6's uniform strip (`reduced.lifetime.paper`); option cup_laws:
              'cone' (the rigid cone, eqs 3-5) or 'curve' (r, V, l from the stiffness curve).
 - "profile": the same force balance on the curve's laws, the leak through the curve's contact-
-             pressure profiles (`reduced.seal.ProfileSeal`).
+             pressure profiles (`reduced.seal.ProfileSeal`); option exact (False: tabulated flows).
 - "coupled": the cup's state from its FEM suction table (`reduced.coupled`); options samples,
              radial, along_u, u_start_m.
 
@@ -82,14 +82,16 @@ class _StripOrProfile:
         _needs(model, "stiffness", "a stiffness curve F0(u) (StiffnessCurve)", self.name)
         _needs(model, "u_c", "a critical gap u_c(p/E) (e.g. a UcTable)", self.name)
 
+    def core(self, model: LeakageModel, options: Mapping[str, Any]):
+        return force_balance(model, self.laws(model, options), self.seal, exact=options.get("exact", False))
+
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
-        laws = self.laws(model, options)
-        record = integrate(force_balance(model, laws, self.seal), force_N, t_max_s=run.t_max_s,
+        record = integrate(self.core(model, options), force_N, t_max_s=run.t_max_s,
                            rtol=run.rtol, refine=run.refine, progress=run.progress)
-        return self.result(record, model, run, {**options, "cup_laws": laws})
+        return self.result(record, model, run, {**options, "cup_laws": self.laws(model, options)})
 
     def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
-        return float(force_balance(model, self.laws(model, options), self.seal).initial[3])
+        return float(self.core(model, options).initial[3])
 
     def result(self, record: LifetimeResult, model: LeakageModel, run: Run, options: dict) -> Lifetime:
         return Lifetime(route=self.name, force_N=record.force_N, lifetime_s=record.lifetime_s,
@@ -119,16 +121,21 @@ class PaperRoute(_StripOrProfile):
 
 
 class ProfileRoute(_StripOrProfile):
-    """The force balance on the curve's laws, the leak through its contact-pressure profiles."""
+    """The force balance on the curve's laws, the leak through its contact-pressure profiles;
+    option exact: solve every flow through a profile directly (the reference for the flow tables,
+    `reduced.seal.PbTable`, used without relaxation)."""
 
     name = "profile"
     seal = "profile"
+    options = {"exact": False}
 
     def laws(self, model: LeakageModel, options: Mapping[str, Any]) -> str:
         return "curve"
 
     def check(self, model: LeakageModel, options: Mapping[str, Any]) -> None:
         super().check(model, options)
+        if not isinstance(options["exact"], bool):
+            raise ValueError(f"exact: expected True or False, got {options['exact']!r}")
         if model.stiffness.profiles is None:
             raise ValueError("stiffness: the profile route needs a curve with contact-pressure "
                              "profiles (an FEM curve from `cupcheck stiffness`)")
