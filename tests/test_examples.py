@@ -108,7 +108,8 @@ def test_01_stiffness_curve_of_a_new_design(tmp_path, capsys):
     text = "\n".join(lines)
     assert shows(number_after(text, "h1 ="), 20 * math.tan(math.radians(40)))     # (r1 - r0) tan(alpha)
     side = json.loads((tmp_path / "new_cup.json").read_text())["provenance"]
-    assert side["geometry"]["thickness_profile"] == {"kind": "table", "r_mm": [5.0, 15.0, 25.0], "d_mm": [2.2, 1.0, 0.4]}
+    assert side["geometry"]["thickness_profile"] == {"kind": "table", "r_mm": [5.0, 15.0, 25.0],
+                                                     "d_mm": [2.2, 1.0, 0.4]}
     assert side["contact"] == "frictionless" and side["fidelity"] == "coarse"
 
     # the same design as a design file, through `cupcheck stiffness`: the same curve
