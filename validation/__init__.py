@@ -4,7 +4,8 @@ The public nouns, imported on first use (``import validation`` imports no fem, s
 matplotlib or dask): the FEM pipeline (`fem_stiffness`, `fem_path`, `fem_curve`, `neo_hookean`,
 `route_model`, `surface_uc_table`), the cup a curve was computed for (`resolve_cup`,
 `CupChoice`), the hand-off (`stiffness_curve`, `write_sidecar`), the cache (`Cache`), the
-coupled route (`CoupledOptions`, `coupled_model`, `suction_table_for`) and scenes (`run_scene`).
+coupled route (`CoupledOptions`, `coupled_model`, `suction_table_for` and its grid
+`SuctionGridSpec`) and scenes (`run_scene`).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ _WHERE = {
     "stiffness_curve": "validation.handoff", "write_sidecar": "validation.handoff",
     "Cache": "validation.cache",
     "CoupledOptions": "validation.coupled.route", "coupled_model": "validation.coupled.route",
-    "suction_table_for": "validation.coupled.build",
+    "suction_table_for": "validation.coupled.build", "SuctionGridSpec": "validation.coupled.build",
     "run_scene": "validation.scenes.outputs",
 }
 
