@@ -1,6 +1,7 @@
 """The scene file: what to model and what to show, validated before any work.
 
-    [cup]            preset = "A" | geometry = "my_cup.toml"        (one of them)
+    [cup]            preset = "A" | geometry = "my_cup.toml"        (one of them),
+                     allow_unusual_design = false (true: a steep cone or slender wall is run)
     [material]       E_MPa = 4.0, nu = 0.49, relaxation = "none" | "default"
     [contact]        law = "frictionless" | "sticking" | "coulomb", friction = MU (Coulomb's mu in
                      [0, 100], with law = "coulomb" only, which needs it); without a law, the design
@@ -56,7 +57,7 @@ FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parame
            "p_Ndot_vs_time")
 SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset", "contact.friction")
 _TABLES: dict[str, dict[str, Any]] = {
-    "cup": {"preset": "A", "geometry": None},
+    "cup": {"preset": "A", "geometry": None, "allow_unusual_design": False},
     "material": {"E_MPa": 4.0, "nu": 0.49, "relaxation": "none"},
     "contact": {"law": "frictionless", "friction": None},
     "surface": {"preset": "pmma-1.89", "uc_table": None},
@@ -122,6 +123,7 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
         raise ValueError(f"{unknown[0]}: unknown table; allowed: {', '.join([*_TABLES, 'sweep', 'outputs'])}")
     tables = {name: _table(name, data.get(name, {}), defaults) for name, defaults in _TABLES.items()}
     _paths(tables, Path(base))
+    _guards(tables)
     contact_source = _design_contact(tables, data.get("contact", {}), source)
     _cross_checks(tables, data.get("sweep"))
     outputs = data.get("outputs")
@@ -203,6 +205,23 @@ def _paths(tables: dict[str, dict[str, Any]], base: Path) -> None:
         if not path.is_file():
             raise ValueError(f"{name}.{key}: no such file '{path}'")
         tables[name][key] = str(path)
+
+
+def _guards(tables: dict[str, dict[str, Any]]) -> None:
+    """The plausibility guards every entry point shares (`validation.guards`), named by key path:
+    the modulus, the pull forces, the design file's lengths and wall, the u_c table's gaps."""
+    from validation import guards
+
+    guards.check_modulus(tables["material"]["E_MPa"], "material.E_MPa")
+    guards.check_forces(tables["loads"]["F1_N"], "loads.F1_N")
+    cup = tables["cup"]
+    if not isinstance(cup["allow_unusual_design"], bool):
+        raise ValueError(f"cup.allow_unusual_design: expected true or false, got {cup['allow_unusual_design']!r}")
+    if cup["geometry"]:
+        guards.load_design(cup["geometry"], cup=cup["preset"], field="cup.geometry",
+                           allow_unusual=cup["allow_unusual_design"], override="set cup.allow_unusual_design = true")
+    if tables["surface"]["uc_table"]:
+        guards.check_uc_file(tables["surface"]["uc_table"], "surface.uc_table")
 
 
 def _friction(value: Any, where: str) -> float:
