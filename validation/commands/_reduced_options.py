@@ -33,9 +33,8 @@ def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
 def check_run_options(args: argparse.Namespace) -> None:
     """The options every route checks before its model: the forces, the integration's t_max and
     rtol, and kappa (ValueError naming the option)."""
-    for F in args.force_N:
-        if not (math.isfinite(F) and F > 0):
-            raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
+    from validation.guards import check_forces
+    check_forces(args.force_N, "--force")
     if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
         raise ValueError("--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
     if not (math.isfinite(args.kappa) and args.kappa > 0):

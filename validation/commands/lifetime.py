@@ -109,13 +109,14 @@ def build_model(args: argparse.Namespace):
     from reduced.appendix_a import appendix_a_curve
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel, largest_holdable_force, reference_model
-    from validation.guards import check_design, check_modulus
+    from validation.guards import check_design, check_modulus, check_stiffness_curve
 
     check_run_options(args)
     check_modulus(args.E_MPa, "--E-MPa")
     geometry, seal = route_model(args)
     curve, choice = _curve_and_cup(args)
     check_design(choice.design, args.allow_unusual_design, source=choice.label)
+    check_stiffness_curve(curve, choice.design["h1_mm"], f"--stiffness '{args.stiffness}'", args.E_MPa)
     args.cup_choice = choice
     cup = choice.cup
     uc = build_uc(args)

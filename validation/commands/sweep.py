@@ -41,7 +41,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from validation.sweeps.execute import pending_designs, run_sweep
     from validation.sweeps.figures import sweep_figures
-    from validation.sweeps.spec import load_sweep
+    from validation.sweeps.spec import load_sweep, lock_store
 
     spec = load_sweep(args.sweep)
     from validation.output import check_outputs, command_inputs
@@ -50,6 +50,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers: must be in [1, 256], got {args.workers}")
     if args.out.exists() and not args.out.is_dir():
         raise ValueError(f"--out: '{args.out}' exists and is not a directory")
+    store_lock = lock_store(args.out)  # noqa: F841 (held until run returns: one sweep per store)
     total = len(spec.designs())
     todo = len(pending_designs(spec, args.out, args.retry_failed)) if args.out.is_dir() else total
     print(f"sweep: {total} designs, {todo} to compute, {total - todo} already done", file=sys.stderr)
