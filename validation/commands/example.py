@@ -36,6 +36,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from validation.cache import user_cache_dir
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
                                       contact_choice, load_cup_design, route_model)
 
@@ -64,8 +65,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     c.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
                    help="the design's table from `cupcheck suction` (default: built at --fidelity "
                         "with --contact and cached)")
-    c.add_argument("--cache-dir", type=Path, default=Path(".cupcheck-cache/suction"), metavar="DIR",
-                   help="where built suction tables are kept (default .cupcheck-cache/suction)")
+    c.add_argument("--cache-dir", type=Path, default=user_cache_dir("suction"), metavar="DIR",
+                   help="where built suction tables are kept (default: %(default)s, the user's cache; "
+                        "$CUPCHECK_CACHE_DIR moves it)")
     c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
     src = p.add_mutually_exclusive_group()
     src.add_argument("--surface", default=None, metavar="NAME",

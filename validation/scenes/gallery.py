@@ -12,6 +12,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
+from validation.cache import user_cache_dir
 from validation.scenes.outputs import run_scene
 from validation.scenes.schema import load_scene
 
@@ -32,7 +33,7 @@ def main() -> None:
             continue
         scene = load_scene(scene_path)
         with tempfile.TemporaryDirectory() as tmp:
-            cache = None if args.no_cache else Path(".cupcheck-cache/scenes")
+            cache = None if args.no_cache else user_cache_dir("scenes")
             result = run_scene(scene, Path(tmp) / "out", cache_dir=cache)
             paths = [Path(f["path"]) for f in result.files]
             image = next((p for p in paths if p.suffix == ".gif"), None) or \
