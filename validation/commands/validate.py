@@ -1,4 +1,4 @@
-"""Cross-check report (issue 5): Appendix A vs FEM, rigid-cone laws vs FEM, the lifetime consequence
+"""Cross-check report: Appendix A vs FEM, rigid-cone laws vs FEM, the lifetime consequence
 of the stiffness source, the speed-accuracy trade, and the extremes.
 
 Writes to DIR, atomically: README.md (all sections, tables inline), one CSV per table (units in the
