@@ -23,7 +23,7 @@ def add_surface_arguments(parser: argparse.ArgumentParser, group=None) -> None:
                      help="line scan CSV, header x_<unit>,z_<unit> (unit m, mm, um or nm)")
     parser.add_argument("--psd-convention", default="persson-2d",
                         choices=("persson-2d", "surfacetopography-2d"),
-                        help="normalisation of --psd: persson-2d (default) or surfacetopography-2d")
+                        help="normalisation of --psd: persson-2d or surfacetopography-2d (default: persson-2d)")
     parser.add_argument("--tip-radius-um", type=float, default=1.0,
                         help="stylus tip radius for --line-scan [um] (default 1, the paper's)")
 
