@@ -46,7 +46,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES"]
+from validation.pipeline import DEFAULT_SURFACE
+
+__all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES", "key_rows"]
 
 OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure", "render", "footprint", "squeeze")
 #: the output kinds drawn from FEM states at given plate displacements (they need u_mm)
@@ -60,7 +62,7 @@ _TABLES: dict[str, dict[str, Any]] = {
     "cup": {"preset": "A", "geometry": None, "allow_unusual_design": False},
     "material": {"E_MPa": 4.0, "nu": 0.49, "relaxation": "none"},
     "contact": {"law": "frictionless", "friction": None},
-    "surface": {"preset": "pmma-1.89", "uc_table": None},
+    "surface": {"preset": DEFAULT_SURFACE, "uc_table": None},
     "fluid": {"kind": "air"},
     "loads": {"F1_N": [5.0, 10.0, 20.0, 40.0, 80.0], "r_start_mm": None, "kappa": 1.0},
     "stiffness": {"source": "fem", "route": "paper", "fidelity": "coarse"},
@@ -69,6 +71,62 @@ _CHOICES = {("cup", "preset"): ("A", "B"), ("material", "relaxation"): ("none", 
             ("contact", "law"): ("frictionless", "sticking", "coulomb"), ("fluid", "kind"): ("air", "water"),
             ("stiffness", "source"): ("fem", "appendix-a"), ("stiffness", "route"): ("paper", "profile"),
             ("stiffness", "fidelity"): ("coarse", "medium", "fine")}
+
+
+#: what each key means (docs/scenes.md is generated from this, `_TABLES` and `_CHOICES`:
+#: ``python scripts/keys_docs.py``)
+MEANING: dict[str, str] = {
+    "cup.preset": "Table 1 cup the design starts from (A: alpha 33 deg; B: 21 deg)",
+    "cup.geometry": "a design file (.toml or .json, the keys of `cupcheck stiffness --geometry`), relative to "
+                    "the scene file; its [contact] table sets the law unless contact.law is given",
+    "cup.allow_unusual_design": "true: a cone angle outside 5..80 deg or a wall more than 400x longer than thick "
+                                "is run, not refused",
+    "material.E_MPa": "Young's modulus [MPa] of the wall (and of p/E)",
+    "material.nu": "Poisson's ratio, in [0, 0.5)",
+    "material.relaxation": "none, or the default power-law relaxation modulus (4.4 MPa at 1 s, 1.8 MPa at 3e4 s)",
+    "contact.law": "the FEM's contact with the plane (default: the design file's [contact] law, else frictionless)",
+    "contact.friction": "Coulomb's mu, in [0, 100]: with law = \"coulomb\" only, which needs it",
+    "surface.preset": "calibrated rough surface for u_c(p/E) (`cupcheck uc --list-surfaces`)",
+    "surface.uc_table": "a u_c table CSV (columns p_over_E,u_c_m; u_c in m) instead of the preset",
+    "fluid.kind": "what fills the cavity and leaks in",
+    "loads.F1_N": "pull forces F1 [N]: one lifetime (and trajectory) per force",
+    "loads.r_start_mm": "start radius of the contact [mm] (default: Table 1's 12 mm for A and B, mid-wall otherwise)",
+    "loads.kappa": "stiffness factor: F0 replaced by kappa F0 (the paper's Fig. 1stiffnessFactor)",
+    "stiffness.source": "F0(h) from the FEM or from Appendix A's formula",
+    "stiffness.route": "how the FEM reaches the lifetime (README, Routes): eq (6)'s strip on the cone, or the "
+                       "FEM's contact-pressure profile (needs source = \"fem\")",
+    "stiffness.fidelity": "FEM mesh level",
+    "sweep.key": "the one parameter varied (contact.friction with law = \"coulomb\")",
+    "sweep.values": "its values, each once: one lifetime table row per value and force",
+    "outputs[].kind": "what to write: a stiffness curve, lifetimes, trajectories, a figure, or a 3D view "
+                      "(render, footprint, squeeze: drawn from FEM states at u_mm)",
+    "outputs[].name": "file stem (default: the figure's name, else the kind)",
+    "outputs[].figure": "with kind = \"figure\": which figure (lifetime_vs_parameter needs [sweep]; "
+                        "uc_vs_pressure and F0_vs_u draw one line per swept surface or cup)",
+    "outputs[].u_mm": "with render, footprint, squeeze (and only them): the plate displacement shown [mm]",
+    "outputs[].field": "with render, squeeze: the colouring",
+    "outputs[].frames": "with squeeze: the number of frames from u = 0 to u_mm",
+}
+#: the [[outputs]] keys: (default, allowed) as the parser applies them
+OUTPUT_KEYS: dict[str, tuple[Any, str]] = {
+    "kind": (None, ", ".join(OUTPUT_KINDS)), "name": (None, "a plain file stem"),
+    "figure": (None, ", ".join(FIGURES)), "u_mm": (None, "> 0"),
+    "field": ("contact_pressure", ", ".join(FIELDS)), "frames": (8, f"2 .. {MAX_FRAMES}"),
+}
+
+
+def key_rows() -> list[tuple[str, Any, str, str]]:
+    """(key path, default, allowed values, meaning) of every scene key, from the parser's own tables."""
+    rows = []
+    for table, keys in _TABLES.items():
+        for key, default in keys.items():
+            allowed = ", ".join(_CHOICES[(table, key)]) if (table, key) in _CHOICES else ""
+            rows.append((f"{table}.{key}", default, allowed, MEANING[f"{table}.{key}"]))
+    rows.append(("sweep.key", None, ", ".join(SWEEP_KEYS), MEANING["sweep.key"]))
+    rows.append(("sweep.values", None, "a non-empty list", MEANING["sweep.values"]))
+    for key, (default, allowed) in OUTPUT_KEYS.items():
+        rows.append((f"outputs[].{key}", default, allowed, MEANING[f"outputs[].{key}"]))
+    return rows
 
 
 @dataclass(frozen=True)
@@ -154,6 +212,9 @@ def _sweep(table: Any, tables: dict[str, dict[str, Any]]) -> dict[str, Any]:
         raise ValueError(f"sweep.key: expected one of {', '.join(SWEEP_KEYS)}, got {key!r}")
     if not isinstance(values, list) or not values:
         raise ValueError("sweep.values: expected a non-empty list")
+    twice = [j for j, v in enumerate(values) if v in values[:j]]
+    if twice:
+        raise ValueError(f"sweep.values[{twice[0]}]: {values[twice[0]]!r} appears twice; give each value once")
     name, field = key.split(".")
     if (name, field) in _CHOICES:
         bad = [v for v in values if v not in _CHOICES[(name, field)]]
@@ -162,6 +223,8 @@ def _sweep(table: Any, tables: dict[str, dict[str, Any]]) -> dict[str, Any]:
     elif field == "preset":
         if not all(isinstance(v, str) for v in values):
             raise ValueError("sweep.values: expected surface preset names")
+        for j, v in enumerate(values):
+            check_surface_preset(v, f"sweep.values[{j}]")
     elif key != "contact.friction":
         values = [_number(v, f"sweep.values[{i}]", positive=True) for i, v in enumerate(values)]
     if key == "contact.friction":
@@ -222,6 +285,23 @@ def _guards(tables: dict[str, dict[str, Any]]) -> None:
                            allow_unusual=cup["allow_unusual_design"], override="set cup.allow_unusual_design = true")
     if tables["surface"]["uc_table"]:
         guards.check_uc_file(tables["surface"]["uc_table"], "surface.uc_table")
+    else:
+        check_surface_preset(tables["surface"]["preset"], "surface.preset")
+
+
+def check_surface_preset(name: Any, where: str) -> None:
+    """A calibrated surface preset's name (read from the presets' data file: importing the
+    roughness model would cost a scene that needs none of it 0.5 s)."""
+    import json
+
+    data = Path(__file__).resolve().parents[2] / "reduced" / "roughness" / "data" / "presets.json"
+    if data.is_file():
+        known = {d["name"] for d in json.loads(data.read_text(encoding="utf-8"))}
+    else:                                  # an unusual install: ask the package
+        from reduced.roughness.surfaces import load_presets
+        known = set(load_presets())
+    if name not in known:
+        raise ValueError(f"{where}: unknown surface preset {name!r}; choose one of {', '.join(sorted(known))}")
 
 
 def _friction(value: Any, where: str) -> float:

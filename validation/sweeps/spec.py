@@ -7,7 +7,7 @@
     d1_mm = 0.447
     E_MPa = 4.0
     nu = 0.49
-    contact = "sticking"            # frictionless | sticking | coulomb
+    contact = "sticking"            # frictionless (default, as everywhere) | sticking | coulomb
     # friction = 0.5                # Coulomb's mu in [0, 100]: with contact = "coulomb" only
     surface = "pmma-1.89"           # a calibrated preset (`cupcheck uc --list-surfaces`)
     fidelity = "coarse"             # FEM mesh level
@@ -54,8 +54,10 @@ from typing import Any
 
 import numpy as np
 
+from validation.pipeline import DEFAULT_SURFACE
+
 __all__ = ["SweepSpec", "load_sweep", "sweep_from_mapping", "NUMERIC_AXES", "design_hash", "MAX_DESIGNS",
-           "lock_store"]
+           "lock_store", "key_rows"]
 
 #: the largest sweep one run takes (a grid's product of axis lengths, or lhs/sobol's n)
 MAX_DESIGNS = 100_000
@@ -67,7 +69,7 @@ NUMERIC_AXES = ("alpha_deg", "r0_mm", "r1_mm", "d0_mm", "d1_mm", "E_MPa", "nu", 
 CATEGORICAL_AXES = ("contact", "surface")
 _BASE_DEFAULTS: dict[str, Any] = {
     "cup": "A", "alpha_deg": None, "r0_mm": None, "r1_mm": None, "d0_mm": None, "d1_mm": None,
-    "E_MPa": 4.0, "nu": 0.49, "contact": "sticking", "surface": "pmma-1.89", "fidelity": "coarse",
+    "E_MPa": 4.0, "nu": 0.49, "contact": "frictionless", "surface": DEFAULT_SURFACE, "fidelity": "coarse",
     "r_start_mm": None, "l0_mm": None, "l1_mm": None, "F1_N": [10.0], "F0_at_u_mm": [1.0], "allow_unusual_design": False,
 }
 #: optional base keys, absent unless given (a design's hash is that of its given keys)
@@ -75,6 +77,50 @@ _OPTIONAL = ("friction",)
 _CHOICES = {"contact": ("frictionless", "sticking", "coulomb"), "fidelity": ("coarse", "medium", "fine"),
             "cup": ("A", "B")}
 _METHODS = ("grid", "lhs", "sobol")
+
+
+#: what each key means (docs/sweeps.md is generated from this and the parser's tables:
+#: ``python scripts/keys_docs.py``)
+MEANING: dict[str, str] = {
+    "base.cup": "Table 1 cup the geometry keys modify",
+    "base.alpha_deg": "cone angle [deg] (default: the cup's)",
+    "base.r0_mm": "top-plate radius [mm] (default: the cup's)", "base.r1_mm": "rim radius [mm] (default: the cup's)",
+    "base.d0_mm": "wall thickness at r0 [mm] (a line to d1 at r1; default: the cup's)",
+    "base.d1_mm": "wall thickness at r1 [mm] (default: the cup's)",
+    "base.E_MPa": "Young's modulus [MPa]", "base.nu": "Poisson's ratio",
+    "base.contact": "the FEM's contact law with the plane",
+    "base.friction": "Coulomb's mu in [0, 100]: with contact = \"coulomb\" only",
+    "base.surface": "calibrated surface preset for u_c(p/E) (`cupcheck uc --list-surfaces`)",
+    "base.fidelity": "FEM mesh level",
+    "base.r_start_mm": "start radius of the contact [mm] (default: Table 1's for A and B, mid-wall otherwise)",
+    "base.l0_mm": "eq (5)'s strip width at r0 [mm] (default: Table 1's for the base cup, as measured for it)",
+    "base.l1_mm": "eq (5)'s strip width at r1 [mm] (default: Table 1's for the base cup)",
+    "base.F1_N": "pull forces [N], each once: one table row per design and force",
+    "base.F0_at_u_mm": "plate displacements [mm] at which F0 is reported, each once",
+    "base.allow_unusual_design": "true: steep or slender walls are run, not failed (`validation.guards`)",
+    "scene": "a scene file whose cup, material, contact, surface, loads and fidelity are the base ([base] "
+             "keys then override them)",
+    "sampling.method": "grid: every combination of the axes' values; lhs, sobol: n designs in [low, high]",
+    "sampling.n": f"lhs, sobol: the number of designs, 1 .. {MAX_DESIGNS}",
+    "sampling.seed": "lhs, sobol: the random seed (reproducible designs)",
+    "axes[].name": "the base key varied (categorical ones on a grid only; friction with a coulomb base)",
+    "axes[].values": f"grid: the values, each once (at most {MAX_DESIGNS} designs in all)",
+    "axes[].low": "lhs, sobol: the lower bound", "axes[].high": "lhs, sobol: the upper bound (> low)",
+}
+
+
+def key_rows() -> list[tuple[str, Any, str, str]]:
+    """(key path, default, allowed values, meaning) of every sweep key, from the parser's own tables."""
+    rows = [("scene", None, "a scene file name", MEANING["scene"])]
+    for key, default in {**_BASE_DEFAULTS, **{k: None for k in _OPTIONAL}}.items():
+        allowed = ", ".join(_CHOICES[key]) if key in _CHOICES else ""
+        rows.append((f"base.{key}", default, allowed, MEANING[f"base.{key}"]))
+    rows += [("sampling.method", "grid", ", ".join(_METHODS), MEANING["sampling.method"]),
+             ("sampling.n", None, f"1 .. {MAX_DESIGNS}", MEANING["sampling.n"]),
+             ("sampling.seed", 0, "an integer", MEANING["sampling.seed"]),
+             ("axes[].name", None, ", ".join(NUMERIC_AXES + CATEGORICAL_AXES), MEANING["axes[].name"])]
+    rows += [(f"axes[].{k}", None, "", MEANING[f"axes[].{k}"]) for k in ("values", "low", "high")]
+    return rows
 
 
 @dataclass(frozen=True)
@@ -183,16 +229,14 @@ def _check_contact_axes(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) 
 
 def _check_surfaces(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) -> None:
     """Every surface a design uses is a calibrated preset (the base's, or a surface axis's values)."""
-    from reduced.roughness.surfaces import load_presets
+    from validation.scenes.schema import check_surface_preset
 
-    known = load_presets()
     given = [("base.surface", base["surface"])]
     for i, axis in enumerate(axes):
         if axis["name"] == "surface":
             given = [(f"axes[{i}].values[{j}]", v) for j, v in enumerate(axis["values"])]
     for where, name in given:
-        if name not in known:
-            raise ValueError(f"{where}: unknown surface preset {name!r}; choose one of {', '.join(sorted(known))}")
+        check_surface_preset(name, where)
 
 
 def lock_store(out: str | Path):
