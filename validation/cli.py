@@ -75,8 +75,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one subcommand; return its exit status (argparse errors and --help raise SystemExit)."""
-    os.environ.setdefault("PYTHONWARNINGS", "ignore")   # the workers' library warnings: not for the terminal
     try:
+        os.environ.setdefault("PYTHONWARNINGS", "ignore")   # the workers' library warnings: not for the terminal
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")              # nor this process's
             return _main(argv)
