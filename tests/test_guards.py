@@ -118,3 +118,21 @@ def test_ctrl_c_at_any_moment_is_one_line(tmp_path):
         else:                       # finished (the interrupt, if any, landed in the interpreter's exit)
             assert done and proc.returncode in (0, -signal.SIGINT), err
     assert 0 not in codes[:2]
+
+
+def test_ctrl_c_on_a_sweep_is_one_line(tmp_path):
+    """Ctrl-C in a terminal reaches the whole process group: the sweep and its dask workers. The
+    workers (validation.sweeps.worker, a dask preload) leave it to the sweep: one line, exit 130."""
+    (tmp_path / "s.toml").write_text('[base]\nF1_N = [10]\n[[axes]]\nname = "alpha_deg"\nvalues = [30, 33, 36]\n')
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg"}
+    proc = subprocess.Popen([sys.executable, "-m", "validation.cli", "sweep", str(tmp_path / "s.toml"), "--out",
+                             str(tmp_path / "out"), "--workers", "1", "--quiet"], env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while not (tmp_path / "out" / "designs").is_dir() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)                         # the sweep checked its file and took its store
+    time.sleep(2.0)                              # the cluster up, the worker on its first design
+    os.killpg(proc.pid, signal.SIGINT)           # as a terminal does: the whole group
+    out, err = proc.communicate(timeout=120)
+    lines = [ln for ln in err.splitlines() if not ln.startswith("sweep: ")]
+    assert proc.returncode == 130 and lines == ["cupcheck sweep: interrupted"], err

@@ -42,6 +42,8 @@ def run(args: argparse.Namespace) -> int:
     from validation.sweeps.execute import pending_designs, run_sweep
     from validation.sweeps.figures import sweep_figures
     from validation.sweeps.spec import load_sweep, lock_store
+    import dask
+    from validation.sweeps.worker import PRELOAD
 
     spec = load_sweep(args.sweep)
     from validation.output import check_outputs, command_inputs
@@ -65,6 +67,7 @@ def run(args: argparse.Namespace) -> int:
             bar.update(1)
             bar.set_postfix(failed=failed, remaining=n - done)
 
+    dask.config.set(PRELOAD)             # the workers leave Ctrl-C to this process (one line)
     result = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler,
                        retry_failed=args.retry_failed, progress=progress)
     if bar is not None:
