@@ -26,7 +26,7 @@ def main() -> None:
     images.mkdir(exist_ok=True)
     lines = ["# Scene gallery", "",
              "Each shipped scene, its animation or first image and the command that made it (regenerate this page with",
-             "`python -m validation.scenes.gallery`). Scene keys: `validation/scenes/schema.py`. Cold and warm run times",
+             "`python -m validation.scenes.gallery`). Scene keys: `docs/scenes.md`. Cold and warm run times",
              "of every scene: the README (`python benchmarks/bench_scenes.py`).", ""]
     for scene_path in sorted(args.scenes.glob("*.toml")):
         if scene_path.name.startswith("sweep_"):
