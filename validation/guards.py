@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ImplausibleInput", "PLAUSIBLE", "check_modulus", "check_forces", "check_length",
+__all__ = ["ImplausibleInput", "PLAUSIBLE", "check_modulus", "check_forces", "check_start_radius", "check_length",
            "check_design_data", "load_design", "check_design", "check_stiffness_curve", "check_uc_table",
            "check_uc_file", "check_spectrum"]
 
@@ -84,6 +84,20 @@ def check_forces(forces_N: Any, field: str = "F1_N") -> list[float]:
         if not lo <= F <= hi:
             _refuse(where, F, "F_N", " N")
     return [float(F) for F in values]
+
+
+def check_start_radius(r_start_mm: float | None, radii_mm: tuple[float, float], field: str) -> None:
+    """The reduced model's start radius inside the wall, r0 < r_start < r1 (None: the default)."""
+    if r_start_mm is None:
+        return
+    r0, r1 = radii_mm
+    if isinstance(r_start_mm, bool) or not isinstance(r_start_mm, (int, float)):
+        return                                 # not a number: the reader that types it says so
+    if not (math.isfinite(r_start_mm) and r0 < r_start_mm < r1):
+        slips = [name for name, factor in _SLIPS["r_mm"] if r0 < r_start_mm * factor < r1]
+        hint = f": did you give {' or '.join(slips)}?" if slips else ""
+        raise ImplausibleInput(f"{field} = {r_start_mm:.4g}{hint} (the start radius must lie in (r0, r1) = "
+                               f"({r0:.4g}, {r1:.4g}) mm)")
 
 
 def check_length(value: Any, field: str, kind: str = "r_mm") -> None:

@@ -444,3 +444,14 @@ for label, text, expected in [
     case(f"sweep file: {label}", SWEEP, expected, **{"s.toml": text})
 case("sweep file: its scene's modulus", SWEEP, "material.E_MPa = 0.001: did you give GPa?",
      **{"s.toml": "scene = \"b.toml\"\n", "b.toml": "[material]\nE_MPa = 0.001\n[[outputs]]\nkind = \"lifetimes\"\n"})
+# the start radius, named as written (it was r_start_m, in metres, after the work had started)
+case("scene file: start radius outside the wall", RUN, "loads.r_start_mm = 3 (the start radius must lie in (r0, r1) = (5, 19) mm)",
+     **{"s.toml": "[loads]\nr_start_mm = 3\n" + _LIFE_SCENE})
+case("scene file: start radius in um", RUN, "loads.r_start_mm = 1.2e+04: did you give um?",
+     **{"s.toml": "[loads]\nr_start_mm = 12000\n" + _LIFE_SCENE})
+case("scene file: swept start radius in m", RUN, "sweep.values[1] = 0.012: did you give m?",
+     **{"s.toml": "[sweep]\nkey = \"loads.r_start_mm\"\nvalues = [10, 0.012]\n" + _LIFE_SCENE})
+case("sweep file: start radius outside the wall", SWEEP, "base.r_start_mm = 3 (the start radius must lie in (r0, r1)",
+     **{"s.toml": "[base]\nr_start_mm = 3\n"})
+case("sweep file: start radius on an axis", SWEEP, "axes[0].values[2] = 30 (the start radius must lie in",
+     **{"s.toml": "[[axes]]\nname = \"r_start_mm\"\nvalues = [10, 12, 30]\n"})

@@ -181,7 +181,7 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
         raise ValueError(f"{unknown[0]}: unknown table; allowed: {', '.join([*_TABLES, 'sweep', 'outputs'])}")
     tables = {name: _table(name, data.get(name, {}), defaults) for name, defaults in _TABLES.items()}
     _paths(tables, Path(base))
-    _guards(tables)
+    _guards(tables, data.get("sweep"))
     contact_source = _design_contact(tables, data.get("contact", {}), source)
     _cross_checks(tables, data.get("sweep"))
     outputs = data.get("outputs")
@@ -270,7 +270,7 @@ def _paths(tables: dict[str, dict[str, Any]], base: Path) -> None:
         tables[name][key] = str(path)
 
 
-def _guards(tables: dict[str, dict[str, Any]]) -> None:
+def _guards(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
     """The plausibility guards every entry point shares (`validation.guards`), named by key path:
     the modulus, the pull forces, the design file's lengths and wall, the u_c table's gaps."""
     from validation import guards
@@ -281,8 +281,17 @@ def _guards(tables: dict[str, dict[str, Any]]) -> None:
     if not isinstance(cup["allow_unusual_design"], bool):
         raise ValueError(f"cup.allow_unusual_design: expected true or false, got {cup['allow_unusual_design']!r}")
     if cup["geometry"]:
-        guards.load_design(cup["geometry"], cup=cup["preset"], field="cup.geometry",
-                           allow_unusual=cup["allow_unusual_design"], override="set cup.allow_unusual_design = true")
+        design = guards.load_design(cup["geometry"], cup=cup["preset"], field="cup.geometry",
+                                    allow_unusual=cup["allow_unusual_design"],
+                                    override="set cup.allow_unusual_design = true").geometry
+        radii = (design.r0_m * 1e3, design.r1_m * 1e3)
+    else:
+        from reduced.cup import CUPS
+        radii = (CUPS[cup["preset"]].r0_m * 1e3, CUPS[cup["preset"]].r1_m * 1e3)
+    guards.check_start_radius(tables["loads"]["r_start_mm"], radii, "loads.r_start_mm")
+    if isinstance(sweep, Mapping) and sweep.get("key") == "loads.r_start_mm" and isinstance(sweep.get("values"), list):
+        for j, value in enumerate(sweep["values"]):
+            guards.check_start_radius(value, radii, f"sweep.values[{j}]")
     if tables["surface"]["uc_table"]:
         guards.check_uc_file(tables["surface"]["uc_table"], "surface.uc_table")
     else:

@@ -199,6 +199,7 @@ def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".") -> Sweep
             raise ValueError(f"axes: the grid has {lengths} = {size:.3g} designs, more than {MAX_DESIGNS} "
                              f"(each is an FEM path); use fewer values, or lhs/sobol sampling with n designs")
     _check_surfaces(base, parsed)
+    _check_start_radius(base, parsed)
     _check_contact_axes(base, parsed)
     return SweepSpec(base=base, axes=parsed, method=method, n=n if method != "grid" else 0, seed=seed)
 
@@ -237,6 +238,26 @@ def _check_surfaces(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) -> N
             given = [(f"axes[{i}].values[{j}]", v) for j, v in enumerate(axis["values"])]
     for where, name in given:
         check_surface_preset(name, where)
+
+
+def _check_start_radius(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) -> None:
+    """r_start inside the base cup's wall (when the radii are not swept: then each design's own
+    check makes a failed row)."""
+    from reduced.cup import CUPS
+    from validation.guards import check_start_radius
+
+    names = [a["name"] for a in axes]
+    if "r0_mm" in names or "r1_mm" in names:
+        return
+    cup = CUPS[base["cup"]]
+    radii = (base["r0_mm"] if base["r0_mm"] is not None else cup.r0_m * 1e3,
+             base["r1_mm"] if base["r1_mm"] is not None else cup.r1_m * 1e3)
+    check_start_radius(base["r_start_mm"], radii, "base.r_start_mm")
+    if "r_start_mm" in names:
+        i = names.index("r_start_mm")
+        for key, value in ([(f"values[{j}]", v) for j, v in enumerate(axes[i]["values"])] if "values" in axes[i]
+                           else [("low", axes[i]["low"]), ("high", axes[i]["high"])]):
+            check_start_radius(value, radii, f"axes[{i}].{key}")
 
 
 def lock_store(out: str | Path):
