@@ -455,3 +455,8 @@ case("sweep file: start radius outside the wall", SWEEP, "base.r_start_mm = 3 (t
      **{"s.toml": "[base]\nr_start_mm = 3\n"})
 case("sweep file: start radius on an axis", SWEEP, "axes[0].values[2] = 30 (the start radius must lie in",
      **{"s.toml": "[[axes]]\nname = \"r_start_mm\"\nvalues = [10, 12, 30]\n"})
+for command in (["lifetime", "--geometry", "{d}/g.toml", "--out", "{d}/out"],
+                ["example", "--geometry", "{d}/g.toml", "--out", "{d}/out"],
+                ["suction", "--geometry", "{d}/g.toml", "--out", "{d}/out/s.json"]):
+    case("design file: thickness table in um", command, "g.toml: thickness.r_mm[0] = 5000: did you give um?",
+         **{"g.toml": "[thickness]\nr_mm = [5000, 22000]\nd_mm = [2000, 500]\n"})
