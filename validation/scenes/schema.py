@@ -1,40 +1,18 @@
 """The scene file: what to model and what to show, validated before any work.
 
-    [cup]            preset = "A" | geometry = "my_cup.toml"        (one of them),
-                     allow_unusual_design = false (true: a steep cone or slender wall is run)
-    [material]       E_MPa = 4.0, nu = 0.49, relaxation = "none" | "default"
-    [contact]        law = "frictionless" | "sticking" | "coulomb", friction = MU (Coulomb's mu in
-                     [0, 100], with law = "coulomb" only, which needs it); without a law, the design
-                     file's [contact] table (cup.geometry) if it has one, else frictionless
-    [surface]        preset = "pmma-1.89" | uc_table = "uc.csv"     (one of them)
-    [fluid]          kind = "air" | "water"
-    [loads]          F1_N = [5, 10, 20], r_start_mm = 12 (optional), kappa = 1.0
-    [stiffness]      source = "fem" | "appendix-a", route = "paper" | "profile",
-                     fidelity = "coarse" | "medium" | "fine"
-    [sweep]          key = "loads.kappa" | "loads.r_start_mm" | "surface.preset" | "cup.preset"
-                     | "contact.friction" (with law = "coulomb"),
-                     values = [...]                  (optional: one parameter varied for a figure)
-    [[outputs]]      kind = "curve" | "lifetimes" | "trajectories" | "figure"
-                     name = "..." (file stem), figure = "lifetime_vs_force" | "uc_vs_pressure" | "F0_vs_u"
-                     | "lifetime_vs_parameter" (needs [sweep]: one line per F1) | "r_pb_vs_time" (r(t),
-                     p_b(t)) | "p_Ndot_vs_time" (p(t), Ndot(t)): one line per F1; uc_vs_pressure and F0_vs_u
-                     with a [sweep] of surface.preset or cup.preset draw one line per value
-                     kind = "render" with u_mm = 3: the revolved deformed FEM cup at u, cut open and
-                     coloured by field = "contact_pressure" (default) | "von_mises" | "min_stretch"
-                     (pyvista off-screen; the FEM runs only to u)
-                     kind = "footprint" with u_mm: the contact seen from below through the substrate
-                     (the sealing annulus), at a fixed scale (the pixel size in the manifest)
-                     kind = "squeeze" with u_mm (the last frame) and frames = N (2 .. 60), field:
-                     N frames from u = 0 to u_mm (PNG) and their animated GIF
+    [cup] [material] [contact] [surface] [fluid] [loads] [stiffness]    what to model
+    [sweep]                                                               one parameter varied
+    [[outputs]]     kind = curve | lifetimes | trajectories | figure | render | footprint | squeeze
 
-Every table and key is optional but `outputs`; defaults: cup A, frictionless FEM at the
-coarse level, the paper's route, pmma-1.89, air, F1 = 5, 10, 20, 40, 80 N (the main job,
-scenes/main.toml, sets the medium level and F1 = 5, 10, ..., 80 N). Unknown keys, wrong
-types and contradictions are ValueErrors naming the key path (``outputs[2].kind: expected one of
-...``): one line and exit status 2 on the command line, before anything is computed or written.
-Paths in the scene are relative to the scene file. The contact law and mu are checked by
-`fem.interface` (imported only for a scene that names mu, coulomb or a design file: a scene of the
-reduced model alone imports no fem); `Scene.contact_source` says where the law came from.
+Every key, its default and allowed values live once, in the tables below (`_TABLES`, `_CHOICES`,
+`OUTPUT_KEYS`) with their meaning (`MEANING`); docs/scenes.md is generated from them
+(``python scripts/keys_docs.py``). Every table and key is optional but `outputs`. Unknown keys,
+wrong types, implausible values (the shared guards of `validation.guards`, named by key path) and
+contradictions are ValueErrors naming the key path (``outputs[2].kind: expected one of ...``):
+one line and exit status 2 on the command line, before anything is computed or written. Paths in
+the scene are relative to the scene file. The contact law and mu are checked by `fem.interface`
+(imported only for a scene that names mu, coulomb or a design file: a scene of the reduced model
+alone imports no fem); `Scene.contact_source` says where the law came from.
 """
 
 from __future__ import annotations
