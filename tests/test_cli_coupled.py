@@ -44,7 +44,8 @@ def test_suction_table_balances(table_path):
 
 def test_coupled_route_matches_the_library(capsys, table_path, tmp_path):
     code, out, _ = _run(capsys, "lifetime", "--route", "coupled", "--suction-table", str(table_path),
-                        "--cup", "A", "--force", "2", "15", "--json", "--out", str(tmp_path / "run"))
+                        "--cup", "A", "--force", "2", "15", "--surface", "illustrative", "--json",
+                        "--out", str(tmp_path / "run"))
     assert code == 0
     rows = json.loads(out)
     model = CoupledCavity(SuctionTable.from_json(table_path), UcTable.from_csv(ILLUSTRATIVE_UC_CSV),
@@ -117,7 +118,7 @@ def test_relaxed_coupled_route_matches_the_library(capsys, table_path, tmp_path)
     """--relaxation default on the coupled route: phi0 defaults to cup A's measurement contact
     time (13 s), the lifetimes are the library's, the trajectory carries phi and kappa."""
     code, out, _ = _run(capsys, "lifetime", "--route", "coupled", "--suction-table", str(table_path),
-                        "--cup", "A", "--force", "2", "--relaxation", "default", "--json",
+                        "--cup", "A", "--force", "2", "--relaxation", "default", "--surface", "illustrative", "--json",
                         "--out", str(tmp_path / "run"))
     assert code == 0
     row = json.loads(out)[0]

@@ -15,7 +15,7 @@ from validation.cli import main
 
 def test_json_reference_mode(capsys):
     code, out, _ = _run(capsys, "lifetime", "--reference-mode", "--cup", "A", "--force", "5", "40",
-                        "200", "--json")
+                        "200", "--surface", "illustrative", "--json")
     assert code == 0
     rows = json.loads(out)
     assert [r["force_N"] for r in rows] == [5.0, 40.0, 200.0]
@@ -129,7 +129,7 @@ def test_kappa_scales_the_stiffness_as_a_scaled_curve(capsys):
     from reduced.appendix_a import appendix_a_curve
     from reduced.lifetime import lifetime, reference_model
 
-    code, out, _ = _run(capsys, "lifetime", "--kappa", "2", "--force", "10", "--json")
+    code, out, _ = _run(capsys, "lifetime", "--kappa", "2", "--force", "10", "--surface", "illustrative", "--json")
     assert code == 0
     base = reference_model(CUP_A, UcTable.from_csv(ILLUSTRATIVE_UC_CSV))
     import dataclasses

@@ -6,18 +6,26 @@ products) and `file_digest` of every input file the product reads, so that an ed
 or u_c table is a new key, while the file's path, passed as an ignored argument, is not part of
 the key. An entry that cannot be read is recomputed with one line on stderr; a cache that cannot
 be written is bypassed likewise.
+
+Where: one cache per user, `user_cache_dir` (``$CUPCHECK_CACHE_DIR`` if set, else the platform's
+user cache directory, ``~/.cache/cupcheck`` on Linux or ``$XDG_CACHE_HOME/cupcheck``), one
+subdirectory per kind of product; never the working directory, so a read-only one works.
 """
 
 from __future__ import annotations
 
 import hashlib
+import os
 import sys
 from collections.abc import Callable
 from functools import lru_cache
 from pathlib import Path
 from typing import Any, TypeVar
 
-__all__ = ["Cache", "source_hash", "file_digest"]
+__all__ = ["Cache", "source_hash", "file_digest", "user_cache_dir", "CACHE_ENV"]
+
+#: the environment variable that moves every cupcheck cache (the --cache-dir options still win)
+CACHE_ENV = "CUPCHECK_CACHE_DIR"
 
 F = TypeVar("F", bound=Callable[..., Any])
 _ROOT = Path(__file__).resolve().parents[1]
@@ -34,6 +42,16 @@ def source_hash(*parts: str) -> str:
             h.update(path.relative_to(_ROOT).as_posix().encode())
             h.update(path.read_bytes())
     return h.hexdigest()[:16]
+
+
+def user_cache_dir(kind: str | None = None) -> Path:
+    """The user's cupcheck cache (`CACHE_ENV`, else platformdirs' user cache directory), or its
+    subdirectory for one kind of product ("scenes", "suction", "validate")."""
+    from platformdirs import user_cache_path
+
+    root = os.environ.get(CACHE_ENV, "").strip()
+    base = Path(root).expanduser() if root else user_cache_path("cupcheck", appauthor=False)
+    return base / kind if kind else base
 
 
 def file_digest(path: str | Path | None) -> str | None:

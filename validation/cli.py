@@ -5,7 +5,11 @@ Every error is one line on stderr, ``cupcheck <command>: error: <what>``, with e
 bad input, whether argparse finds it (an unknown choice, a value that is not a number, a missing
 required option) or the command does (a ``ValueError`` whose message names the field and its
 allowed range); a solver that fails (``RuntimeError``) prints where and why and exits 1.
-``--help`` prints the full usage as usual.
+``--help`` prints the full usage as usual; bare ``cupcheck`` prints the command list and exits 0
+(nothing was asked, nothing went wrong); ``--version`` prints the version. Ctrl-C at any moment is
+one line and exit status 130. Warnings of the libraries underneath (numpy, scipy, joblib, dask),
+in this process and in its workers, never reach the user: what a user must know, cupcheck says
+itself, as a note or in the output's provenance.
 """
 
 from __future__ import annotations
@@ -13,8 +17,10 @@ from __future__ import annotations
 import argparse
 import errno
 import importlib
+import os
 import signal
 import sys
+import warnings
 from collections.abc import Sequence
 from typing import NoReturn
 
@@ -35,12 +41,23 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {_one_line(message)}\n")
 
 
+def version() -> str:
+    """The installed cupcheck's version (the package metadata), or the source tree's."""
+    from importlib.metadata import PackageNotFoundError, version as installed
+
+    try:
+        return installed("cupcheck")
+    except PackageNotFoundError:
+        return "unknown (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(
         prog="cupcheck",
         description="Suction-cup cross-checks: axisymmetric FEM stiffness and the Tiwari-Persson "
                     "leakage model (Soft Matter 2019, arXiv:1906.01459). SI units inside; every "
                     "option names its unit.")
+    parser.add_argument("--version", action="version", version=f"cupcheck {version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMANDS:
         try:
@@ -58,15 +75,34 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one subcommand; return its exit status (argparse errors and --help raise SystemExit)."""
+    try:
+        os.environ.setdefault("PYTHONWARNINGS", "ignore")   # the workers' library warnings: not for the terminal
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")              # nor this process's
+            return _main(argv)
+    except KeyboardInterrupt:                # during start-up or while a command was reporting
+        return _interrupted("cupcheck")
+
+
+def _interrupted(who: str) -> int:
+    print(f"{who}: interrupted", file=sys.stderr)
+    return 130
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
-    args, unknown = parser.parse_known_args(argv)
+    given = list(sys.argv[1:] if argv is None else argv)
+    if not given:                            # bare `cupcheck`: what it can do
+        parser.print_help()
+        return 0
+    args, unknown = parser.parse_known_args(given)
     if unknown:                              # said by the subcommand, not by `cupcheck`
         args._parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     if hasattr(signal, "SIGXFSZ"):           # a file-size limit: an OSError to report, not a kill
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     try:
         from validation.output import check_option_values
-        check_option_values(list(sys.argv[1:] if argv is None else argv))
+        check_option_values(given)
         return int(args._run(args) or 0)
     except OSError as exc:                   # a full disk, a read-only directory, a size limit
         where = f" ('{exc.filename}')" if exc.filename else ""
@@ -80,8 +116,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"cupcheck {args.command}: failed: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print(f"cupcheck {args.command}: interrupted", file=sys.stderr)
-        return 130
+        return _interrupted(f"cupcheck {args.command}")
 
 
 def _one_line(message: str) -> str:

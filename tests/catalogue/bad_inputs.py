@@ -373,3 +373,90 @@ case("output path", ["stiffness", "--out", "{d}/mycup.csv"], "--out's sidecar: '
 # (/dev/null as --out: tests/test_output_paths.py, which also checks that it is left untouched)
 case("stiffness CSV: header only", LIFE + ["--stiffness", "{d}/c.csv"],
      "stiffness: '{d}/c.csv' has no rows; a stiffness curve needs at least 2 samples", **{"c.csv": "u_mm,h_mm,F0_N\n"})
+
+# ------------------------------------------------------------------ plausibility at every entry (validation.guards)
+# a design file read by the command line: lengths in um named as the slip, before the wall is built
+case("design file: thickness table in um", GEO, "g.toml: thickness.r_mm[0] = 5000: did you give um?",
+     **{"g.toml": "[thickness]\nr_mm = [5000, 22000]\nd_mm = [2000, 500]\n"})
+case("design file: wall thickness in um", GEO, "g.toml: thickness.d_mm[0] = 2000: did you give um?",
+     **{"g.toml": "r1_mm = 22\n[thickness]\nr_mm = [5, 22]\nd_mm = [2000, 500]\n"})
+# the same guards from a scene file, named by the scene's key path
+_CURVE_SCENE = "[cup]\ngeometry = \"g.toml\"\n[stiffness]\nfidelity = \"coarse\"\n[[outputs]]\nkind = \"curve\"\n"
+_LIFE_SCENE = "[stiffness]\nsource = \"appendix-a\"\n[[outputs]]\nkind = \"lifetimes\"\n"
+for label, design, expected in [
+    ("radii in um", "r0_mm = 5000\nr1_mm = 19000\n", "cup.geometry (g.toml): r0_mm = 5000: did you give um?"),
+    ("thickness table in um", "[thickness]\nr_mm = [5000, 22000]\nd_mm = [2000, 500]\n",
+     "cup.geometry (g.toml): thickness.r_mm[0] = 5000: did you give um?"),
+    ("steep cone", "alpha_deg = 85\n", "cup.geometry (g.toml): alpha_deg = 85 is outside 5 .. 80 deg (a tube"),
+    ("slender wall", "r1_mm = 50\nalpha_deg = 45\n[thickness]\nr_mm = [5, 50]\nd_mm = [0.1, 0.1]\n",
+     "set cup.allow_unusual_design = true"),
+]:
+    case(f"scene file: design {label}", RUN, expected, **{"s.toml": _CURVE_SCENE, "g.toml": design})
+for label, table, expected in [
+    ("modulus in GPa", "[material]\nE_MPa = 0.001\n", "material.E_MPa = 0.001: did you give GPa?"),
+    ("modulus in Pa", "[material]\nE_MPa = 4e6\n", "material.E_MPa = 4e+06: did you give Pa?"),
+    ("tiny force", "[loads]\nF1_N = [1e-300]\n", "loads.F1_N = 1e-300 (plausible: 1e-06 .. 100000 N)"),
+    ("force in mN", "[loads]\nF1_N = [5, 1e4, 2e5]\n", "loads.F1_N[2] = 2e+05: did you give mN?"),
+    ("unusual flag not a boolean", "[cup]\nallow_unusual_design = \"yes\"\n",
+     "cup.allow_unusual_design: expected true or false"),
+]:
+    case(f"scene file: {label}", RUN, expected, **{"s.toml": table + _LIFE_SCENE})
+case("scene file: u_c table in um", RUN, "surface.uc_table: u_c_m at p_over_E = 0.0001 = 2: did you give um",
+     **{"s.toml": "[surface]\nuc_table = \"u.csv\"\n" + _LIFE_SCENE,
+        "u.csv": "p_over_E,u_c_m\n1e-4,2\n1e-3,1\n1e-2,0.5\n1e-1,0.1\n"})
+case("scene file: u_c table unreadable", RUN, "surface.uc_table: p_over_E",
+     **{"s.toml": "[surface]\nuc_table = \"u.csv\"\n" + _LIFE_SCENE, "u.csv": "p_over_E,u_c_m\n1e-4,2e-6\n"})
+# a stiffness curve against the cup it is used for
+_U_CURVE = "u_mm,F0_N\n" + "".join(f"{u},{f}\n" for u, f in ((0, 0), (1, 2.5), (2, 4), (4, 5.5), (8, 14)))
+case("stiffness CSV: u in um", LIFE + ["--cup", "A", "--stiffness", "{d}/c.csv"],
+     "--stiffness '{d}/c.csv': u_mm runs to 4000 mm, beyond the cup's height h1 = 9.092 mm (the plate stops "
+     "at u = h1): did you give um?", **{"c.csv": _U_CURVE.replace("\n8,", "\n4000,").replace("\n4,", "\n3000,")
+                                       .replace("\n2,", "\n2000,").replace("\n1,", "\n1000,")})
+case("stiffness CSV: modulus against its sidecar", LIFE + ["--cup", "A", "--stiffness", "{d}/c.csv", "--E-MPa", "10"],
+     "--E-MPa = 10 MPa, but --stiffness '{d}/c.csv' was computed with E = 4 MPa (its sidecar)",
+     **{"c.csv": _U_CURVE, "c.json": _json.dumps({"provenance": {"material": {"E_Pa": 4e6, "nu": 0.49}}})})
+case("CLI option", LIFE + ["--force", "1e-300"], "--force = 1e-300 (plausible: 1e-06 .. 100000 N)")
+
+# ------------------------------------------------------------------ sweep semantics and guards
+_AXES8 = "".join(f"[[axes]]\nname = \"{name}\"\nvalues = [{', '.join(f'{lo + k * step:g}' for k in range(10))}]\n"
+                 for name, lo, step in (("alpha_deg", 20, 2), ("r0_mm", 3, 1), ("r1_mm", 15, 1), ("d0_mm", 1, 0.1),
+                                        ("d1_mm", 0.2, 0.04), ("E_MPa", 1, 1), ("nu", 0.3, 0.02),
+                                        ("r_start_mm", 10, 0.4)))
+for label, text, expected in [
+    ("duplicate axis value", "[[axes]]\nname = \"alpha_deg\"\nvalues = [30, 33, 30]\n",
+     "axes[0].values[2]: 30.0 appears twice on the axis alpha_deg"),
+    ("duplicate surface value", "[[axes]]\nname = \"surface\"\nvalues = [\"pmma-1.89\", \"pmma-1.89\"]\n",
+     "axes[0].values[1]: 'pmma-1.89' appears twice"),
+    ("duplicate force", "[base]\nF1_N = [10, 10.0]\n", "base.F1_N: 10 appears twice"),
+    ("empty force list", "[base]\nF1_N = []\n", "base.F1_N: expected at least one value"),
+    ("unknown base surface", "[base]\nsurface = \"glass\"\n", "base.surface: unknown surface preset 'glass'"),
+    ("unknown surface on an axis", "[[axes]]\nname = \"surface\"\nvalues = [\"pmma-1.89\", \"glass\"]\n",
+     "axes[0].values[1]: unknown surface preset 'glass'"),
+    ("grid too large", _AXES8, "axes: the grid has 10 x 10 x 10 x 10 x 10 x 10 x 10 x 10 = 1e+08 designs"),
+    ("radius in um on an axis", "[[axes]]\nname = \"r1_mm\"\nvalues = [19, 19000]\n",
+     "axes[0].values[1] = 1.9e+04: did you give um?"),
+    ("thickness in um", "[base]\nd0_mm = 2500\n", "base.d0_mm = 2500: did you give um?"),
+    ("modulus in Pa", "[base]\nE_MPa = 4e6\n", "base.E_MPa = 4e+06: did you give Pa?"),
+    ("modulus bound in Pa", "[sampling]\nmethod = \"lhs\"\nn = 4\n[[axes]]\nname = \"E_MPa\"\nlow = 1\nhigh = 4e6\n",
+     "axes[0].high = 4e+06: did you give Pa?"),
+    ("tiny force", "[base]\nF1_N = [1e-12]\n", "base.F1_N = 1e-12 (plausible"),
+]:
+    case(f"sweep file: {label}", SWEEP, expected, **{"s.toml": text})
+case("sweep file: its scene's modulus", SWEEP, "material.E_MPa = 0.001: did you give GPa?",
+     **{"s.toml": "scene = \"b.toml\"\n", "b.toml": "[material]\nE_MPa = 0.001\n[[outputs]]\nkind = \"lifetimes\"\n"})
+# the start radius, named as written (it was r_start_m, in metres, after the work had started)
+case("scene file: start radius outside the wall", RUN, "loads.r_start_mm = 3 (the start radius must lie in (r0, r1) = (5, 19) mm)",
+     **{"s.toml": "[loads]\nr_start_mm = 3\n" + _LIFE_SCENE})
+case("scene file: start radius in um", RUN, "loads.r_start_mm = 1.2e+04: did you give um?",
+     **{"s.toml": "[loads]\nr_start_mm = 12000\n" + _LIFE_SCENE})
+case("scene file: swept start radius in m", RUN, "sweep.values[1] = 0.012: did you give m?",
+     **{"s.toml": "[sweep]\nkey = \"loads.r_start_mm\"\nvalues = [10, 0.012]\n" + _LIFE_SCENE})
+case("sweep file: start radius outside the wall", SWEEP, "base.r_start_mm = 3 (the start radius must lie in (r0, r1)",
+     **{"s.toml": "[base]\nr_start_mm = 3\n"})
+case("sweep file: start radius on an axis", SWEEP, "axes[0].values[2] = 30 (the start radius must lie in",
+     **{"s.toml": "[[axes]]\nname = \"r_start_mm\"\nvalues = [10, 12, 30]\n"})
+for command in (["lifetime", "--geometry", "{d}/g.toml", "--out", "{d}/out"],
+                ["example", "--geometry", "{d}/g.toml", "--out", "{d}/out"],
+                ["suction", "--geometry", "{d}/g.toml", "--out", "{d}/out/s.json"]):
+    case("design file: thickness table in um", command, "g.toml: thickness.r_mm[0] = 5000: did you give um?",
+         **{"g.toml": "[thickness]\nr_mm = [5000, 22000]\nd_mm = [2000, 500]\n"})

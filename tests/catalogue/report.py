@@ -67,6 +67,19 @@ a hump in C_1D); `spectrum.isotropic_misfit` measures it by the forward transfor
 0, a 5 % Gaussian hump 6 % and 0.6 decades. A line scan carries it (`PowerSpectrum.misfit`, its
 provenance), says it in one line where C_1D is missed anywhere, and is refused above 25 %.
 
+## One guard for every entry, and interrupts (tests/test_guards.py, tests/test_defaults.py)
+
+- The command line, scene files, sweep files and design files pass the same plausibility guards
+  (`validation/guards.py`), named by the key path the user wrote, before any FEM work: the
+  catalogue's scene, sweep and design-file rows above; real cups (Table 1, a design in mm, a curve
+  used at its own modulus) pass.
+- Two sweeps on one store: the second is refused at once (exit 2, one line; an OS file lock in the
+  store, `validation.sweeps.spec.lock_store`) and computes nothing.
+- Ctrl-C on a real `cupcheck run` at 0 .. 1.5 s from cupcheck's first line, and on a real sweep's
+  process group (dask workers included): one line, exit status 130, no output left.
+- Library warnings (numpy, scipy, joblib, dask) never reach the terminal; a scene runs from a
+  read-only working directory (its cache is the user's).
+
 ## Properties (tests/test_properties.py, hypothesis, derandomized)
 
 - Random bytes and valid-ish CSVs into the stiffness, u_c, relaxation, PSD and line-scan readers,

@@ -126,8 +126,9 @@ def contact_choice(args: argparse.Namespace, design: Design | None = None) -> Co
 
 def load_cup_design(args: argparse.Namespace) -> Design:
     """The design of --geometry FILE (on top of --cup), or the --cup preset (cup A) without a file."""
-    from fem.geometry import Design, cup_geometry, load_design
+    from fem.geometry import Design, cup_geometry
+    from validation.guards import load_design as guarded_design
 
     if args.geometry is not None:
-        return load_design(args.geometry, cup=args.cup or "A")
+        return guarded_design(args.geometry, cup=args.cup or "A", allow_unusual=args.allow_unusual_design)
     return Design(cup_geometry(args.cup or "A"))

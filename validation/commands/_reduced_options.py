@@ -1,5 +1,7 @@
 """The reduced model's options shared by the routes of `cupcheck lifetime`: the critical gap
-u_c(p/E) the surface options ask for, the run options every route checks, and --relaxation."""
+u_c(p/E) the surface options ask for (without any, the calibrated `pipeline.DEFAULT_SURFACE`, as in
+`example` and the scenes; the ILLUSTRATIVE table only as ``--surface illustrative``), the run
+options every route checks, and --relaxation."""
 
 from __future__ import annotations
 
@@ -9,13 +11,21 @@ from collections.abc import Callable
 
 from validation.commands._surface import has_surface, spectrum_from_args
 
-__all__ = ["build_uc", "check_run_options", "relaxation_law"]
+__all__ = ["build_uc", "check_run_options", "relaxation_law", "ILLUSTRATIVE"]
+
+#: the --surface name of the ILLUSTRATIVE u_c table in reduced/data (a power law, not Persson theory)
+ILLUSTRATIVE = "illustrative"
 
 
 def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
     """The critical gap u_c(p/E) [m] the options ask for (the one place that builds it)."""
     from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
     from validation.guards import check_spectrum, check_uc_table
+    from validation.pipeline import DEFAULT_SURFACE
+    if args.surface == ILLUSTRATIVE:                  # asked for by name only
+        return UcTable.from_csv(ILLUSTRATIVE_UC_CSV)
+    if not has_surface(args) and args.uc_table is None:
+        args.surface = DEFAULT_SURFACE                # the one default surface of every command
     if has_surface(args):
         from reduced.roughness import uc_table
         from reduced.roughness.persson import check_gap_parameters, effective_modulus
@@ -25,7 +35,7 @@ def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
         spectrum = spectrum_from_args(args)
         check_spectrum(spectrum.h_rms_m(), "surface")
         return uc_table(spectrum, args.nu, method=args.uc_method, gamma=args.gamma, a_c=args.a_c)
-    table = UcTable.from_csv(args.uc_table if args.uc_table else ILLUSTRATIVE_UC_CSV)
+    table = UcTable.from_csv(args.uc_table)
     check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
     return table
 
@@ -33,9 +43,8 @@ def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
 def check_run_options(args: argparse.Namespace) -> None:
     """The options every route checks before its model: the forces, the integration's t_max and
     rtol, and kappa (ValueError naming the option)."""
-    for F in args.force_N:
-        if not (math.isfinite(F) and F > 0):
-            raise ValueError(f"--force: pull force must be > 0 N, got {F:g}")
+    from validation.guards import check_forces
+    check_forces(args.force_N, "--force")
     if not (args.t_max_s > 0 and 0 < args.rtol < 1e-2):
         raise ValueError("--t-max-s, --rtol: need t_max > 0 s and 0 < rtol < 0.01")
     if not (math.isfinite(args.kappa) and args.kappa > 0):

@@ -14,13 +14,16 @@ import warnings
 def add_surface_arguments(parser: argparse.ArgumentParser, group=None) -> None:
     """--surface | --psd | --line-scan (mutually exclusive), --psd-convention, --tip-radius-um."""
     src = group if group is not None else parser.add_mutually_exclusive_group()
-    src.add_argument("--surface", metavar="NAME", help="calibrated preset (see `cupcheck uc --list-surfaces`)")
+    src.add_argument("--surface", metavar="NAME",
+                     help="calibrated preset (see `cupcheck uc --list-surfaces`); for `lifetime`, "
+                          "pmma-1.89 when no surface or table is given, and `illustrative` the "
+                          "power-law u_c table of reduced/data (not a rough-contact result)")
     src.add_argument("--psd", metavar="FILE", help="isotropic C(q) CSV, columns q_per_m,C_m4 [1/m, m^4]")
     src.add_argument("--line-scan", metavar="FILE",
                      help="line scan CSV, header x_<unit>,z_<unit> (unit m, mm, um or nm)")
     parser.add_argument("--psd-convention", default="persson-2d",
                         choices=("persson-2d", "surfacetopography-2d"),
-                        help="normalisation of --psd: persson-2d (default) or surfacetopography-2d")
+                        help="normalisation of --psd: persson-2d or surfacetopography-2d (default: persson-2d)")
     parser.add_argument("--tip-radius-um", type=float, default=1.0,
                         help="stylus tip radius for --line-scan [um] (default 1, the paper's)")
 

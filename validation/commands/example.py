@@ -10,9 +10,10 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
    theory, EMT, nu = 0.5), the surface of the paper's Figs. for cup A.
 3. Reduced model (Sec. 3-4) in reference conventions (no relaxation, E = 4 MPa in p/E, air at
    293.15 K, p_a = 1e5 Pa), by the chosen route:
-   - paper (default): F0(h) from step 1, r, V, l from the cone laws (3)-(5) with Table 1's l0, l1
+   - profile (the default, as in the main job): F0, r_c, V from the FEM curve, the leak through
+     its contact-pressure profiles;
+   - paper: F0(h) from step 1, r, V, l from the cone laws (3)-(5) with Table 1's l0, l1
      (--cup-laws curve takes them from the FEM instead), the leak through eq (6)'s uniform strip;
-   - profile: F0, r_c, V from the FEM curve, the leak through its contact-pressure profiles;
    - coupled: the FEM cup under the cavity's suction on a (u, dp) grid (`cupcheck suction`,
      built here and cached in --cache-dir, or read from --suction-table): F1, V and the profile of
      every state from the FEM, replacing eqs (3)-(7) and beta (`reduced.coupled`). Building the
@@ -36,6 +37,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from validation.cache import user_cache_dir
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
                                       contact_choice, load_cup_design, route_model)
 
@@ -64,8 +66,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     c.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
                    help="the design's table from `cupcheck suction` (default: built at --fidelity "
                         "with --contact and cached)")
-    c.add_argument("--cache-dir", type=Path, default=Path(".cupcheck-cache/suction"), metavar="DIR",
-                   help="where built suction tables are kept (default .cupcheck-cache/suction)")
+    c.add_argument("--cache-dir", type=Path, default=user_cache_dir("suction"), metavar="DIR",
+                   help="where built suction tables are kept (default: %(default)s, the user's cache; "
+                        "$CUPCHECK_CACHE_DIR moves it)")
     c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
     src = p.add_mutually_exclusive_group()
     src.add_argument("--surface", default=None, metavar="NAME",

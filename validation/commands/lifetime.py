@@ -9,8 +9,10 @@ stiffness (x0 = r0, x1 = r1, d0 = 2 mm, d1 = 0, E = 4 MPa), no relaxation (E = 4
 p/E), air at 293.15 K (eta = 1.81e-5 Pa s, m = 28.97 u), p_a = 1e5 Pa, rigid-cone geometry
 (eqs 3-5), u_c from the table by log-log interpolation.
 
-Without --uc-table the ILLUSTRATIVE u_c table shipped in reduced/data is used (a power law through
-the paper's 0.68 um at p/E = 0.025; not a rough-contact result).
+The critical gap u_c(p/E) comes from the calibrated surface pmma-1.89 (sandblasted PMMA, 1.89 um
+rms: Persson theory, EMT) unless --surface, --psd, --line-scan or --uc-table names another, as in
+`cupcheck example` and the scenes. --surface illustrative takes the ILLUSTRATIVE table shipped in
+reduced/data (a power law through the paper's 0.68 um at p/E = 0.025; not a rough-contact result).
 """
 
 from __future__ import annotations
@@ -22,8 +24,8 @@ import sys
 from pathlib import Path
 
 from validation.commands._cup import add_cup_arguments, add_cup_law_arguments, route_model
-from validation.commands._reduced_options import build_uc, check_run_options, relaxation_law
-from validation.commands._surface import add_surface_arguments, has_surface
+from validation.commands._reduced_options import ILLUSTRATIVE, build_uc, check_run_options, relaxation_law
+from validation.commands._surface import add_surface_arguments
 
 NAME = "lifetime"
 HELP = "lifetime of a suction cup under pull forces (reduced leakage model, eqs 3-24)"
@@ -54,7 +56,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     src = p.add_mutually_exclusive_group()
     src.add_argument("--uc-table", default=None, metavar="FILE.csv",
                      help="critical gap table, columns p_over_E,u_c_m (u_c in m; 0 = sealed) "
-                          "(default without a surface: the ILLUSTRATIVE table in reduced/data)")
+                          "(default: the surface pmma-1.89)")
     add_surface_arguments(p, src)
     p.add_argument("--uc-method", default="emt", choices=("emt", "critical-junction"),
                    help="with a surface: u_c route of Persson theory (default: emt, as in the paper)")
@@ -109,13 +111,14 @@ def build_model(args: argparse.Namespace):
     from reduced.appendix_a import appendix_a_curve
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel, largest_holdable_force, reference_model
-    from validation.guards import check_design, check_modulus
+    from validation.guards import check_design, check_modulus, check_stiffness_curve
 
     check_run_options(args)
     check_modulus(args.E_MPa, "--E-MPa")
     geometry, seal = route_model(args)
     curve, choice = _curve_and_cup(args)
     check_design(choice.design, args.allow_unusual_design, source=choice.label)
+    check_stiffness_curve(curve, choice.design["h1_mm"], f"--stiffness '{args.stiffness}'", args.E_MPa)
     args.cup_choice = choice
     cup = choice.cup
     uc = build_uc(args)
@@ -221,7 +224,7 @@ def run(args: argparse.Namespace) -> int:
     cup = {**choice.describe(), "laws": args.cup_laws, "route": args.route}
     for note in choice.notes:
         print(f"note: {note}", file=sys.stderr)
-    if args.uc_table is None and not has_surface(args) and not args.json:
+    if args.surface == ILLUSTRATIVE and not args.json:
         print("note: using the ILLUSTRATIVE u_c table (reduced/data/uc_illustrative.csv)", file=sys.stderr)
     # a reference-mode lifetime takes milliseconds, a relaxed one ~0.1 s: report only long sweeps
     cost = len(args.force_N) * (1 if model.reference else 30)

@@ -2,8 +2,9 @@
 
 Writes the scene's outputs into DIR atomically, with DIR/manifest.json (every file written with
 its name and kind, the scene as resolved with its defaults, software versions and timings).
-Products are cached on disk (--cache-dir, default .cupcheck-cache/scenes): a second run of the
-same scene computes nothing; --no-cache computes everything afresh.
+Products are cached on disk, in the user's cache (--cache-dir; default the platform's cache directory,
+~/.cache/cupcheck/scenes on Linux, or $CUPCHECK_CACHE_DIR/scenes): a second run of the same scene
+computes nothing; --no-cache computes everything afresh.
 
 examples:
   cupcheck run scenes/lifetime_vs_force_cupA.toml --out out/lifetime
@@ -16,6 +17,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from validation.cache import CACHE_ENV, user_cache_dir
+
 NAME = "run"
 HELP = "run a scene file: the curves, lifetimes and figures it asks for (cached)"
 
@@ -23,8 +26,9 @@ HELP = "run a scene file: the curves, lifetimes and figures it asks for (cached)
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scene", type=Path, metavar="SCENE.toml", help="the scene file")
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (written atomically)")
-    p.add_argument("--cache-dir", type=Path, default=Path(".cupcheck-cache/scenes"), metavar="DIR",
-                   help="where products are cached (default .cupcheck-cache/scenes)")
+    p.add_argument("--cache-dir", type=Path, default=user_cache_dir("scenes"), metavar="DIR",
+                   help=f"where products are cached (default: %(default)s, the user's cache; "
+                        f"${CACHE_ENV} moves it)")
     p.add_argument("--no-cache", action="store_true", help="compute every product afresh, cache nothing")
     p.add_argument("--quiet", action="store_true",
                    help="no progress bar (there is none either when stderr is not a terminal)")

@@ -1,9 +1,9 @@
 """Compute a cup's stiffness curve F0(h), r_c(h), l(h), V(h) with the axisymmetric finite-strain FEM.
 
 The cup's top plate is pressed onto the rigid plane z = 0 (displacement control, u from 0 to
---u-max-mm, default 0.9 h1); the wall is a compressible neo-Hookean solid, in frictionless or
-sticking contact with the plane. Writes the hand-off CSV (u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3; l is
-the force-quartile width of the sealing strip) and a JSON sidecar next to it (same name, .json) with the
+--u-max-mm, default 0.9 h1); the wall is a compressible neo-Hookean solid, in frictionless,
+sticking or Coulomb-friction contact with the plane (--contact, --friction). Writes the hand-off
+CSV (u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3; l is the force-quartile width of the sealing strip) and a JSON sidecar next to it (same name, .json) with the
 provenance, the solver statistics and per step the contact-pressure profile p(r), the instability
 flags and the other widths (lengths in mm). All files appear together or not at all.
 

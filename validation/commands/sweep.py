@@ -41,7 +41,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from validation.sweeps.execute import pending_designs, run_sweep
     from validation.sweeps.figures import sweep_figures
-    from validation.sweeps.spec import load_sweep
+    from validation.sweeps.spec import load_sweep, lock_store
+    import dask
+    from validation.sweeps.worker import PRELOAD
 
     spec = load_sweep(args.sweep)
     from validation.output import check_outputs, command_inputs
@@ -50,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers: must be in [1, 256], got {args.workers}")
     if args.out.exists() and not args.out.is_dir():
         raise ValueError(f"--out: '{args.out}' exists and is not a directory")
+    store_lock = lock_store(args.out)  # noqa: F841 (held until run returns: one sweep per store)
     total = len(spec.designs())
     todo = len(pending_designs(spec, args.out, args.retry_failed)) if args.out.is_dir() else total
     print(f"sweep: {total} designs, {todo} to compute, {total - todo} already done", file=sys.stderr)
@@ -64,6 +67,7 @@ def run(args: argparse.Namespace) -> int:
             bar.update(1)
             bar.set_postfix(failed=failed, remaining=n - done)
 
+    dask.config.set(PRELOAD)             # the workers leave Ctrl-C to this process (one line)
     result = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler,
                        retry_failed=args.retry_failed, progress=progress)
     if bar is not None:

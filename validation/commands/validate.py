@@ -1,17 +1,18 @@
-"""Cross-check report (issue 5): Appendix A vs FEM, rigid-cone laws vs FEM, the lifetime consequence
+"""Cross-check report: Appendix A vs FEM, rigid-cone laws vs FEM, the lifetime consequence
 of the stiffness source, the speed-accuracy trade, and the extremes.
 
 Writes to DIR, atomically: README.md (all sections, tables inline), one CSV per table (units in the
 column names), PNG figures, and summary.json with the headline numbers (appendix_a_slope_N_per_mm,
 fem_slope_frictionless_N_per_mm, fem_slope_sticking_N_per_mm, ...). Every FEM run a section needs is
-declared up front and run once; --cache-dir keeps them between calls (keyed by the run and the fem
-sources). The report is written in full either way; the exit status is 1 when any of its checks
+declared up front and run once, and kept between calls in the user's cache (--cache-dir; default
+~/.cache/cupcheck/validate on Linux or $CUPCHECK_CACHE_DIR/validate; keyed by the run and the fem
+sources; --no-cache keeps nothing). The report is written in full either way; the exit status is 1 when any of its checks
 FAILs (the rows marked FAIL), 0 when all pass.
 
 examples:
   cupcheck validate --quick --out out/validate-quick            # the CI subset, ~1 min
   cupcheck validate --out validation/report                     # the full report, ~10 min on 2 cores
-  cupcheck validate --only appendix cone_laws --out out/v --cache-dir .cupcheck-cache
+  cupcheck validate --only appendix cone_laws --out out/v --no-cache
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+
+from validation.cache import user_cache_dir
 
 NAME = "validate"
 HELP = ("cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes, the paper's "
@@ -33,9 +36,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="a small representative subset (cup A only, coarse mesh, a few extremes)")
     p.add_argument("--only", nargs="+", metavar="SECTION",
                    help=f"run only these sections: {', '.join(section_names())} (default: all)")
-    p.add_argument("--cache-dir", type=Path, metavar="DIR",
-                   help="keep FEM runs on disk between calls (e.g. .cupcheck-cache, gitignored); "
-                        "default: no disk cache")
+    p.add_argument("--cache-dir", type=Path, default=user_cache_dir("validate"), metavar="DIR",
+                   help="where FEM runs are kept between calls (default: %(default)s, the user's cache; "
+                        "$CUPCHECK_CACHE_DIR moves it)")
+    p.add_argument("--no-cache", action="store_true", help="compute every FEM run afresh, keep nothing")
     p.add_argument("--no-scene", action="store_true", help="skip the pyvista scene of the deformed cup")
 
 
@@ -49,10 +53,10 @@ def run(args: argparse.Namespace) -> int:
 
     plan = planned_requests(args.quick, args.only)          # validates --only before any work
     from validation.output import check_outputs, command_inputs
-    check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
+    check_outputs(directories={"--out": args.out}, stores={"--cache-dir": None if args.no_cache else args.cache_dir}, inputs=command_inputs(args))
     if args.out.exists() and not args.out.is_dir():
         raise ValueError(f"--out: {args.out} exists and is not a directory")
-    memo = RunMemo(cache_dir=args.cache_dir)
+    memo = RunMemo(cache_dir=None if args.no_cache else args.cache_dir)
     print(f"validate: {len(plan)} FEM runs planned ({'quick' if args.quick else 'full'})")
     with atomic_directory(args.out) as tmp:
         report = run_validation(tmp, quick=args.quick, only=args.only, memo=memo, scene=not args.no_scene,

@@ -12,6 +12,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
+from validation.cache import user_cache_dir
 from validation.scenes.outputs import run_scene
 from validation.scenes.schema import load_scene
 
@@ -25,14 +26,14 @@ def main() -> None:
     images.mkdir(exist_ok=True)
     lines = ["# Scene gallery", "",
              "Each shipped scene, its animation or first image and the command that made it (regenerate this page with",
-             "`python -m validation.scenes.gallery`). Scene keys: `validation/scenes/schema.py`. Cold and warm run times",
+             "`python -m validation.scenes.gallery`). Scene keys: `docs/scenes.md`. Cold and warm run times",
              "of every scene: the README (`python benchmarks/bench_scenes.py`).", ""]
     for scene_path in sorted(args.scenes.glob("*.toml")):
         if scene_path.name.startswith("sweep_"):
             continue
         scene = load_scene(scene_path)
         with tempfile.TemporaryDirectory() as tmp:
-            cache = None if args.no_cache else Path(".cupcheck-cache/scenes")
+            cache = None if args.no_cache else user_cache_dir("scenes")
             result = run_scene(scene, Path(tmp) / "out", cache_dir=cache)
             paths = [Path(f["path"]) for f in result.files]
             image = next((p for p in paths if p.suffix == ".gif"), None) or \

@@ -1,39 +1,18 @@
 """The scene file: what to model and what to show, validated before any work.
 
-    [cup]            preset = "A" | geometry = "my_cup.toml"        (one of them)
-    [material]       E_MPa = 4.0, nu = 0.49, relaxation = "none" | "default"
-    [contact]        law = "frictionless" | "sticking" | "coulomb", friction = MU (Coulomb's mu in
-                     [0, 100], with law = "coulomb" only, which needs it); without a law, the design
-                     file's [contact] table (cup.geometry) if it has one, else frictionless
-    [surface]        preset = "pmma-1.89" | uc_table = "uc.csv"     (one of them)
-    [fluid]          kind = "air" | "water"
-    [loads]          F1_N = [5, 10, 20], r_start_mm = 12 (optional), kappa = 1.0
-    [stiffness]      source = "fem" | "appendix-a", route = "paper" | "profile",
-                     fidelity = "coarse" | "medium" | "fine"
-    [sweep]          key = "loads.kappa" | "loads.r_start_mm" | "surface.preset" | "cup.preset"
-                     | "contact.friction" (with law = "coulomb"),
-                     values = [...]                  (optional: one parameter varied for a figure)
-    [[outputs]]      kind = "curve" | "lifetimes" | "trajectories" | "figure"
-                     name = "..." (file stem), figure = "lifetime_vs_force" | "uc_vs_pressure" | "F0_vs_u"
-                     | "lifetime_vs_parameter" (needs [sweep]: one line per F1) | "r_pb_vs_time" (r(t),
-                     p_b(t)) | "p_Ndot_vs_time" (p(t), Ndot(t)): one line per F1; uc_vs_pressure and F0_vs_u
-                     with a [sweep] of surface.preset or cup.preset draw one line per value
-                     kind = "render" with u_mm = 3: the revolved deformed FEM cup at u, cut open and
-                     coloured by field = "contact_pressure" (default) | "von_mises" | "min_stretch"
-                     (pyvista off-screen; the FEM runs only to u)
-                     kind = "footprint" with u_mm: the contact seen from below through the substrate
-                     (the sealing annulus), at a fixed scale (the pixel size in the manifest)
-                     kind = "squeeze" with u_mm (the last frame) and frames = N (2 .. 60), field:
-                     N frames from u = 0 to u_mm (PNG) and their animated GIF
+    [cup] [material] [contact] [surface] [fluid] [loads] [stiffness]    what to model
+    [sweep]                                                               one parameter varied
+    [[outputs]]     kind = curve | lifetimes | trajectories | figure | render | footprint | squeeze
 
-Every table and key is optional but `outputs`; defaults: cup A, frictionless FEM at the
-coarse level, the paper's route, pmma-1.89, air, F1 = 5, 10, 20, 40, 80 N (the main job,
-scenes/main.toml, sets the medium level and F1 = 5, 10, ..., 80 N). Unknown keys, wrong
-types and contradictions are ValueErrors naming the key path (``outputs[2].kind: expected one of
-...``): one line and exit status 2 on the command line, before anything is computed or written.
-Paths in the scene are relative to the scene file. The contact law and mu are checked by
-`fem.interface` (imported only for a scene that names mu, coulomb or a design file: a scene of the
-reduced model alone imports no fem); `Scene.contact_source` says where the law came from.
+Every key, its default and allowed values live once, in the tables below (`_TABLES`, `_CHOICES`,
+`OUTPUT_KEYS`) with their meaning (`MEANING`); docs/scenes.md is generated from them
+(``python scripts/keys_docs.py``). Every table and key is optional but `outputs`. Unknown keys,
+wrong types, implausible values (the shared guards of `validation.guards`, named by key path) and
+contradictions are ValueErrors naming the key path (``outputs[2].kind: expected one of ...``):
+one line and exit status 2 on the command line, before anything is computed or written. Paths in
+the scene are relative to the scene file. The contact law and mu are checked by `fem.interface`
+(imported only for a scene that names mu, coulomb or a design file: a scene of the reduced model
+alone imports no fem); `Scene.contact_source` says where the law came from.
 """
 
 from __future__ import annotations
@@ -45,7 +24,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES"]
+from validation.pipeline import DEFAULT_SURFACE
+
+__all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES", "key_rows"]
 
 OUTPUT_KINDS = ("curve", "lifetimes", "trajectories", "figure", "render", "footprint", "squeeze")
 #: the output kinds drawn from FEM states at given plate displacements (they need u_mm)
@@ -56,10 +37,10 @@ FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parame
            "p_Ndot_vs_time")
 SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset", "contact.friction")
 _TABLES: dict[str, dict[str, Any]] = {
-    "cup": {"preset": "A", "geometry": None},
+    "cup": {"preset": "A", "geometry": None, "allow_unusual_design": False},
     "material": {"E_MPa": 4.0, "nu": 0.49, "relaxation": "none"},
     "contact": {"law": "frictionless", "friction": None},
-    "surface": {"preset": "pmma-1.89", "uc_table": None},
+    "surface": {"preset": DEFAULT_SURFACE, "uc_table": None},
     "fluid": {"kind": "air"},
     "loads": {"F1_N": [5.0, 10.0, 20.0, 40.0, 80.0], "r_start_mm": None, "kappa": 1.0},
     "stiffness": {"source": "fem", "route": "paper", "fidelity": "coarse"},
@@ -68,6 +49,62 @@ _CHOICES = {("cup", "preset"): ("A", "B"), ("material", "relaxation"): ("none", 
             ("contact", "law"): ("frictionless", "sticking", "coulomb"), ("fluid", "kind"): ("air", "water"),
             ("stiffness", "source"): ("fem", "appendix-a"), ("stiffness", "route"): ("paper", "profile"),
             ("stiffness", "fidelity"): ("coarse", "medium", "fine")}
+
+
+#: what each key means (docs/scenes.md is generated from this, `_TABLES` and `_CHOICES`:
+#: ``python scripts/keys_docs.py``)
+MEANING: dict[str, str] = {
+    "cup.preset": "Table 1 cup the design starts from (A: alpha 33 deg; B: 21 deg)",
+    "cup.geometry": "a design file (.toml or .json, the keys of `cupcheck stiffness --geometry`), relative to "
+                    "the scene file; its [contact] table sets the law unless contact.law is given",
+    "cup.allow_unusual_design": "true: a cone angle outside 5..80 deg or a wall more than 400x longer than thick "
+                                "is run, not refused",
+    "material.E_MPa": "Young's modulus [MPa] of the wall (and of p/E)",
+    "material.nu": "Poisson's ratio, in [0, 0.5)",
+    "material.relaxation": "none, or the default power-law relaxation modulus (4.4 MPa at 1 s, 1.8 MPa at 3e4 s)",
+    "contact.law": "the FEM's contact with the plane (default: the design file's [contact] law, else frictionless)",
+    "contact.friction": "Coulomb's mu, in [0, 100]: with law = \"coulomb\" only, which needs it",
+    "surface.preset": "calibrated rough surface for u_c(p/E) (`cupcheck uc --list-surfaces`)",
+    "surface.uc_table": "a u_c table CSV (columns p_over_E,u_c_m; u_c in m) instead of the preset",
+    "fluid.kind": "what fills the cavity and leaks in",
+    "loads.F1_N": "pull forces F1 [N]: one lifetime (and trajectory) per force",
+    "loads.r_start_mm": "start radius of the contact [mm] (default: Table 1's 12 mm for A and B, mid-wall otherwise)",
+    "loads.kappa": "stiffness factor: F0 replaced by kappa F0 (the paper's Fig. 1stiffnessFactor)",
+    "stiffness.source": "F0(h) from the FEM or from Appendix A's formula",
+    "stiffness.route": "how the FEM reaches the lifetime (README, Routes): eq (6)'s strip on the cone, or the "
+                       "FEM's contact-pressure profile (needs source = \"fem\")",
+    "stiffness.fidelity": "FEM mesh level",
+    "sweep.key": "the one parameter varied (contact.friction with law = \"coulomb\")",
+    "sweep.values": "its values, each once: one lifetime table row per value and force",
+    "outputs[].kind": "what to write: a stiffness curve, lifetimes, trajectories, a figure, or a 3D view "
+                      "(render, footprint, squeeze: drawn from FEM states at u_mm)",
+    "outputs[].name": "file stem (default: the figure's name, else the kind)",
+    "outputs[].figure": "with kind = \"figure\": which figure (lifetime_vs_parameter needs [sweep]; "
+                        "uc_vs_pressure and F0_vs_u draw one line per swept surface or cup)",
+    "outputs[].u_mm": "with render, footprint, squeeze (and only them): the plate displacement shown [mm]",
+    "outputs[].field": "with render, squeeze: the colouring",
+    "outputs[].frames": "with squeeze: the number of frames from u = 0 to u_mm",
+}
+#: the [[outputs]] keys: (default, allowed) as the parser applies them
+OUTPUT_KEYS: dict[str, tuple[Any, str]] = {
+    "kind": (None, ", ".join(OUTPUT_KINDS)), "name": (None, "a plain file stem"),
+    "figure": (None, ", ".join(FIGURES)), "u_mm": (None, "> 0"),
+    "field": ("contact_pressure", ", ".join(FIELDS)), "frames": (8, f"2 .. {MAX_FRAMES}"),
+}
+
+
+def key_rows() -> list[tuple[str, Any, str, str]]:
+    """(key path, default, allowed values, meaning) of every scene key, from the parser's own tables."""
+    rows = []
+    for table, keys in _TABLES.items():
+        for key, default in keys.items():
+            allowed = ", ".join(_CHOICES[(table, key)]) if (table, key) in _CHOICES else ""
+            rows.append((f"{table}.{key}", default, allowed, MEANING[f"{table}.{key}"]))
+    rows.append(("sweep.key", None, ", ".join(SWEEP_KEYS), MEANING["sweep.key"]))
+    rows.append(("sweep.values", None, "a non-empty list", MEANING["sweep.values"]))
+    for key, (default, allowed) in OUTPUT_KEYS.items():
+        rows.append((f"outputs[].{key}", default, allowed, MEANING[f"outputs[].{key}"]))
+    return rows
 
 
 @dataclass(frozen=True)
@@ -122,6 +159,7 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
         raise ValueError(f"{unknown[0]}: unknown table; allowed: {', '.join([*_TABLES, 'sweep', 'outputs'])}")
     tables = {name: _table(name, data.get(name, {}), defaults) for name, defaults in _TABLES.items()}
     _paths(tables, Path(base))
+    _guards(tables, data.get("sweep"))
     contact_source = _design_contact(tables, data.get("contact", {}), source)
     _cross_checks(tables, data.get("sweep"))
     outputs = data.get("outputs")
@@ -152,6 +190,9 @@ def _sweep(table: Any, tables: dict[str, dict[str, Any]]) -> dict[str, Any]:
         raise ValueError(f"sweep.key: expected one of {', '.join(SWEEP_KEYS)}, got {key!r}")
     if not isinstance(values, list) or not values:
         raise ValueError("sweep.values: expected a non-empty list")
+    twice = [j for j, v in enumerate(values) if v in values[:j]]
+    if twice:
+        raise ValueError(f"sweep.values[{twice[0]}]: {values[twice[0]]!r} appears twice; give each value once")
     name, field = key.split(".")
     if (name, field) in _CHOICES:
         bad = [v for v in values if v not in _CHOICES[(name, field)]]
@@ -160,6 +201,8 @@ def _sweep(table: Any, tables: dict[str, dict[str, Any]]) -> dict[str, Any]:
     elif field == "preset":
         if not all(isinstance(v, str) for v in values):
             raise ValueError("sweep.values: expected surface preset names")
+        for j, v in enumerate(values):
+            check_surface_preset(v, f"sweep.values[{j}]")
     elif key != "contact.friction":
         values = [_number(v, f"sweep.values[{i}]", positive=True) for i, v in enumerate(values)]
     if key == "contact.friction":
@@ -203,6 +246,49 @@ def _paths(tables: dict[str, dict[str, Any]], base: Path) -> None:
         if not path.is_file():
             raise ValueError(f"{name}.{key}: no such file '{path}'")
         tables[name][key] = str(path)
+
+
+def _guards(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
+    """The plausibility guards every entry point shares (`validation.guards`), named by key path:
+    the modulus, the pull forces, the design file's lengths and wall, the u_c table's gaps."""
+    from validation import guards
+
+    guards.check_modulus(tables["material"]["E_MPa"], "material.E_MPa")
+    guards.check_forces(tables["loads"]["F1_N"], "loads.F1_N")
+    cup = tables["cup"]
+    if not isinstance(cup["allow_unusual_design"], bool):
+        raise ValueError(f"cup.allow_unusual_design: expected true or false, got {cup['allow_unusual_design']!r}")
+    if cup["geometry"]:
+        design = guards.load_design(cup["geometry"], cup=cup["preset"], field="cup.geometry",
+                                    allow_unusual=cup["allow_unusual_design"],
+                                    override="set cup.allow_unusual_design = true").geometry
+        radii = (design.r0_m * 1e3, design.r1_m * 1e3)
+    else:
+        from reduced.cup import CUPS
+        radii = (CUPS[cup["preset"]].r0_m * 1e3, CUPS[cup["preset"]].r1_m * 1e3)
+    guards.check_start_radius(tables["loads"]["r_start_mm"], radii, "loads.r_start_mm")
+    if isinstance(sweep, Mapping) and sweep.get("key") == "loads.r_start_mm" and isinstance(sweep.get("values"), list):
+        for j, value in enumerate(sweep["values"]):
+            guards.check_start_radius(value, radii, f"sweep.values[{j}]")
+    if tables["surface"]["uc_table"]:
+        guards.check_uc_file(tables["surface"]["uc_table"], "surface.uc_table")
+    else:
+        check_surface_preset(tables["surface"]["preset"], "surface.preset")
+
+
+def check_surface_preset(name: Any, where: str) -> None:
+    """A calibrated surface preset's name (read from the presets' data file: importing the
+    roughness model would cost a scene that needs none of it 0.5 s)."""
+    import json
+
+    data = Path(__file__).resolve().parents[2] / "reduced" / "roughness" / "data" / "presets.json"
+    if data.is_file():
+        known = {d["name"] for d in json.loads(data.read_text(encoding="utf-8"))}
+    else:                                  # an unusual install: ask the package
+        from reduced.roughness.surfaces import load_presets
+        known = set(load_presets())
+    if name not in known:
+        raise ValueError(f"{where}: unknown surface preset {name!r}; choose one of {', '.join(sorted(known))}")
 
 
 def _friction(value: Any, where: str) -> float:

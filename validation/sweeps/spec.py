@@ -7,7 +7,7 @@
     d1_mm = 0.447
     E_MPa = 4.0
     nu = 0.49
-    contact = "sticking"            # frictionless | sticking | coulomb
+    contact = "sticking"            # frictionless (default, as everywhere) | sticking | coulomb
     # friction = 0.5                # Coulomb's mu in [0, 100]: with contact = "coulomb" only
     surface = "pmma-1.89"           # a calibrated preset (`cupcheck uc --list-surfaces`)
     fidelity = "coarse"             # FEM mesh level
@@ -31,6 +31,14 @@ keys in ``[base]`` then override the scene's. Axis names are the numeric base ke
 friction: with a coulomb base) and, on a grid, the categorical ones (contact, surface; a coulomb
 value takes the base's friction). Errors name the key path
 (``axes[1].name: expected one of ...``) and are ValueErrors (exit status 2 on the command line).
+
+Semantics checked here, before any FEM work: the plausibility guards every entry point shares
+(`validation.guards`: moduli, forces, radii and wall thicknesses, named by key path; a steep or
+slender design stays a failed row of its own, so one odd corner does not stop a sweep); a value
+given twice on one axis is refused (it would be one design twice, and a duplicate usually is a
+typo for another value); an empty force list and an unknown surface preset are refused; and a
+sweep of more than `MAX_DESIGNS` designs is refused (each design is an FEM path: a larger sweep is
+several sweeps). `lock_store` holds a sweep's store for one run at a time.
 """
 
 from __future__ import annotations
@@ -46,14 +54,22 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["SweepSpec", "load_sweep", "sweep_from_mapping", "NUMERIC_AXES", "design_hash"]
+from validation.pipeline import DEFAULT_SURFACE
+
+__all__ = ["SweepSpec", "load_sweep", "sweep_from_mapping", "NUMERIC_AXES", "design_hash", "MAX_DESIGNS",
+           "lock_store", "key_rows"]
+
+#: the largest sweep one run takes (a grid's product of axis lengths, or lhs/sobol's n)
+MAX_DESIGNS = 100_000
+#: which plausibility guard a numeric key's values pass (`validation.guards`)
+_LENGTHS = {"r0_mm": "r_mm", "r1_mm": "r_mm", "d0_mm": "d_mm", "d1_mm": "d_mm"}
 
 NUMERIC_AXES = ("alpha_deg", "r0_mm", "r1_mm", "d0_mm", "d1_mm", "E_MPa", "nu", "r_start_mm", "l0_mm", "l1_mm",
                 "friction")
 CATEGORICAL_AXES = ("contact", "surface")
 _BASE_DEFAULTS: dict[str, Any] = {
     "cup": "A", "alpha_deg": None, "r0_mm": None, "r1_mm": None, "d0_mm": None, "d1_mm": None,
-    "E_MPa": 4.0, "nu": 0.49, "contact": "sticking", "surface": "pmma-1.89", "fidelity": "coarse",
+    "E_MPa": 4.0, "nu": 0.49, "contact": "frictionless", "surface": DEFAULT_SURFACE, "fidelity": "coarse",
     "r_start_mm": None, "l0_mm": None, "l1_mm": None, "F1_N": [10.0], "F0_at_u_mm": [1.0], "allow_unusual_design": False,
 }
 #: optional base keys, absent unless given (a design's hash is that of its given keys)
@@ -61,6 +77,50 @@ _OPTIONAL = ("friction",)
 _CHOICES = {"contact": ("frictionless", "sticking", "coulomb"), "fidelity": ("coarse", "medium", "fine"),
             "cup": ("A", "B")}
 _METHODS = ("grid", "lhs", "sobol")
+
+
+#: what each key means (docs/sweeps.md is generated from this and the parser's tables:
+#: ``python scripts/keys_docs.py``)
+MEANING: dict[str, str] = {
+    "base.cup": "Table 1 cup the geometry keys modify",
+    "base.alpha_deg": "cone angle [deg] (default: the cup's)",
+    "base.r0_mm": "top-plate radius [mm] (default: the cup's)", "base.r1_mm": "rim radius [mm] (default: the cup's)",
+    "base.d0_mm": "wall thickness at r0 [mm] (a line to d1 at r1; default: the cup's)",
+    "base.d1_mm": "wall thickness at r1 [mm] (default: the cup's)",
+    "base.E_MPa": "Young's modulus [MPa]", "base.nu": "Poisson's ratio",
+    "base.contact": "the FEM's contact law with the plane",
+    "base.friction": "Coulomb's mu in [0, 100]: with contact = \"coulomb\" only",
+    "base.surface": "calibrated surface preset for u_c(p/E) (`cupcheck uc --list-surfaces`)",
+    "base.fidelity": "FEM mesh level",
+    "base.r_start_mm": "start radius of the contact [mm] (default: Table 1's for A and B, mid-wall otherwise)",
+    "base.l0_mm": "eq (5)'s strip width at r0 [mm] (default: Table 1's for the base cup, as measured for it)",
+    "base.l1_mm": "eq (5)'s strip width at r1 [mm] (default: Table 1's for the base cup)",
+    "base.F1_N": "pull forces [N], each once: one table row per design and force",
+    "base.F0_at_u_mm": "plate displacements [mm] at which F0 is reported, each once",
+    "base.allow_unusual_design": "true: steep or slender walls are run, not failed (`validation.guards`)",
+    "scene": "a scene file whose cup, material, contact, surface, loads and fidelity are the base ([base] "
+             "keys then override them)",
+    "sampling.method": "grid: every combination of the axes' values; lhs, sobol: n designs in [low, high]",
+    "sampling.n": f"lhs, sobol: the number of designs, 1 .. {MAX_DESIGNS}",
+    "sampling.seed": "lhs, sobol: the random seed (reproducible designs)",
+    "axes[].name": "the base key varied (categorical ones on a grid only; friction with a coulomb base)",
+    "axes[].values": f"grid: the values, each once (at most {MAX_DESIGNS} designs in all)",
+    "axes[].low": "lhs, sobol: the lower bound", "axes[].high": "lhs, sobol: the upper bound (> low)",
+}
+
+
+def key_rows() -> list[tuple[str, Any, str, str]]:
+    """(key path, default, allowed values, meaning) of every sweep key, from the parser's own tables."""
+    rows = [("scene", None, "a scene file name", MEANING["scene"])]
+    for key, default in {**_BASE_DEFAULTS, **{k: None for k in _OPTIONAL}}.items():
+        allowed = ", ".join(_CHOICES[key]) if key in _CHOICES else ""
+        rows.append((f"base.{key}", default, allowed, MEANING[f"base.{key}"]))
+    rows += [("sampling.method", "grid", ", ".join(_METHODS), MEANING["sampling.method"]),
+             ("sampling.n", None, f"1 .. {MAX_DESIGNS}", MEANING["sampling.n"]),
+             ("sampling.seed", 0, "an integer", MEANING["sampling.seed"]),
+             ("axes[].name", None, ", ".join(NUMERIC_AXES + CATEGORICAL_AXES), MEANING["axes[].name"])]
+    rows += [(f"axes[].{k}", None, "", MEANING[f"axes[].{k}"]) for k in ("values", "low", "high")]
+    return rows
 
 
 @dataclass(frozen=True)
@@ -119,8 +179,8 @@ def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".") -> Sweep
     if method not in _METHODS:
         raise ValueError(f"sampling.method: expected one of {', '.join(_METHODS)}, got {method!r}")
     n, seed = sampling.get("n", 0), sampling.get("seed", 0)
-    if method != "grid" and not (isinstance(n, int) and 1 <= n <= 100_000):
-        raise ValueError(f"sampling.n: {method} needs a number of designs in [1, 100000], got {n!r}")
+    if method != "grid" and not (isinstance(n, int) and not isinstance(n, bool) and 1 <= n <= MAX_DESIGNS):
+        raise ValueError(f"sampling.n: {method} needs a number of designs in [1, {MAX_DESIGNS}], got {n!r}")
     if not isinstance(seed, int):
         raise ValueError(f"sampling.seed: expected an integer, got {seed!r}")
     axes = data.get("axes", [])
@@ -132,6 +192,14 @@ def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".") -> Sweep
         raise ValueError(f"axes: an axis appears twice ({', '.join(names)})")
     if method != "grid" and not parsed:
         raise ValueError(f"axes: {method} sampling needs at least one axis")
+    if method == "grid":
+        size = math.prod(len(a["values"]) for a in parsed)
+        if size > MAX_DESIGNS:
+            lengths = " x ".join(str(len(a["values"])) for a in parsed)
+            raise ValueError(f"axes: the grid has {lengths} = {size:.3g} designs, more than {MAX_DESIGNS} "
+                             f"(each is an FEM path); use fewer values, or lhs/sobol sampling with n designs")
+    _check_surfaces(base, parsed)
+    _check_start_radius(base, parsed)
     _check_contact_axes(base, parsed)
     return SweepSpec(base=base, axes=parsed, method=method, n=n if method != "grid" else 0, seed=seed)
 
@@ -158,6 +226,55 @@ def _check_contact_axes(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) 
         contact_law(law, mu if law == "coulomb" else None, spelling)
     if mu is not None and "coulomb" not in laws:
         contact_law(laws[0], mu, spelling)          # a mu without a coulomb law: refused
+
+
+def _check_surfaces(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) -> None:
+    """Every surface a design uses is a calibrated preset (the base's, or a surface axis's values)."""
+    from validation.scenes.schema import check_surface_preset
+
+    given = [("base.surface", base["surface"])]
+    for i, axis in enumerate(axes):
+        if axis["name"] == "surface":
+            given = [(f"axes[{i}].values[{j}]", v) for j, v in enumerate(axis["values"])]
+    for where, name in given:
+        check_surface_preset(name, where)
+
+
+def _check_start_radius(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) -> None:
+    """r_start inside the base cup's wall (when the radii are not swept: then each design's own
+    check makes a failed row)."""
+    from reduced.cup import CUPS
+    from validation.guards import check_start_radius
+
+    names = [a["name"] for a in axes]
+    if "r0_mm" in names or "r1_mm" in names:
+        return
+    cup = CUPS[base["cup"]]
+    radii = (base["r0_mm"] if base["r0_mm"] is not None else cup.r0_m * 1e3,
+             base["r1_mm"] if base["r1_mm"] is not None else cup.r1_m * 1e3)
+    check_start_radius(base["r_start_mm"], radii, "base.r_start_mm")
+    if "r_start_mm" in names:
+        i = names.index("r_start_mm")
+        for key, value in ([(f"values[{j}]", v) for j, v in enumerate(axes[i]["values"])] if "values" in axes[i]
+                           else [("low", axes[i]["low"]), ("high", axes[i]["high"])]):
+            check_start_radius(value, radii, f"axes[{i}].{key}")
+
+
+def lock_store(out: str | Path):
+    """Hold a sweep's store `out` for this run (an OS file lock on its resolved path, released when
+    the returned lock is dropped or the process ends): a second sweep on the same store is refused
+    at once instead of computing every design again beside the first."""
+    from filelock import FileLock, Timeout
+
+    real = Path(out).resolve()
+    real.mkdir(parents=True, exist_ok=True)
+    lock = FileLock(str(real / ".sweep.lock"), timeout=0)
+    try:
+        lock.acquire()
+    except Timeout:
+        raise ValueError(f"--out: the sweep store '{out}' is being computed by another cupcheck sweep; "
+                         f"wait for it (a rerun then computes only what is missing)") from None
+    return lock
 
 
 def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
@@ -203,13 +320,33 @@ def _base(table: Mapping[str, Any]) -> dict[str, Any]:
             raise ValueError(f"base.{key}: expected one of {', '.join(choices)}, got {base[key]!r}")
     if not isinstance(base["allow_unusual_design"], bool):
         raise ValueError(f"base.allow_unusual_design: expected true or false, got {base['allow_unusual_design']!r}")
+    if not isinstance(base["surface"], str):
+        raise ValueError(f"base.surface: expected a surface preset name, got {base['surface']!r}")
     for key in NUMERIC_AXES:
         if base.get(key) is not None:
             base[key] = _number(base[key], f"base.{key}")
+            _plausible(key, base[key], f"base.{key}")
     for key in ("F1_N", "F0_at_u_mm"):
         values = base[key] if isinstance(base[key], list) else [base[key]]
+        if not values:
+            raise ValueError(f"base.{key}: expected at least one value (an empty list gives an empty table)")
         base[key] = [_number(v, f"base.{key}[{i}]", positive=True) for i, v in enumerate(values)]
+        if len(set(base[key])) != len(base[key]):
+            twice = next(v for v in base[key] if base[key].count(v) > 1)
+            raise ValueError(f"base.{key}: {twice:g} appears twice; give each value once")
+    from validation.guards import check_forces
+    check_forces(base["F1_N"], "base.F1_N")
     return base
+
+
+def _plausible(key: str, value: float, where: str) -> None:
+    """The shared plausibility guard of a numeric key's value (`validation.guards`)."""
+    from validation import guards
+
+    if key == "E_MPa":
+        guards.check_modulus(value, where)
+    elif key in _LENGTHS:
+        guards.check_length(value, where, _LENGTHS[key])
 
 
 def _axis(axis: Any, i: int, method: str) -> dict[str, Any]:
@@ -229,11 +366,20 @@ def _axis(axis: Any, i: int, method: str) -> dict[str, Any]:
             if bad:
                 raise ValueError(f"{where}.values: expected {' or '.join(choices) if choices else 'names'}, "
                                  f"got {bad[0]!r}")
-            return {"name": name, "values": values}
-        return {"name": name, "values": [_number(v, f"{where}.values[{j}]") for j, v in enumerate(values)]}
+        else:
+            values = [_number(v, f"{where}.values[{j}]") for j, v in enumerate(values)]
+            for j, v in enumerate(values):
+                _plausible(name, v, f"{where}.values[{j}]")
+        twice = [j for j, v in enumerate(values) if v in values[:j]]
+        if twice:
+            raise ValueError(f"{where}.values[{twice[0]}]: {values[twice[0]]!r} appears twice on the axis "
+                             f"{name}; give each value once")
+        return {"name": name, "values": values}
     if "values" in axis:
         raise ValueError(f"{where}.values: {method} sampling takes low and high, not values")
     lo, hi = (_number(axis.get(k), f"{where}.{k}") for k in ("low", "high"))
+    _plausible(name, lo, f"{where}.low")
+    _plausible(name, hi, f"{where}.high")
     if not lo < hi:
         raise ValueError(f"{where}.high: must exceed low = {lo:g}, got {hi:g}")
     return {"name": name, "low": lo, "high": hi}
