@@ -29,19 +29,25 @@ def _xy(v):
     return np.stack([v[0::2], v[1::2]])
 
 
-@pytest.mark.parametrize("wetting_m", [0.0, 2e-5])
-def test_volume_gradient_and_hessian_match_finite_differences(wetting_m):
+@pytest.mark.parametrize("wetting_m, seal, halved", [(0.0, -1, False), (2e-5, -1, False),
+                                                      (0.0, -6, True), (2e-5, -6, True)])
+def test_volume_gradient_and_hessian_match_finite_differences(wetting_m, seal, halved):
+    """On a perturbed chain whose first node on the plane is the rim (a vertex) or a mid-side node
+    (the cut halves that edge)."""
     mesh = cup_mesh(cup_geometry("A"), "coarse")
     cav = CavitySurface.of(mesh, wetting_m)
     rng = np.random.default_rng(1)
     x = mesh.doflocs + 1e-6 * rng.standard_normal(mesh.doflocs.shape)
     x[1, cav.nodes[-12:-1]] = 3e-5 * rng.random(11)      # the wall near the rim just above the plane
-    x[1, cav.nodes[-1]] = 0.0
+    x[1, cav.nodes[seal]] = 0.0
+    assert (cav.cut_index(x) % 2 == 1) == halved
     n = x.size
     V, (dofs, g), h, pairs = cav.derivatives(x)
     G = np.bincount(dofs, g, minlength=n)
     H = sp.coo_matrix((h, (pairs[0], pairs[1])), shape=(n, n)).toarray()
     d, eps = rng.standard_normal(n), 1e-9
+    if halved:                               # an inner node on the plane stays there (V is cut there)
+        d[2 * cav.nodes[seal] + 1] = 0.0
     xv = _flat(x)
     fd = (cav.loaded_volume(_xy(xv + eps * d)) - cav.loaded_volume(_xy(xv - eps * d))) / (2 * eps)
     assert fd == pytest.approx(G @ d, rel=1e-6)
