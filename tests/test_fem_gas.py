@@ -3,6 +3,8 @@
 frictionless (u, N) states against the dp-driven states of fem.suction (path independence),
 global equilibrium of plate, contact and suction, and the sealed cup pulled and leaked into."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -11,6 +13,7 @@ from fem.cavity import CavitySurface, PressurizedMechanics
 from fem.condensation import make_solver
 from fem.cup import CupSetup
 from fem.geometry import cup_geometry
+from fem.gas_branch import equilibrium_branch, pull_sensitivities
 from fem.gas_path import CupWithGas, cup_path
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
@@ -195,3 +198,77 @@ def test_bad_input_is_refused_before_work(mesh):
     with pytest.raises(ValueError, match="^u_pulled_m: "):
         cup_path(mesh, NeoHookean(), 3e-3, 3.5e-3, 1.2)
     assert not cup.costs
+
+
+# --- the cup held by a given pull (fem/gas_branch.py) -------------------------------------------
+
+F1_HELD = 25.0      # N: frictionless coarse cup A folds at u ~ -4.6 mm (no seal opening first)
+
+
+@pytest.fixture(scope="module")
+def held(mesh):
+    cup = CupWithGas.of(mesh, NeoHookean(), rtol=RTOL)
+    return cup, equilibrium_branch(cup, cup.press(4e-3)[-1], F1_HELD, du_m=0.25e-3)
+
+
+def test_branch_holds_the_pull_and_balances(mesh, held):
+    """Every state of the branch pulls F1 (to the root's tolerance) and balances plate, contact
+    and suction; N rises as the plate rises, up to the fold, where it is largest."""
+    cup, b = held
+    assert b.reason == "fold" and b.detachment is b.states[-1]
+    N = b.column("N")
+    assert np.all(np.diff(b.column("u_m")[:-1]) < 0) and np.all(np.diff(N) > 0)
+    assert b.N_max == N.max() and b.N_max > 1.5 * N[0]
+    for s in b.states:
+        scale = cup.p_a_Pa * np.pi * s.seal_r_m**2
+        assert abs(s.F1_N - F1_HELD) <= RTOL * scale
+        contact = float(np.sum(s.profile.p_gauss_Pa * s.profile.w_m2))
+        assert abs(s.F1_N + contact - s.dp_Pa * np.pi * s.cut_r_m**2) <= 1e-7 * scale
+
+
+def test_branch_frictionless_states_equal_the_suction_grid(mesh, held):
+    """At mu = 0 a branch state (reached by pressing, sealing, pulling and letting gas in along
+    the branch) is the dp-driven state of `suction_grid` at its (u, dp): the grid's pull there
+    is F1 (the branch's root), with the same volume and seal."""
+    _, b = held
+    for s in [s for s in b.states if s.u_m > 0][1::3][:2]:
+        g = suction_grid(mesh, NeoHookean(), u_m=[s.u_m], dp_Pa=[0.0, s.dp_Pa], rtol=RTOL)
+        scale = s.dp_Pa * np.pi * s.seal_r_m**2
+        assert abs(g.F1_N[0, 1] - F1_HELD) <= 3e-6 * scale
+        assert g.V_m3[0, 1] == pytest.approx(s.V_m3, rel=1e-6)
+        assert g.seal_r_m[0, 1] == pytest.approx(s.seal_r_m, rel=1e-6)
+
+
+def test_pull_sensitivities_match_neighbouring_states(mesh, held):
+    """dF1/dN and dF1/du of `pull_sensitivities` against central differences of converged states
+    at N (1 +- 1e-5) and u +- 1e-4 mm from a branch state; and at the reported detachment
+    dN/du = -(dF1/du)/(dF1/dN) vanishes (to 1e-3 of its largest value on the branch)."""
+    cup, b = held
+    s = b.states[len(b.states) // 2]
+    dF1_dN, dF1_du = pull_sensitivities(cup, s)
+    options = replace(cup.options, initial_step=1.0, max_step=1.0)
+
+    def pull(u_m, N):
+        mech = GasMechanics(cup.cup.mech, cup.cavity, TrappedGas(N))
+        last = []
+        follow_path(mech, cup.cup.plate_at(u_m, moving=False), 1.0, plane=cup.cup.plane,
+                    start=s.state, on_step=last.append, options=options)
+        return float(np.sum(last[-1].r_int[2 * cup.cup.top + 1]))
+    dN, du = 1e-5 * s.N, 1e-7
+    assert (pull(s.u_m, s.N + dN) - pull(s.u_m, s.N - dN)) / (2 * dN) == pytest.approx(dF1_dN, rel=1e-4)
+    assert (pull(s.u_m + du, s.N) - pull(s.u_m - du, s.N)) / (2 * du) == pytest.approx(dF1_du, rel=1e-4)
+    assert abs(b.dN_du[-1]) <= 1e-3 * np.max(np.abs(b.dN_du))
+    assert np.all(b.dN_du[:-1] < 0)
+
+
+def test_branch_bad_input_is_refused(mesh):
+    cup = CupWithGas.of(mesh, NeoHookean())
+    sealed = cup.press(1e-3)[-1]
+    with pytest.raises(ValueError, match="^F1_N: "):
+        equilibrium_branch(cup, sealed, float("nan"))
+    with pytest.raises(ValueError, match="^du_m: "):
+        equilibrium_branch(cup, sealed, 5.0, du_m=0.0)
+    with pytest.raises(ValueError, match="^press_to: "):
+        cup.press_to(force_N=1.0, r_start_m=12e-3)
+    with pytest.raises(ValueError, match="^force_N: "):
+        cup.press_to(force_N=-1.0)
