@@ -36,7 +36,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from .gas_path import CupWithGas, GasState
-from .solver import SolverOptions, SolverStats
+from .solver import SolverStats, StepResult
 from .cup import _joined
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
@@ -73,13 +73,17 @@ def pull_sensitivities(cup: CupWithGas, s: GasState) -> tuple[float, float]:
     held contact dofs fixed (its contact set kept). F1 is the plate's reaction (`fem.gas_path`).
     The sparse part is factored by sparse LU (it need not be definite where the gas alone holds
     the wall), the rank-one term added by Sherman-Morrison."""
-    mech = GasMechanics(cup.cup.mech, cup.cavity, cup._gas(s.N))
-    u = s.state.u
+    return _sensitivities(cup, s.N, s.state)
+
+
+def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, float]:
+    mech = GasMechanics(cup.cup.mech, cup.cavity, cup._gas(N))
+    u = state.u
     _, r, K = mech.evaluate(u)
     c, g = K.rank_one
     top = cup.cup.top
     plate_z = 2 * top + 1
-    held, _ = cup.cup.plane.constraints(s.state.contact)
+    held, _ = cup.cup.plane.constraints(state.contact)
     free = np.ones(u.size, bool)
     free[np.concatenate([2 * top, plate_z, held])] = False
     Ks = K.plain()
@@ -98,10 +102,11 @@ def pull_sensitivities(cup: CupWithGas, s: GasState) -> tuple[float, float]:
 def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: float = 0.1e-3,
                        u_min_m: float | None = None, max_states: int = 400) -> Branch:
     """The states holding the pull F1_N from `sealed` (a "pressed" state, sealed there at p_a, or
-    a sealed state) to detachment (module docstring). du_m: the plate step along the branch;
-    u_min_m: the lowest plate position (default -h1: the plate above the touching height, the
-    suction holding the wall on the plane). Raises ValueError for bad input and what the solver
-    raises where a state cannot be reached."""
+    a sealed state) to detachment (module docstring). du_m: the plate step along the branch
+    (halved, down to du_m / 16, where a state cannot be found); u_min_m: the lowest plate
+    position (default -h1: the plate above the touching height, the suction holding the wall on
+    the plane). Raises ValueError for bad input; where no state is found even with the smallest
+    step, the branch ends there with reason "stopped: <why>" and no detachment."""
     if not (isinstance(F1_N, (int, float)) and math.isfinite(F1_N)):
         raise ValueError(f"F1_N: must be a finite number, got {F1_N!r}")
     if not (math.isfinite(du_m) and 0.0 < du_m <= 0.1 * cup.h1_m):
@@ -111,34 +116,53 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
         raise ValueError(f"u_min_m: must be below the sealed plate position {sealed.u_m * 1e3:.4g} mm, "
                          f"got {u_min * 1e3:.4g} mm")
     walk = _Walk(cup, float(F1_N))
-    start = sealed if sealed.stage != "pressed" else replace(sealed, stage="sealed")
-    first = walk.pull_to_force(start, du_m, u_min)
+    start = _Trial(sealed.u_m, sealed.N, sealed.F1_N, sealed.state)
+    try:
+        first = walk.pull_to_force(start, du_m, u_min)
+    except RuntimeError as err:
+        return walk.result(None, f"stopped: {err}")
     if first is None:
         return walk.result(None, "not held")
-    states, slopes = [first], [walk.slope(first)]
-    while len(states) < max_states:
-        prev = states[-1]
-        u_next = prev.u_m - du_m
+    trials, slopes = [first], [walk.slope(first)]
+    step = du_m
+    while len(trials) < max_states:
+        prev = trials[-1]
+        u_next = prev.u_m - step
         if u_next < u_min:
-            return walk.result(None, "u_min", states, slopes)
-        s = walk.hold(prev, u_next, prev.N - slopes[-1] * du_m)
+            return walk.result(None, "u_min", trials, slopes)
+        try:
+            s = walk.hold(prev, u_next, prev.N - slopes[-1] * step)
+        except RuntimeError as err:
+            if step > du_m / 16 * (1 + 1e-9):
+                step *= 0.5
+                continue
+            return walk.result(None, f"stopped: {err}", trials, slopes)
+        step = min(du_m, 2.0 * step)
         if _open(cup, s):
-            states.append(s)
-            slopes.append(walk.slope(s))
-            return walk.result(s, "seal opened", states, slopes)
+            return walk.result(s, "seal opened", trials + [s], slopes + [walk.slope(s)])
         k = walk.slope(s)
         if k > 0.0 >= slopes[-1]:                # N(u) passed its maximum (u decreasing)
             fold = walk.fold(prev, slopes[-1], s, k)
-            return walk.result(fold, "fold", states + [fold], slopes + [walk.slope(fold)])
-        states.append(s)
+            return walk.result(fold, "fold", trials + [fold], slopes + [walk.slope(fold)])
+        trials.append(s)
         slopes.append(k)
     raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
 
 
-def _open(cup: CupWithGas, s: GasState) -> bool:
+def _open(cup: CupWithGas, s: "_Trial") -> bool:
     """Whether no node of the cavity chain is on the plane (the cavity is open to the outside)."""
-    x = cup.mesh.doflocs + np.stack([s.state.u[0::2], s.state.u[1::2]])
+    x = cup.mesh.doflocs + np.stack([s.step.u[0::2], s.step.u[1::2]])
     return not np.any(x[1, cup.cavity.nodes] <= cup.cavity.tolerance_m)
+
+
+@dataclass(frozen=True, eq=False)
+class _Trial:
+    """A converged sealed state before its measurement: plate position, N, pull, solver state."""
+
+    u_m: float
+    N: float
+    F1_N: float
+    step: StepResult
 
 
 class _Walk:
@@ -148,77 +172,78 @@ class _Walk:
         self.cup, self.F1 = cup, F1_N
         self.options = replace(cup.options, initial_step=1.0, max_step=1.0)
         self.stats: SolverStats | None = None
-        self.slopes: dict[GasState, tuple[float, float]] = {}     # by identity
+        self.slopes: dict[_Trial, tuple[float, float]] = {}     # by identity
+        rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
+        # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
+        self.tolerance = cup.options.rtol * cup.p_a_Pa * math.pi * rim**2
 
-    def tolerance(self, s: GasState) -> float:
-        """|F1 - F1_N| accepted: rtol of the largest suction force p_a pi r_k^2 [N]."""
-        return self.cup.options.rtol * self.cup.p_a_Pa * math.pi * s.seal_r_m**2
-
-    def derivatives(self, s: GasState) -> tuple[float, float]:
+    def derivatives(self, s: _Trial) -> tuple[float, float]:
         if s not in self.slopes:
-            self.slopes[s] = pull_sensitivities(self.cup, s)
+            self.slopes[s] = _sensitivities(self.cup, s.N, s.step)
         return self.slopes[s]
 
-    def slope(self, s: GasState) -> float:
+    def slope(self, s: _Trial) -> float:
         """dN/du along the branch at s [1/m]."""
         dF1_dN, dF1_du = self.derivatives(s)
         return -dF1_du / dF1_dN
 
-    def solve(self, start: GasState, u_m: float, N: float, stage: str) -> GasState:
+    def solve(self, start: _Trial, u_m: float, N: float) -> _Trial:
         """The state at (u_m, N), reached from `start` with the plate and N on a line."""
         u0, N0 = start.u_m, start.N
         mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
                             schedule=lambda t: N0 + t * (N - N0))
-        dofs, _ = self.cup._plate(0.0, 0.0)(0.0)
-        n_top = dofs.size // 2
+        top = self.cup.cup.top
+        dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
 
         def plate(t):
-            return dofs, np.concatenate([np.zeros(n_top), np.full(n_top, -(u0 + t * (u_m - u0)))])
+            return dofs, np.concatenate([zeros, np.full(top.size, -(u0 + t * (u_m - u0)))])
         last = []
-        stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.state,
+        stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
                                 options=self.options, on_step=last.append)
         self.stats = stats if self.stats is None else _joined(self.stats, stats)
-        return self.cup.measure(last[-1], mech.at(1.0), u_m, stage)
+        end = last[-1]
+        return _Trial(float(u_m), float(N), float(np.sum(end.r_int[2 * top + 1])), end)
 
-    def hold(self, prev: GasState, u_m: float, N_guess: float) -> GasState:
+    def hold(self, prev: _Trial, u_m: float, N_guess: float) -> _Trial:
         """The state at plate position u_m whose pull is F1 (N by Newton on F1(N), module
         docstring), reached from prev."""
-        s = self.solve(prev, u_m, N_guess, "held")
+        s = self.solve(prev, u_m, N_guess)
         tried: list[tuple[float, float]] = [(s.N, s.F1_N - self.F1)]
         for _ in range(12):
             miss = s.F1_N - self.F1
-            if abs(miss) <= self.tolerance(s):
+            if abs(miss) <= self.tolerance:
                 return s
             N_new = s.N - miss / self.derivatives(s)[0]
             if len(tried) >= 2 and abs(miss) > 0.5 * abs(tried[-2][1]):   # slow: secant
                 (Na, fa), (Nb, fb) = tried[-2:]
                 if fb != fa:
                     N_new = Nb - fb * (Nb - Na) / (fb - fa)
-            s = self.solve(s, u_m, N_new, "held")
+            if not N_new > 0.0:
+                break
+            s = self.solve(s, u_m, N_new)
             tried.append((s.N, s.F1_N - self.F1))
         raise RuntimeError(f"F1_N = {self.F1:g} N: N not found at u = {u_m * 1e3:.4g} mm "
-                           f"(pull off by {s.F1_N - self.F1:.3g} N after 12 corrections)")
+                           f"(pull off by {s.F1_N - self.F1:.3g} N after {len(tried) - 1} corrections)")
 
-    def pull_to_force(self, sealed: GasState, du_m: float, u_min: float) -> GasState | None:
+    def pull_to_force(self, sealed: _Trial, du_m: float, u_min: float) -> _Trial | None:
         """Raise the plate at fixed N from `sealed` until the pull is F1 (Newton in u with the exact
         dF1/du, the steps at most du_m); None if the plate reaches u_min first."""
         s = sealed
         while True:
             miss = s.F1_N - self.F1
-            if abs(miss) <= self.tolerance(s):
-                return replace(s, stage="held")
+            if abs(miss) <= self.tolerance:
+                return s
             step = -miss / self.derivatives(s)[1]
             u_new = s.u_m + float(np.clip(step, -du_m, du_m))
             if u_new < u_min:
                 return None
-            s = self.solve(s, u_new, s.N, "pulled")
+            s = self.solve(s, u_new, s.N)
 
-    def fold(self, a: GasState, ka: float, b: GasState, kb: float) -> GasState:
+    def fold(self, a: _Trial, ka: float, b: _Trial, kb: float) -> _Trial:
         """The state between a and b where dN/du = 0 on the branch (secant on dN/du)."""
         for _ in range(8):
             u = b.u_m + (a.u_m - b.u_m) * kb / (kb - ka)
-            N_guess = a.N + ka * (u - a.u_m)
-            s = self.hold(a, u, N_guess)
+            s = self.hold(a, u, a.N + ka * (u - a.u_m))
             k = self.slope(s)
             if abs(k) <= 1e-3 * max(abs(ka), abs(kb)) or abs(u - a.u_m) < 1e-9 * self.cup.h1_m:
                 return s
@@ -228,5 +253,10 @@ class _Walk:
                 a, ka = s, k
         return s
 
-    def result(self, detachment, reason, states=(), slopes=()) -> Branch:
-        return Branch(self.F1, tuple(states), np.array(slopes), detachment, reason, self.stats)
+    def result(self, detachment, reason, trials=(), slopes=()) -> Branch:
+        """The measured branch (`fem.gas_path.CupWithGas.measure`)."""
+        states = {id(t): self.cup.measure(t.step, GasMechanics(self.cup.cup.mech, self.cup.cavity,
+                                                               self.cup._gas(t.N)), t.u_m, "held")
+                  for t in trials}
+        return Branch(self.F1, tuple(states[id(t)] for t in trials), np.array(slopes),
+                      None if detachment is None else states[id(detachment)], reason, self.stats)
