@@ -13,10 +13,13 @@ moving together on a line in (u, N), so the contact history (sticking anchors, C
 carried from state to state; N is found by a scalar Newton iteration on F1(u, N) = F1 whose
 derivative dF1/dN is exact for the state's contact set: the linear response of the equilibrium
 to dN at the held plate, solved with the rank-one gas tangent (`fem.trapped_gas`), the held
-contact dofs fixed. A correction of N continues the path from the trial state at the held plate.
-(For Coulomb contact the response ignores the change of the sliding nodes' friction with their
-normal reaction, so the iteration converges linearly there; a secant step takes over when the
-tangent's step does not reduce the mismatch.)
+contact dofs fixed and Coulomb's sliding nodes sliding (`pull_sensitivities`). Every trial N is
+reached from the previous state of the branch (not from the last trial: with friction a trial's
+back-and-forth would enter the history); a secant step takes over when the tangent's step does
+not halve the mismatch (the contact set changed in between).
+A bordered Newton (N an unknown of the solver's Newton iteration beside u) would need the
+solver's Newton step and line search (`fem.newton`) to carry a constraint that is not an energy;
+the scalar root keeps the solver an energy minimization at given (u, N).
 
 Detachment (the criterion): with the pull F1 held, the leak raises N, and the cup follows the
 branch while N can still rise along it. Where N(u) has its maximum, dN/du = 0 (the fold of the
@@ -33,6 +36,7 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .gas_path import CupWithGas, GasState
@@ -71,8 +75,10 @@ def pull_sensitivities(cup: CupWithGas, s: GasState) -> tuple[float, float]:
     the equilibrium to a change of N at the held plate and to a plate move at fixed N, with the
     full tangent K + dp Hess V + (N k_B T / V^2) grad V grad V^T on the free dofs and the state's
     held contact dofs fixed (its contact set kept). F1 is the plate's reaction (`fem.gas_path`).
-    The sparse part is factored by sparse LU (it need not be definite where the gas alone holds
-    the wall), the rank-one term added by Sherman-Morrison."""
+    Coulomb's sliding nodes keep t = -mu lambda s: their radial row gains mu s times their normal
+    row (the reaction lambda changes with the state). The matrix is factored by sparse LU (it
+    need not be symmetric, nor definite where the gas alone holds the wall), the rank-one term
+    added by Sherman-Morrison."""
     return _sensitivities(cup, s.N, s.state)
 
 
@@ -81,19 +87,27 @@ def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float,
     u = state.u
     _, r, K = mech.evaluate(u)
     c, g = K.rank_one
-    top = cup.cup.top
+    plane, top = cup.cup.plane, cup.cup.top
     plate_z = 2 * top + 1
-    held, _ = cup.cup.plane.constraints(state.contact)
+    held, _ = plane.constraints(state.contact)
     free = np.ones(u.size, bool)
     free[np.concatenate([2 * top, plate_z, held])] = False
+    slide = state.contact.active & (state.contact.slip != 0)
+    P = sp.identity(u.size, format="csr")                 # rows: r + mu s lambda = 0 when sliding
+    if slide.any():
+        nodes = plane.nodes[slide]
+        P = P + sp.csr_matrix((plane.law.mu * state.contact.slip[slide].astype(float),
+                               (2 * nodes, 2 * nodes + 1)), shape=P.shape)
     Ks = K.plain()
-    lu = spla.splu(Ks[free][:, free].tocsc())
+    lu = spla.splu((P @ Ks)[free][:, free].tocsc())
     down = np.zeros(u.size)
     down[plate_z] = -1.0                                  # u_z = -u on the plate: d/du
     b = -(K_B * cup.T_K / mech.volume_m3(u)) * g          # dr/dN at fixed u
-    rhs = np.stack([-b[free], -(Ks @ down)[free] - c * g[free] * (g @ down), g[free]], axis=1)
+    h = (P @ g)[free]
+    rhs = np.stack([-(P @ b)[free], -(P @ (Ks @ down))[free] - c * h * (g @ down), h], axis=1)
     y = lu.solve(rhs)
-    y[:, :2] -= np.outer(y[:, 2], c * (g[free] @ y[:, :2]) / (1.0 + c * g[free] @ y[:, 2]))
+    gf = g[free]
+    y[:, :2] -= np.outer(y[:, 2], c * (gf @ y[:, :2]) / (1.0 + c * gf @ y[:, 2]))
     x_N, x_u = np.zeros(u.size), down.copy()
     x_N[free], x_u[free] = y[:, 0], y[:, 1]
     return float(np.sum((K @ x_N + b)[plate_z])), float(np.sum((K @ x_u)[plate_z]))
@@ -220,7 +234,7 @@ class _Walk:
                     N_new = Nb - fb * (Nb - Na) / (fb - fa)
             if not N_new > 0.0:
                 break
-            s = self.solve(s, u_m, N_new)
+            s = self.solve(prev, u_m, N_new)
             tried.append((s.N, s.F1_N - self.F1))
         raise RuntimeError(f"F1_N = {self.F1:g} N: N not found at u = {u_m * 1e3:.4g} mm "
                            f"(pull off by {s.F1_N - self.F1:.3g} N after {len(tried) - 1} corrections)")
