@@ -13,13 +13,18 @@ the roof, axis and plane contributing nothing. With the pressure difference dp =
 gas does work p_b dV on the surface and the uniform ambient pressure none on the closed body,
 so the potential energy gains dp V_cav and the equilibrium minimizes W(u) + dp V_cav(u) under the
 plate displacement and the contact conditions. `PressurizedMechanics` adds dp V_cav, its exact
-gradient and Hessian on the quadratic edges (3-point Gauss per edge: the integrand r^2 dz/dxi is
+gradient and Hessian on the quadratic edges (6-point Gauss per edge: the integrand r^2 dz/dxi is
 a quintic) to `fem.forms.Mechanics`; the solver (`fem.solver`) needs nothing else.
 
-The chain is cut at its first node on the plane (z <= a round-off tolerance): beyond the seal the
-surface lies outside the gas region (a lifted pocket outside a mid-wall touchdown carries no
-cavity pressure). V_cav is continuous as the seal moves from node to node (z_k = 0 at the cut)
-and piecewise smooth like the contact conditions it follows.
+The chain is cut at its last node on the plane (z <= a round-off tolerance), the outer end of
+the outermost contact zone: beyond it the surface lies outside the gas region, and the gas fills
+every pocket the wall lifts between contact zones inside it (an inner touchdown does not seal a
+pocket off; it shares the cavity's pressure). So V_cav is continuous as nodes touch down and lift
+off inside the outermost contact, and as that contact's end moves from node to node (z_k = 0 at
+the cut); it is piecewise smooth like the contact conditions it follows. (Cut at the end of the
+first contact zone instead, V jumped by a pocket's volume when an inner touchdown lifted: an
+energy barrier that stalled the Newton iteration of a sticking cup under suction.) The seal r_k
+is the first node on the plane, the inner edge of the contact.
 
 Global equilibrium (tested): the vertical resultant of the pressure on any surface of revolution
 between radii r_0 and r_k is dp pi (r_k^2 - r_0^2), pulling the wall towards the plane, so the
@@ -111,13 +116,10 @@ class CavitySurface:
         return int(on[0]) if on.size else self.nodes.size - 1
 
     def cut_index(self, x: np.ndarray) -> int:
-        """Position of the last node of the first run of nodes on the plane: the load acts on
-        the chain up to here (module docstring)."""
-        on = x[1, self.nodes] <= self.tolerance_m
-        k = self.seal_index(x)
-        while k + 1 < on.size and on[k + 1]:
-            k += 1
-        return k
+        """Position of the last node on the plane, the outer end of the outermost contact: the
+        load acts on the chain up to here (module docstring); the last node if none is."""
+        on = np.flatnonzero(x[1, self.nodes] <= self.tolerance_m)
+        return int(on[-1]) if on.size else self.nodes.size - 1
 
     def seal_radius(self, x: np.ndarray) -> float:
         """r_k: the deformed radius of the seal node [m]."""

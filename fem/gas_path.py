@@ -56,7 +56,7 @@ class GasState:
     contact_force_N: float      # N_c: the plane's reaction less dp on the zone beyond the seal
     V_m3: float                 # cavity volume (geometric)
     seal_r_m: float             # r_k: radius of the seal node
-    cut_r_m: float              # outer end of the innermost contact zone (the suction's extent)
+    cut_r_m: float              # outer end of the outermost contact zone (the suction's extent)
     r_c_m: float                # inner contact radius of the pressure profile
     profile: PressureProfile = field(repr=False)
     state: StepResult = field(repr=False)     # the solver's state, to continue the path from
