@@ -7,7 +7,10 @@
 
 From the sealed state the plate is first raised at fixed N0 until the handle pulls F1 (the pull is
 ramped at fixed N). Then, as gas leaks in, the cup moves along the states (u, N) whose pull is
-F1: the branch is stepped in the plate position u (upwards, u decreasing) with N the unknown.
+F1: the branch is stepped in the plate position u (upwards, u decreasing) with N the unknown,
+or, where the branch turns in u (dF1/dN -> 0: more gas at the held plate no longer lowers the
+pull), in N with u the unknown (natural-parameter switching along the branch's tangent, which
+`pull_sensitivities` gives exactly; the direction is the one in which N rises, the leak's).
 Each state is one `fem.solver` path from the previous state of the branch, the plate and N
 moving together on a line in (u, N), so the contact history (sticking anchors, Coulomb slips) is
 carried from state to state; N is found by a scalar Newton iteration on F1(u, N) = F1 whose
@@ -26,8 +29,11 @@ branch while N can still rise along it. Where N(u) has its maximum, dN/du = 0 (t
 branch), no state with more gas holds F1: the cup lets go. That N_max is the largest amount of
 gas the cup holds at F1, and the branch ends there ("fold"; dN/du is computed exactly at every
 state, dN/du = -(dF1/du)/(dF1/dN), and the fold located by a secant on it). The branch also ends
-where the seal opens, no node of the cavity chain being on the plane ("seal opened"), or where the
-plate reaches u_min_m without either ("u_min"; not a detachment).
+where the seal opens, no node of the cavity chain being on the plane any more: the detachment is
+then the last state with the seal closed, bisected to 1/64 of a step ("seal opened"). It ends
+without a detachment where the plate reaches u_min_m ("u_min"), or where no state holds F1 even
+with 1/16 of a step ("stopped: why"; e.g. the sticking law's slips, whose landing depends on the
+load step, make F1(N) at the held plate discontinuous and not monotone).
 """
 
 from __future__ import annotations
@@ -46,6 +52,9 @@ from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
 __all__ = ["Branch", "equilibrium_branch", "pull_sensitivities"]
 
+SNAP_DN = 1e-6      # relative rise of N at the held plate that tests for a snap
+SNAP_DROP = 1e-3    # ... and the relative fall of F1 that makes it one
+
 
 @dataclass(frozen=True, eq=False)
 class Branch:
@@ -57,8 +66,9 @@ class Branch:
     states: tuple[GasState, ...]
     dN_du: np.ndarray
     detachment: GasState | None       # the fold (largest N) or the state where the seal opened
-    reason: str                       # "fold", "seal opened", "u_min", "not held"
+    reason: str                       # "fold", "seal opened", "u_min", "not held", "stopped: why"
     stats: SolverStats
+    snaps: int = 0                    # snaps crossed (the plate rose at fixed N to restore F1)
 
     @property
     def N_max(self) -> float:
@@ -138,28 +148,52 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     if first is None:
         return walk.result(None, "not held")
     trials, slopes = [first], [walk.slope(first)]
-    step = du_m
+    N_ref = abs(slopes[0]) * du_m if math.isfinite(slopes[0]) and slopes[0] else 1e-3 * first.N
+    tangent = walk.tangent(first, du_m, N_ref, None)
+    h = 1.0
     while len(trials) < max_states:
         prev = trials[-1]
-        u_next = prev.u_m - step
-        if u_next < u_min:
+        u_pred, N_pred = prev.u_m + h * tangent[0] * du_m, prev.N + h * tangent[1] * N_ref
+        if u_pred < u_min:
             return walk.result(None, "u_min", trials, slopes)
         try:
-            s = walk.hold(prev, u_next, prev.N - slopes[-1] * step)
+            if abs(tangent[0]) >= abs(tangent[1]):      # u leads: N is the unknown
+                s = walk.hold(prev, u_pred, N_pred)
+            else:                                        # N leads (near a turn of u): u is
+                s = walk.hold_u(prev, u_pred, N_pred)
         except RuntimeError as err:
-            if step > du_m / 16 * (1 + 1e-9):
-                step *= 0.5
+            if h > 1.0 / 16.0 * (1 + 1e-9):
+                h *= 0.5
                 continue
-            return walk.result(None, f"stopped: {err}", trials, slopes)
-        step = min(du_m, 2.0 * step)
+            # a snap? F1 falls by a finite amount as N rises at the held plate (a seal slips):
+            # under the held pull the plate then rises at that N until F1 is restored
+            try:
+                after = walk.solve(prev, prev.u_m, prev.N * (1.0 + SNAP_DN))
+                restored = after.F1_N < walk.F1 - SNAP_DROP * abs(walk.F1) and \
+                    walk.pull_to_force(after, du_m, u_min)
+            except RuntimeError:
+                restored = None
+            if not restored:
+                return walk.result(None, f"stopped: {err}", trials, slopes)
+            trials.append(restored)
+            slopes.append(walk.slope(restored))
+            tangent = walk.tangent(restored, du_m, N_ref, None)
+            walk.snaps += 1
+            h = 1.0
+            continue
+        h = min(1.0, 2.0 * h)
         if _open(cup, s):
-            return walk.result(s, "seal opened", trials + [s], slopes + [walk.slope(s)])
-        k = walk.slope(s)
-        if k > 0.0 >= slopes[-1]:                # N(u) passed its maximum (u decreasing)
-            fold = walk.fold(prev, slopes[-1], s, k)
+            last = walk.opening(prev, s, tangent)
+            trials = trials + ([last] if last is not prev else [])
+            slopes = slopes + ([walk.slope(last)] if last is not prev else [])
+            return walk.result(last, "seal opened", trials, slopes)
+        t = walk.tangent(s, du_m, N_ref, tangent)
+        if t[1] < 0.0 < tangent[1]:                  # N passed its maximum along the branch
+            fold = walk.fold(prev, slopes[-1], s, walk.slope(s))
             return walk.result(fold, "fold", trials + [fold], slopes + [walk.slope(fold)])
         trials.append(s)
-        slopes.append(k)
+        slopes.append(walk.slope(s))
+        tangent = t
     raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
 
 
@@ -186,6 +220,7 @@ class _Walk:
         self.cup, self.F1 = cup, F1_N
         self.options = replace(cup.options, initial_step=1.0, max_step=1.0)
         self.stats: SolverStats | None = None
+        self.snaps = 0
         self.slopes: dict[_Trial, tuple[float, float]] = {}     # by identity
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
@@ -200,6 +235,35 @@ class _Walk:
         """dN/du along the branch at s [1/m]."""
         dF1_dN, dF1_du = self.derivatives(s)
         return -dF1_du / dF1_dN
+
+    def tangent(self, s: _Trial, du_m: float, N_ref: float, previous) -> tuple[float, float]:
+        """The branch's unit tangent at s in (u / du_m, N / N_ref), dF1 = 0: along the previous
+        tangent (continuity), or with N rising if there is none."""
+        dF1_dN, dF1_du = self.derivatives(s)
+        t = np.array([dF1_dN * N_ref, -dF1_du * du_m])
+        t /= np.linalg.norm(t)
+        if (previous is None and t[1] < 0.0) or (previous is not None and t @ previous < 0.0):
+            t = -t
+        return float(t[0]), float(t[1])
+
+    def hold_u(self, prev: _Trial, u_guess: float, N: float) -> _Trial:
+        """The state at N whose pull is F1 (the plate position by Newton on F1(u), the secant
+        where it is slow), reached from prev."""
+        s = self.solve(prev, u_guess, N)
+        tried: list[tuple[float, float]] = [(s.u_m, s.F1_N - self.F1)]
+        for _ in range(12):
+            miss = s.F1_N - self.F1
+            if abs(miss) <= self.tolerance:
+                return s
+            u_new = s.u_m - miss / self.derivatives(s)[1]
+            if len(tried) >= 2 and abs(miss) > 0.5 * abs(tried[-2][1]):
+                (ua, fa), (ub, fb) = tried[-2:]
+                if fb != fa:
+                    u_new = ub - fb * (ub - ua) / (fb - fa)
+            s = self.solve(prev, u_new, N)
+            tried.append((s.u_m, s.F1_N - self.F1))
+        raise RuntimeError(f"F1_N = {self.F1:g} N: the plate position not found at N = {N:.6g} "
+                           f"(pull off by {s.F1_N - self.F1:.3g} N after {len(tried) - 1} corrections)")
 
     def solve(self, start: _Trial, u_m: float, N: float) -> _Trial:
         """The state at (u_m, N), reached from `start` with the plate and N on a line."""
@@ -240,18 +304,60 @@ class _Walk:
                            f"(pull off by {s.F1_N - self.F1:.3g} N after {len(tried) - 1} corrections)")
 
     def pull_to_force(self, sealed: _Trial, du_m: float, u_min: float) -> _Trial | None:
-        """Raise the plate at fixed N from `sealed` until the pull is F1 (Newton in u with the exact
-        dF1/du, the steps at most du_m); None if the plate reaches u_min first."""
-        s = sealed
-        while True:
-            miss = s.F1_N - self.F1
+        """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m
+        (Newton's with the exact dF1/du where it points up), each from the last state pulling
+        less than F1; a step that overshoots brackets the crossing, which regula falsi (Illinois)
+        closes. None if the plate reaches u_min first. The plate never moves down: with friction
+        a back-and-forth would enter the history."""
+        a, b = sealed, None
+        while b is None:
+            miss = a.F1_N - self.F1
             if abs(miss) <= self.tolerance:
-                return s
-            step = -miss / self.derivatives(s)[1]
-            u_new = s.u_m + float(np.clip(step, -du_m, du_m))
+                return a
+            dF1_du = self.derivatives(a)[1]
+            step = -miss / dF1_du if dF1_du < 0.0 else -du_m
+            u_new = a.u_m + float(np.clip(step, -du_m, -1e-6 * du_m))
             if u_new < u_min:
                 return None
-            s = self.solve(s, u_new, s.N)
+            s = self.solve(a, u_new, a.N)
+            if s.F1_N - self.F1 > self.tolerance:
+                b = s
+            else:
+                a = s
+        fa, fb, side = a.F1_N - self.F1, b.F1_N - self.F1, 0
+        for _ in range(60):
+            u = b.u_m + (a.u_m - b.u_m) * fb / (fb - fa)
+            s = self.solve(a, u, a.N)
+            f = s.F1_N - self.F1
+            if abs(f) <= self.tolerance:
+                return s
+            if f < 0.0:
+                a, fa = s, f
+                fb *= 0.5 if side == -1 else 1.0
+                side = -1
+            else:
+                b, fb = s, f
+                fa *= 0.5 if side == 1 else 1.0
+                side = 1
+        raise RuntimeError(f"F1_N = {self.F1:g} N: the pull at fixed N0 not closed between "
+                           f"u = {b.u_m * 1e3:.6g} and {a.u_m * 1e3:.6g} mm")
+
+    def opening(self, closed: _Trial, opened: _Trial, tangent, halvings: int = 6) -> _Trial:
+        """The last state with the seal closed between `closed` and `opened` (bisection on the
+        line between them, each trial from `closed`, to 2^-halvings of their distance)."""
+        for _ in range(halvings):
+            u, N = 0.5 * (closed.u_m + opened.u_m), 0.5 * (closed.N + opened.N)
+            try:
+                s = self.hold(closed, u, N) if abs(tangent[0]) >= abs(tangent[1]) else \
+                    self.hold_u(closed, u, N)
+            except RuntimeError:
+                opened = _Trial(u, N, math.nan, opened.step)
+                continue
+            if _open(self.cup, s):
+                opened = s
+            else:
+                closed = s
+        return closed
 
     def fold(self, a: _Trial, ka: float, b: _Trial, kb: float) -> _Trial:
         """The state between a and b where dN/du = 0 on the branch (secant on dN/du)."""
@@ -261,7 +367,7 @@ class _Walk:
             k = self.slope(s)
             if abs(k) <= 1e-3 * max(abs(ka), abs(kb)) or abs(u - a.u_m) < 1e-9 * self.cup.h1_m:
                 return s
-            if k > 0.0:
+            if (k > 0.0) == (kb > 0.0):
                 b, kb = s, k
             else:
                 a, ka = s, k
@@ -273,4 +379,5 @@ class _Walk:
                                                                self.cup._gas(t.N)), t.u_m, "held")
                   for t in trials}
         return Branch(self.F1, tuple(states[id(t)] for t in trials), np.array(slopes),
-                      None if detachment is None else states[id(detachment)], reason, self.stats)
+                      None if detachment is None else states[id(detachment)], reason, self.stats,
+                      self.snaps)

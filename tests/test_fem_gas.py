@@ -261,6 +261,24 @@ def test_pull_sensitivities_match_neighbouring_states(mesh, held):
     assert np.all(b.dN_du[:-1] < 0)
 
 
+def test_friction_holds_more_gas_than_frictionless(mesh, held):
+    """The largest N held at F1 (the fold of the branch): with Coulomb friction (mu = 0.5) the
+    contact zone cannot slide freely inwards under the suction as the plate rises, so the wall
+    stays stiffer and the cup reaches a larger cavity before the fold: more gas is held, the
+    fold comes at a higher plate, the gas at a higher pressure (coarse: N_max 2.31 against 2.17 N0
+    of the frictionless cup, the fold at u = -4.76 against -4.63 mm). Sticking is not compared:
+    its slips (a released node lands where the iteration puts it) make F1(N) at the held plate
+    discontinuous, and the branch stops at their onset."""
+    _, smooth = held
+    cup = CupWithGas.of(mesh, NeoHookean(), "coulomb", 0.5, rtol=RTOL)
+    rough = equilibrium_branch(cup, cup.press(4e-3)[-1], F1_HELD, du_m=0.25e-3)
+    assert rough.reason == "fold" and abs(rough.dN_du[-1]) <= 1e-3 * np.max(np.abs(rough.dN_du))
+    assert rough.N_max > 1.03 * smooth.N_max
+    assert rough.detachment.u_m < smooth.detachment.u_m
+    assert rough.detachment.p_b_Pa > smooth.detachment.p_b_Pa
+    assert rough.detachment.V_m3 > smooth.detachment.V_m3
+
+
 def test_branch_bad_input_is_refused(mesh):
     cup = CupWithGas.of(mesh, NeoHookean())
     sealed = cup.press(1e-3)[-1]
