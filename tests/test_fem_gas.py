@@ -279,6 +279,25 @@ def test_friction_holds_more_gas_than_frictionless(mesh, held):
     assert rough.detachment.V_m3 > smooth.detachment.V_m3
 
 
+@pytest.mark.parametrize("target", [{"force_N": 2.0}, {"r_start_m": 13e-3}])
+def test_press_to_a_force_or_a_start_radius(mesh, target):
+    """Pressing with the cavity open stops where the pressing force F0 = -F1 reaches force_N, or
+    the inner contact radius falls to r_start_m: the last state meets the target, the one before
+    (1e-7 m of plate short of it) does not; the cavity is open (p_b = p_a). The force is met to
+    1e-3; r_c can jump by a node spacing there (the mesh's resolution of r_start)."""
+    cup = CupWithGas.of(mesh, NeoHookean())
+    states = cup.press_to(**target)
+    before, last = states[-2], states[-1]
+    assert last.u_m - before.u_m <= 1e-7 and all(s.stage == "pressed" for s in states)
+    assert last.p_b_Pa == pytest.approx(cup.p_a_Pa, rel=1e-12)
+    if "force_N" in target:
+        assert -before.F1_N < 2.0 <= -last.F1_N <= 2.0 * (1 + 1e-3)
+    else:
+        chain = mesh.doflocs[:, cup.cavity.nodes]
+        spacing = np.max(np.hypot(*np.diff(chain, axis=1)))     # r_c moves node to node
+        assert before.r_c_m > 13e-3 >= last.r_c_m >= before.r_c_m - spacing
+
+
 def test_branch_bad_input_is_refused(mesh):
     cup = CupWithGas.of(mesh, NeoHookean())
     sealed = cup.press(1e-3)[-1]
