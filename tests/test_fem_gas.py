@@ -8,6 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from fem.cavity import CavitySurface, PressurizedMechanics
 from fem.condensation import make_solver
@@ -15,6 +16,7 @@ from fem.cup import CupSetup
 from fem.geometry import cup_geometry
 from fem.gas_branch import equilibrium_branch, pull_sensitivities
 from fem.gas_path import CupWithGas, cup_path
+from fem.linsolve import NotPositiveDefinite
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
 from fem.solver import SolverOptions, follow_path
@@ -81,6 +83,45 @@ def test_rank_one_factor_solves_the_full_tangent(mesh, frictionless):
     wider[let_go] = True
     x = fac.freeing(let_go).solve(rhs, du_fixed)
     assert np.linalg.norm(x - reference(wider)) <= 1e-8 * np.linalg.norm(x)
+
+
+def test_rank_one_factor_of_an_indefinite_sparse_part(mesh, frictionless):
+    """Where the sparse part K_s,ff has one negative eigenvalue and c is large enough, K_s + c g g^T
+    is positive definite (1 + c g^T K_s^-1 g < 0): the solver's factor is exact there (a dense
+    solve agrees) instead of failing into a shift; with c too small the whole is indefinite and
+    the factor says so (NotPositiveDefinite)."""
+    s = next(s for s in frictionless.states if s.stage == "pulled" and s.dp_Pa > 5e3)
+    cup, mech = _gas_mech(mesh, s)
+    _, K = mech.linearize(s.state.u)
+    n = K.shape[0]
+    fixed = np.concatenate([2 * cup.cup.top, 2 * cup.cup.top + 1,
+                            2 * cup.cup.plane.nodes[s.state.contact.active] + 1])
+    free = np.ones(n, bool)
+    free[fixed] = False
+    Ks = K.plain()
+    D = sp.diags(Ks.diagonal(), format="csr")
+    mu = np.sort(spla.eigsh(Ks[free][:, free].tocsc(), k=2, M=D[free][:, free].tocsc(), sigma=0.0,
+                            return_eigenvectors=False))
+    lam = 0.5 * (mu[0] + mu[1])                      # K_s - lam D: one negative eigenvalue
+    shifted = (Ks - lam * D).tocsr()
+    shifted.sort_indices()
+    w, v = np.linalg.eigh((shifted[free][:, free]).toarray())
+    assert w[0] < 0.0 < w[1]
+    g = np.zeros(n)
+    g[free] = v[:, 0] + 0.1 * v[:, 1]
+    solver = RankOneSolver(make_solver(Ks, mech.kin.node_coordinates(), mesh))
+    rhs = np.random.default_rng(4).standard_normal(n)
+    for c, definite in ((4.0 * abs(w[0]), True), (0.25 * abs(w[0]), False)):
+        T = GasTangent.of(shifted, shifted.data, c, g)
+        if not definite:
+            with pytest.raises(NotPositiveDefinite):
+                solver.factor(T, free)
+            continue
+        x = solver.factor(T, free).solve(rhs)
+        dense = (shifted + c * sp.csr_matrix(np.outer(g, g))).toarray()[np.ix_(free, free)]
+        assert np.linalg.eigvalsh(dense)[0] > 0.0
+        assert np.linalg.norm(x[free] - np.linalg.solve(dense, rhs[free])) <= 1e-8 * np.linalg.norm(x)
+        assert np.all(x[~free] == 0.0)
 
 
 def test_gas_potential_force_and_tangent_are_exact(mesh, frictionless):
