@@ -1,6 +1,6 @@
 """The sealed cup held by a given pull F1: its equilibrium branch, N as the unknown.
 
-    cup = CupWithGas.of(mesh, NeoHookean(), contact="sticking")
+    cup = CupWithGas.of(mesh, NeoHookean(), contact="coulomb", friction=0.5)
     sealed = cup.press(4e-3)[-1]                   # pressed with the gas escaping, sealed at N0
     branch = equilibrium_branch(cup, sealed, F1_N=10.0)
     branch.detachment.N, branch.reason, [(s.u_m, s.N, s.p_b_Pa, s.V_m3, s.seal_r_m) for s in branch.states]
@@ -19,8 +19,9 @@ to dN at the held plate, solved with the rank-one gas tangent (`fem.trapped_gas`
 contact dofs fixed and Coulomb's sliding nodes sliding (`pull_sensitivities`). Every trial N is
 reached from the previous state of the branch (not from the last trial: with friction a trial's
 back-and-forth would enter the history); a secant step takes over when the tangent's step does
-not halve the mismatch (the contact set changed in between).
-A bordered Newton (N an unknown of the solver's Newton iteration beside u) would need the
+not halve the mismatch (the contact set changed in between). A snap, F1 falling by a finite
+amount as N rises at the held plate, is crossed at that N by raising the plate until the pull is
+F1 again (`Branch.snaps`). A bordered Newton (N an unknown of the solver's Newton iteration beside u) would need the
 solver's Newton step and line search (`fem.newton`) to carry a constraint that is not an energy;
 the scalar root keeps the solver an energy minimization at given (u, N).
 
