@@ -13,13 +13,18 @@ the roof, axis and plane contributing nothing. With the pressure difference dp =
 gas does work p_b dV on the surface and the uniform ambient pressure none on the closed body,
 so the potential energy gains dp V_cav and the equilibrium minimizes W(u) + dp V_cav(u) under the
 plate displacement and the contact conditions. `PressurizedMechanics` adds dp V_cav, its exact
-gradient and Hessian on the quadratic edges (3-point Gauss per edge: the integrand r^2 dz/dxi is
+gradient and Hessian on the quadratic edges (6-point Gauss per edge: the integrand r^2 dz/dxi is
 a quintic) to `fem.forms.Mechanics`; the solver (`fem.solver`) needs nothing else.
 
-The chain is cut at its first node on the plane (z <= a round-off tolerance): beyond the seal the
-surface lies outside the gas region (a lifted pocket outside a mid-wall touchdown carries no
-cavity pressure). V_cav is continuous as the seal moves from node to node (z_k = 0 at the cut)
-and piecewise smooth like the contact conditions it follows.
+The chain is cut at its last node on the plane (z <= a round-off tolerance), the outer end of
+the outermost contact zone: beyond it the surface lies outside the gas region, and the gas fills
+every pocket the wall lifts between contact zones inside it (an inner touchdown does not seal a
+pocket off; it shares the cavity's pressure). So V_cav is continuous as nodes touch down and lift
+off inside the outermost contact, and as that contact's end moves from node to node (z_k = 0 at
+the cut); it is piecewise smooth like the contact conditions it follows. (Cut at the end of the
+first contact zone instead, V jumped by a pocket's volume when an inner touchdown lifted: an
+energy barrier that stalled the Newton iteration of a sticking cup under suction.) The seal r_k
+is the first node on the plane, the inner edge of the contact.
 
 Global equilibrium (tested): the vertical resultant of the pressure on any surface of revolution
 between radii r_0 and r_k is dp pi (r_k^2 - r_0^2), pulling the wall towards the plane, so the
@@ -63,7 +68,7 @@ def _rule(upper: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return N, dN, _W * half
 
 
-_FULL, _HALF = _rule(1.0), _rule(0.0)
+_RULES = tuple(np.stack(pair) for pair in zip(_rule(1.0), _rule(0.0)))   # full edge, half edge
 
 
 def wetted_fraction(z: np.ndarray, z_ref: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -111,13 +116,10 @@ class CavitySurface:
         return int(on[0]) if on.size else self.nodes.size - 1
 
     def cut_index(self, x: np.ndarray) -> int:
-        """Position of the last node of the first run of nodes on the plane: the load acts on
-        the chain up to here (module docstring)."""
-        on = x[1, self.nodes] <= self.tolerance_m
-        k = self.seal_index(x)
-        while k + 1 < on.size and on[k + 1]:
-            k += 1
-        return k
+        """Position of the last node on the plane, the outer end of the outermost contact: the
+        load acts on the chain up to here (module docstring); the last node if none is."""
+        on = np.flatnonzero(x[1, self.nodes] <= self.tolerance_m)
+        return int(on[-1]) if on.size else self.nodes.size - 1
 
     def seal_radius(self, x: np.ndarray) -> float:
         """r_k: the deformed radius of the seal node [m]."""
@@ -139,46 +141,49 @@ class CavitySurface:
 
     def _terms(self, x: np.ndarray, order: int, z_ref: float):
         """V_phi = pi r_k^2 Phi(z_k) - pi int_chain r^2 phi(z) dz and its derivatives, the chain
-        cut at `cut_index`."""
+        cut at `cut_index`; all edges at once, in chain order (the last one halved if the cut is
+        at a mid-side node)."""
         k = self.cut_index(x)
         full_edges, half = divmod(k, 2)
-        pieces = [(self.nodes[2 * e: 2 * e + 3], _FULL) for e in range(full_edges)]
-        if half:
-            pieces.append((self.nodes[2 * full_edges: 2 * full_edges + 3], _HALF))
+        edges = self.nodes[2 * np.arange(full_edges + half)[:, None] + np.arange(3)]   # [E, 3]
+        rule = np.zeros(edges.shape[0], int)
+        rule[full_edges:] = 1
+        N, dN, w = _RULES[0][rule], _RULES[1][rule], _RULES[2][rule]    # [E, 3, q], [E, q]
         seal = self.nodes[k]
         rk, zk = x[:, seal]
         Phi_k, phi_k, dphi_k, _ = (float(v) for v in wetted_fraction(np.array(zk), z_ref))
-        V = np.pi * rk**2 * Phi_k
-        grads, hess, pairs = [], [], []
-        for nodes, (N, dN, w) in pieces:
-            r, z = N.T @ x[0, nodes], N.T @ x[1, nodes]
-            dz = dN.T @ x[1, nodes]
-            _, phi, dphi, d2phi = wetted_fraction(z, z_ref)
-            V -= np.pi * np.sum(w * r**2 * phi * dz)
-            if not order:
-                continue
-            dofs = np.concatenate([2 * nodes, 2 * nodes + 1])
-            g_r = (N * (2.0 * r * phi * dz * w)).sum(axis=1)
-            g_z = (N * (r**2 * dphi * dz * w) + dN * (r**2 * phi * w)).sum(axis=1)
-            grads.append((dofs, -np.pi * np.concatenate([g_r, g_z])))
-            H = np.zeros((6, 6))
-            H[:3, :3] = (N * (2.0 * phi * dz * w)) @ N.T
-            H[:3, 3:] = (N * (2.0 * r * dphi * dz * w)) @ N.T + (N * (2.0 * r * phi * w)) @ dN.T
-            H[3:, :3] = H[:3, 3:].T
-            B = (N * (r**2 * dphi * w)) @ dN.T
-            H[3:, 3:] = (N * (r**2 * d2phi * dz * w)) @ N.T + B + B.T
-            hess.append(-np.pi * H.ravel())
-            pairs.append(np.stack(np.meshgrid(dofs, dofs, indexing="ij")).reshape(2, -1))
+        xr, xz = x[0, edges], x[1, edges]
+        r = np.einsum("eiq,ei->eq", N, xr)
+        z = np.einsum("eiq,ei->eq", N, xz)
+        dz = np.einsum("eiq,ei->eq", dN, xz)
+        _, phi, dphi, d2phi = wetted_fraction(z, z_ref)
+        V = np.pi * rk**2 * Phi_k - np.pi * np.sum(w * r**2 * phi * dz)
         if not order:
             return (float(V),)
+        dofs = np.concatenate([2 * edges, 2 * edges + 1], axis=1)                   # [E, 6]
+        g_r = np.einsum("eiq,eq->ei", N, 2.0 * r * phi * dz * w)
+        g_z = np.einsum("eiq,eq->ei", N, r**2 * dphi * dz * w) \
+            + np.einsum("eiq,eq->ei", dN, r**2 * phi * w)
+        grad = -np.pi * np.concatenate([g_r, g_z], axis=1)
+
+        def outer(a, weight, b):
+            return np.einsum("eiq,eq,ejq->eij", a, weight, b)
+        H = np.empty((edges.shape[0], 6, 6))
+        H[:, :3, :3] = outer(N, 2.0 * phi * dz * w, N)
+        H[:, :3, 3:] = outer(N, 2.0 * r * dphi * dz * w, N) + outer(N, 2.0 * r * phi * w, dN)
+        H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
+        B = outer(N, r**2 * dphi * w, dN)
+        H[:, 3:, 3:] = outer(N, r**2 * d2phi * dz * w, N) + B + B.transpose(0, 2, 1)
+        rows = np.broadcast_to(dofs[:, :, None], H.shape)
+        cols = np.broadcast_to(dofs[:, None, :], H.shape)
         d = np.array([2 * seal, 2 * seal + 1])
-        grads.append((d, np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])))
-        hess.append(np.array([2.0 * np.pi * Phi_k, 2.0 * np.pi * rk * phi_k,
-                              2.0 * np.pi * rk * phi_k, np.pi * rk**2 * dphi_k]))
-        pairs.append(np.stack(np.meshgrid(d, d, indexing="ij")).reshape(2, -1))
-        dofs = np.concatenate([g[0] for g in grads])
-        grad = np.concatenate([g[1] for g in grads])
-        return float(V), (dofs, grad), np.concatenate(hess), np.concatenate(pairs, axis=1)
+        seal_grad = np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])
+        seal_hess = np.array([2.0 * np.pi * Phi_k, 2.0 * np.pi * rk * phi_k,
+                              2.0 * np.pi * rk * phi_k, np.pi * rk**2 * dphi_k])
+        pairs = np.concatenate([np.stack([rows.reshape(-1), cols.reshape(-1)]),
+                                np.stack([np.repeat(d, 2), np.tile(d, 2)])], axis=1)
+        return (float(V), (np.concatenate([dofs.ravel(), d]), np.concatenate([grad.ravel(), seal_grad])),
+                np.concatenate([-np.pi * H.ravel(), seal_hess]), pairs)
 
 
 @dataclass

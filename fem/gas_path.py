@@ -23,7 +23,7 @@ seal radius r_k, the inner contact radius and the contact-pressure profile (the 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -46,7 +46,8 @@ __all__ = ["GasState", "CupWithGas", "CupPath", "cup_path"]
 class GasState:
     """One converged state of the cup with its gas (module docstring); SI units."""
 
-    stage: str                  # "pressed" (open cavity), "pulled" (fixed N), "leaked" (N moved)
+    stage: str                  # "pressed" (open cavity), "pulled" (fixed N), "leaked" (N moved),
+    #                             "sealed", "held" (`fem.gas_branch`: at a given pull)
     u_m: float                  # plate displacement down from touching (h = h1 - u)
     N: float                    # molecules in the cavity
     p_b_Pa: float               # gas pressure, N k_B T / V
@@ -55,6 +56,7 @@ class GasState:
     contact_force_N: float      # N_c: the plane's reaction less dp on the zone beyond the seal
     V_m3: float                 # cavity volume (geometric)
     seal_r_m: float             # r_k: radius of the seal node
+    cut_r_m: float              # outer end of the outermost contact zone (the suction's extent)
     r_c_m: float                # inner contact radius of the pressure profile
     profile: PressureProfile = field(repr=False)
     state: StepResult = field(repr=False)     # the solver's state, to continue the path from
@@ -111,6 +113,47 @@ class CupWithGas:
             on_step=on_step, start=None if start is None else start.state, name="u [m]"),
             lambda s: (mech, u0 + s.t, "pressed"), skip_first=start is not None)
 
+    def press_to(self, *, u_m: float | None = None, force_N: float | None = None,
+                 r_start_m: float | None = None, du_m: float = 0.25e-3,
+                 u_tol_m: float = 1e-7) -> list[GasState]:
+        """Press with the cavity open until one target is met: the plate displacement u_m, the
+        pressing force F0 = -F1 = force_N, or the inner contact radius r_c = r_start_m (it falls
+        as the cup is pressed). The plate moves in steps of du_m until the target is passed, then
+        the crossing is bisected in u to u_tol_m, each trial continuing the path from the last
+        state short of the target (so the contact history is the pressing path's). The last
+        state is the one to seal (`move_plate`, `fem.gas_branch`: N0 = p_a V / k_B T); r_c is
+        resolved to the mesh's node spacing, so r_start is met to that resolution."""
+        given = {k: v for k, v in (("u_m", u_m), ("force_N", force_N), ("r_start_m", r_start_m))
+                 if v is not None}
+        if len(given) != 1:
+            raise ValueError(f"press_to: give exactly one of u_m, force_N, r_start_m, got {sorted(given) or 'none'}")
+        (name, target), = given.items()
+        if not (isinstance(target, (int, float)) and np.isfinite(target) and target > 0.0):
+            raise ValueError(f"{name}: must be a number > 0, got {target!r}")
+        if name == "u_m":
+            return self.press(float(target))
+        if not (np.isfinite(du_m) and 0.0 < du_m <= 0.1 * self.h1_m):
+            raise ValueError(f"du_m: must be in (0, {0.1 * self.h1_m * 1e3:.4g}] mm, got {du_m * 1e3:.4g} mm")
+
+        def short(s: GasState) -> bool:                 # the target not yet reached
+            return -s.F1_N < target if name == "force_N" else s.r_c_m > target
+        stepper = replace(self, options=replace(self.options, initial_step=1.0, max_step=1.0),
+                          costs=self.costs)        # one load step per call unless it must cut
+        states = stepper.press(du_m)
+        while short(states[-1]):
+            if states[-1].u_m + du_m > self.h1_m:
+                raise ValueError(f"{name}: {target:.6g} is not reached by pressing the plate to "
+                                 f"h1 = {self.h1_m * 1e3:.4g} mm")
+            states.append(stepper.press(states[-1].u_m + du_m, start=states[-1])[-1])
+        over = states.pop()
+        while over.u_m - states[-1].u_m > u_tol_m:
+            mid = stepper.press(0.5 * (states[-1].u_m + over.u_m), start=states[-1])[-1]
+            if short(mid):
+                states.append(mid)
+            else:
+                over = mid
+        return states + [over]
+
     def move_plate(self, start: GasState, u_m: float, N: float | None = None) -> list[GasState]:
         """Move the plate from start's position to u_m (up: u_m smaller) with N molecules sealed
         in (default: start's N; a "pressed" start is sealed there, at p_a)."""
@@ -140,12 +183,12 @@ class CupWithGas:
             loaded, gas = mech.pressurized(step.u), mech.gas
         else:
             loaded, gas = mech, None
-        F1, Nc, V, r_k, _, r_c, _, profile = _outputs(step, loaded, self.cup, self.cavity)
+        F1, Nc, V, r_k, r_cut, r_c, _, profile = _outputs(step, loaded, self.cup, self.cavity)
         if gas is None:
             gas = self._gas(self.p_a_Pa * V / (K_B * self.T_K))
         p_b = gas.pressure_Pa(V)
-        return GasState(stage, float(u_m), gas.N, p_b, self.p_a_Pa - p_b, F1, Nc, V, r_k, r_c,
-                        profile, step)
+        return GasState(stage, float(u_m), gas.N, p_b, self.p_a_Pa - p_b, F1, Nc, V, r_k, r_cut,
+                        r_c, profile, step)
 
     def _gas(self, N: float) -> TrappedGas:
         return TrappedGas(float(N), self.T_K, self.p_a_Pa)

@@ -51,7 +51,7 @@ class SuctionGrid:
     contact_force_N: np.ndarray  # N: the plane's reaction less dp on the zone beyond the seal
     V_m3: np.ndarray            # cavity volume (geometric)
     seal_r_m: np.ndarray        # r_k: radius of the seal node (the cavity's edge)
-    cut_r_m: np.ndarray         # outer end of the innermost contact zone (the load's extent)
+    cut_r_m: np.ndarray         # outer end of the outermost contact zone (the load's extent)
     r_c_m: np.ndarray           # inner contact radius of the pressure profile
     potential_J: np.ndarray     # W + dp V_cav at the state (its dp-derivative is V_cav)
     profiles: tuple[tuple[PressureProfile, ...], ...] = field(repr=False)
@@ -128,8 +128,8 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
 def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:
     """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile) of a converged state. F1 = -F0, the plate's
     reaction, which with suction includes the roof's share dp pi r_0^2; N is the plane's
-    reaction less the suction dp pi (r_cut^2 - r_k^2) that the load puts on the flat contact
-    zone beyond the seal (there the interface is outside the cavity), so F1 + N = dp pi r_k^2
+    reaction less the suction dp pi (r_cut^2 - r_k^2) that the load puts on the contact zones
+    and pockets beyond the seal (`fem.cavity`), so F1 + N = dp pi r_k^2
     (`fem.cavity`). The profile is the plane's reaction per area (the gap at p_b)."""
     m = _measure(state, mech, cup.plane, cup.top, cup.path)
     x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])

@@ -44,15 +44,17 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from .cavity import CavitySurface, PressurizedMechanics
 from .condensation import make_solver
 from .contact import RigidPlane
 from .forms import Mechanics
+from .linsolve import NotPositiveDefinite
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
 __all__ = ["K_B", "TrappedGas", "GasMechanics", "GasTangent", "RankOneSolver", "RankOneFactor",
-           "follow_gas_path"]
+           "SymmetricLU", "follow_gas_path"]
 
 K_B = 1.380649e-23          # J/K (exact, SI 2019)
 
@@ -146,7 +148,60 @@ class RankOneFactor:
 
     def freeing(self, dofs: np.ndarray) -> "RankOneFactor":
         """As `fem.linsolve.Factor.freeing`, with the rank-one term on the larger block."""
-        return RankOneFactor(self._base.freeing(dofs), self._c, self._g)
+        return _definite(RankOneFactor(self._base.freeing(dofs), self._c, self._g))
+
+    @property
+    def definite(self) -> bool:
+        """Whether (K_s + c g g^T)_ff is positive definite: K_s,ff is (c >= 0), or it has one
+        negative eigenvalue and 1 + c g^T K_s^-1 g < 0 (the rank-one update's determinant lemma)."""
+        negative = getattr(self._base, "negative", 0)
+        return negative == 0 or (negative == 1 and self._den < 0.0)
+
+
+def _definite(fac: RankOneFactor) -> RankOneFactor:
+    if not fac.definite:
+        raise NotPositiveDefinite("the gas tangent K_s + c g g^T is not positive definite")
+    return fac
+
+
+class SymmetricLU:
+    """An indefinite K_ff (+ shift diag|K_ff|) factored by sparse LU with diagonal pivots only
+    (SuperLU in symmetric mode): P K_ff P^T = L D L^T, so `negative`, the count of negative
+    pivots, is K_ff's count of negative eigenvalues (Sylvester's law of inertia). The interface
+    of `fem.linsolve.Factor`; raises NotPositiveDefinite where a diagonal pivot is refused."""
+
+    def __init__(self, K: sp.csr_matrix, free: np.ndarray, shift: float = 0.0):
+        self.K, self.free, self.shift = K, free, shift
+        A = K[free][:, free].tocsc()
+        if shift:
+            A = A + sp.diags(shift * np.abs(A.diagonal()), format="csc")
+        try:
+            lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                           options=dict(SymmetricMode=True))
+        except RuntimeError as err:             # an exactly singular pivot
+            raise NotPositiveDefinite(f"symmetric LU: {err}") from None
+        if not np.array_equal(lu.perm_r, lu.perm_c):
+            raise NotPositiveDefinite("symmetric LU: an off-diagonal pivot was taken")
+        self._lu = lu
+        self.negative = int(np.count_nonzero(lu.U.diagonal() < 0.0))
+
+    def solve(self, rhs: np.ndarray, du_fixed: np.ndarray | None = None) -> np.ndarray:
+        """x with K_ff x_f = rhs_f - K_fc du_fixed_c, x_c = du_fixed_c (0 if None); rhs [n] or [n, m]."""
+        fixed = ~self.free
+        x = np.zeros_like(rhs, dtype=float)
+        b = rhs
+        if du_fixed is not None:
+            d = np.where(fixed, du_fixed, 0.0)
+            b = rhs - (self.K @ d if rhs.ndim == 1 else (self.K @ d)[:, None])
+            x[fixed] = du_fixed[fixed] if rhs.ndim == 1 else du_fixed[fixed, None]
+        x[self.free] = self._lu.solve(np.ascontiguousarray(b[self.free]))
+        return x
+
+    def freeing(self, dofs: np.ndarray) -> "SymmetricLU":
+        """The factor of the larger free block (a new factorization)."""
+        free = self.free.copy()
+        free[dofs] = True
+        return SymmetricLU(self.K, free, self.shift)
 
 
 class RankOneSolver:
@@ -157,8 +212,17 @@ class RankOneSolver:
         self._base = base
 
     def factor(self, K, free: np.ndarray, shift: float = 0.0):
-        fac = self._base.factor(_sparse_part(K), free, shift)
+        """The factor of (K_s + c g g^T)_ff (+ shift diag|K_s,ff|). Where K_s,ff is not definite but
+        the whole is (the gas holds the wall that would snap at fixed dp), an indefinite
+        factor of the sparse part (`SymmetricLU`) replaces the Cholesky factor: the Newton step
+        stays exact instead of shifted. Raises NotPositiveDefinite where the whole is not."""
         rank_one = getattr(K, "rank_one", None)
+        try:
+            fac = self._base.factor(_sparse_part(K), free, shift)
+        except NotPositiveDefinite:
+            if rank_one is None:
+                raise
+            return _definite(RankOneFactor(SymmetricLU(_sparse_part(K), free, shift), *rank_one))
         return fac if rank_one is None else RankOneFactor(fac, *rank_one)
 
     def __getattr__(self, name):

@@ -29,19 +29,27 @@ def _xy(v):
     return np.stack([v[0::2], v[1::2]])
 
 
-@pytest.mark.parametrize("wetting_m", [0.0, 2e-5])
-def test_volume_gradient_and_hessian_match_finite_differences(wetting_m):
+@pytest.mark.parametrize("wetting_m, seal, halved", [(0.0, -1, False), (2e-5, -1, False),
+                                                      (0.0, -6, True), (2e-5, -6, True)])
+def test_volume_gradient_and_hessian_match_finite_differences(wetting_m, seal, halved):
+    """On a perturbed chain whose first node on the plane is the rim (a vertex) or a mid-side node
+    (the cut halves that edge)."""
     mesh = cup_mesh(cup_geometry("A"), "coarse")
     cav = CavitySurface.of(mesh, wetting_m)
     rng = np.random.default_rng(1)
     x = mesh.doflocs + 1e-6 * rng.standard_normal(mesh.doflocs.shape)
     x[1, cav.nodes[-12:-1]] = 3e-5 * rng.random(11)      # the wall near the rim just above the plane
-    x[1, cav.nodes[-1]] = 0.0
+    x[1, cav.nodes[seal]] = 0.0
+    if halved:
+        x[1, cav.nodes[-1]] = 3e-5                        # the rim lifted: the seal alone touches
+    assert (cav.cut_index(x) % 2 == 1) == halved
     n = x.size
     V, (dofs, g), h, pairs = cav.derivatives(x)
     G = np.bincount(dofs, g, minlength=n)
     H = sp.coo_matrix((h, (pairs[0], pairs[1])), shape=(n, n)).toarray()
     d, eps = rng.standard_normal(n), 1e-9
+    if halved:                               # an inner node on the plane stays there (V is cut there)
+        d[2 * cav.nodes[seal] + 1] = 0.0
     xv = _flat(x)
     fd = (cav.loaded_volume(_xy(xv + eps * d)) - cav.loaded_volume(_xy(xv - eps * d))) / (2 * eps)
     assert fd == pytest.approx(G @ d, rel=1e-6)
@@ -54,6 +62,31 @@ def test_volume_gradient_and_hessian_match_finite_differences(wetting_m):
     assert np.allclose(H, H.T)
     if wetting_m == 0.0:
         assert V == pytest.approx(cav.volume(x), rel=1e-14)
+
+
+def test_volume_is_continuous_when_an_inner_touchdown_lifts():
+    """A wall touching the plane mid-way and at the rim, with a lifted pocket between: lifting the
+    inner touchdown by eps changes V_cav by O(eps) (the pocket is part of the gas region, its
+    pressure the cavity's), and the gradient predicts the change; the seal r_k moves out to the
+    rim. Cut at the first contact zone instead, V jumped by the pocket's volume."""
+    mesh = cup_mesh(cup_geometry("A"), "coarse")
+    cav = CavitySurface.of(mesh)
+    x = mesh.doflocs.copy()
+    chain = cav.nodes
+    k = chain.size - 15                                   # the inner touchdown
+    x[1, chain[k:]] = 2e-4 * np.sin(np.pi * np.arange(chain.size - k) / (chain.size - 1 - k))
+    x[1, chain[k]] = x[1, chain[-1]] = 0.0
+    assert cav.seal_index(x) == k and cav.cut_index(x) == chain.size - 1
+    V, (dofs, g), _, _ = cav.derivatives(x)
+    pocket = -np.pi * np.trapezoid(x[0, chain[k:]] ** 2, x[1, chain[k:]])
+    for eps in (1e-9, 1e-8):
+        lifted = x.copy()
+        lifted[1, chain[k]] = eps
+        assert cav.seal_index(lifted) == chain.size - 1
+        dV = cav.volume(lifted) - V
+        assert abs(dV) < 1e-3 * abs(pocket)                 # no jump by the pocket
+        assert dV == pytest.approx(eps * np.bincount(dofs, g, minlength=x.size)[2 * chain[k] + 1],
+                                   rel=1e-3)
 
 
 def test_undeformed_cone_volume_is_the_frustum():

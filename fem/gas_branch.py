@@ -1,0 +1,384 @@
+"""The sealed cup held by a given pull F1: its equilibrium branch, N as the unknown.
+
+    cup = CupWithGas.of(mesh, NeoHookean(), contact="coulomb", friction=0.5)
+    sealed = cup.press(4e-3)[-1]                   # pressed with the gas escaping, sealed at N0
+    branch = equilibrium_branch(cup, sealed, F1_N=10.0)
+    branch.detachment.N, branch.reason, [(s.u_m, s.N, s.p_b_Pa, s.V_m3, s.seal_r_m) for s in branch.states]
+
+From the sealed state the plate is first raised at fixed N0 until the handle pulls F1 (the pull is
+ramped at fixed N). Then, as gas leaks in, the cup moves along the states (u, N) whose pull is
+F1: the branch is stepped in the plate position u (upwards, u decreasing) with N the unknown,
+or, where the branch turns in u (dF1/dN -> 0: more gas at the held plate no longer lowers the
+pull), in N with u the unknown (natural-parameter switching along the branch's tangent, which
+`pull_sensitivities` gives exactly; the direction is the one in which N rises, the leak's).
+Each state is one `fem.solver` path from the previous state of the branch, the plate and N
+moving together on a line in (u, N), so the contact history (sticking anchors, Coulomb slips) is
+carried from state to state; N is found by a scalar Newton iteration on F1(u, N) = F1 whose
+derivative dF1/dN is exact for the state's contact set: the linear response of the equilibrium
+to dN at the held plate, solved with the rank-one gas tangent (`fem.trapped_gas`), the held
+contact dofs fixed and Coulomb's sliding nodes sliding (`pull_sensitivities`). Every trial N is
+reached from the previous state of the branch (not from the last trial: with friction a trial's
+back-and-forth would enter the history); a secant step takes over when the tangent's step does
+not halve the mismatch (the contact set changed in between). A snap, F1 falling by a finite
+amount as N rises at the held plate, is crossed at that N by raising the plate until the pull is
+F1 again (`Branch.snaps`). A bordered Newton (N an unknown of the solver's Newton iteration beside u) would need the
+solver's Newton step and line search (`fem.newton`) to carry a constraint that is not an energy;
+the scalar root keeps the solver an energy minimization at given (u, N).
+
+Detachment (the criterion): with the pull F1 held, the leak raises N, and the cup follows the
+branch while N can still rise along it. Where N(u) has its maximum, dN/du = 0 (the fold of the
+branch), no state with more gas holds F1: the cup lets go. That N_max is the largest amount of
+gas the cup holds at F1, and the branch ends there ("fold"; dN/du is computed exactly at every
+state, dN/du = -(dF1/du)/(dF1/dN), and the fold located by a secant on it). The branch also ends
+where the seal opens, no node of the cavity chain being on the plane any more: the detachment is
+then the last state with the seal closed, bisected to 1/64 of a step ("seal opened"). It ends
+without a detachment where the plate reaches u_min_m ("u_min"), or where no state holds F1 even
+with 1/16 of a step ("stopped: why"; e.g. the sticking law's slips, whose landing depends on the
+load step, make F1(N) at the held plate discontinuous and not monotone).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .gas_path import CupWithGas, GasState
+from .solver import SolverStats, StepResult
+from .cup import _joined
+from .trapped_gas import K_B, GasMechanics, follow_gas_path
+
+__all__ = ["Branch", "equilibrium_branch", "pull_sensitivities"]
+
+SNAP_DN = 1e-6      # relative rise of N at the held plate that tests for a snap
+SNAP_DROP = 1e-3    # ... and the relative fall of F1 that makes it one
+
+
+@dataclass(frozen=True, eq=False)
+class Branch:
+    """The states holding the pull F1_N, the pulled state first (plate raised at N0 to F1), then
+    along the plate position; `dN_du` [1/m] per state; the detachment state and its reason
+    (module docstring); the cost of the whole branch."""
+
+    F1_N: float
+    states: tuple[GasState, ...]
+    dN_du: np.ndarray
+    detachment: GasState | None       # the fold (largest N) or the state where the seal opened
+    reason: str                       # "fold", "seal opened", "u_min", "not held", "stopped: why"
+    stats: SolverStats
+    snaps: int = 0                    # snaps crossed (the plate rose at fixed N to restore F1)
+
+    @property
+    def N_max(self) -> float:
+        """The largest N held at F1 (that of the detachment state) [molecules]."""
+        return self.detachment.N if self.detachment is not None else float("nan")
+
+    def column(self, name: str) -> np.ndarray:
+        """One field of every state as an array, e.g. column("N")."""
+        return np.array([getattr(s, name) for s in self.states])
+
+
+def pull_sensitivities(cup: CupWithGas, s: GasState) -> tuple[float, float]:
+    """(dF1/dN [N per molecule], dF1/du [N/m]) at a converged sealed state: the linear response of
+    the equilibrium to a change of N at the held plate and to a plate move at fixed N, with the
+    full tangent K + dp Hess V + (N k_B T / V^2) grad V grad V^T on the free dofs and the state's
+    held contact dofs fixed (its contact set kept). F1 is the plate's reaction (`fem.gas_path`).
+    Coulomb's sliding nodes keep t = -mu lambda s: their radial row gains mu s times their normal
+    row (the reaction lambda changes with the state). The matrix is factored by sparse LU (it
+    need not be symmetric, nor definite where the gas alone holds the wall), the rank-one term
+    added by Sherman-Morrison."""
+    return _sensitivities(cup, s.N, s.state)
+
+
+def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, float]:
+    mech = GasMechanics(cup.cup.mech, cup.cavity, cup._gas(N))
+    u = state.u
+    _, r, K = mech.evaluate(u)
+    c, g = K.rank_one
+    plane, top = cup.cup.plane, cup.cup.top
+    plate_z = 2 * top + 1
+    held, _ = plane.constraints(state.contact)
+    free = np.ones(u.size, bool)
+    free[np.concatenate([2 * top, plate_z, held])] = False
+    slide = state.contact.active & (state.contact.slip != 0)
+    P = sp.identity(u.size, format="csr")                 # rows: r + mu s lambda = 0 when sliding
+    if slide.any():
+        nodes = plane.nodes[slide]
+        P = P + sp.csr_matrix((plane.law.mu * state.contact.slip[slide].astype(float),
+                               (2 * nodes, 2 * nodes + 1)), shape=P.shape)
+    Ks = K.plain()
+    lu = spla.splu((P @ Ks)[free][:, free].tocsc())
+    down = np.zeros(u.size)
+    down[plate_z] = -1.0                                  # u_z = -u on the plate: d/du
+    b = -(K_B * cup.T_K / mech.volume_m3(u)) * g          # dr/dN at fixed u
+    h = (P @ g)[free]
+    rhs = np.stack([-(P @ b)[free], -(P @ (Ks @ down))[free] - c * h * (g @ down), h], axis=1)
+    y = lu.solve(rhs)
+    gf = g[free]
+    y[:, :2] -= np.outer(y[:, 2], c * (gf @ y[:, :2]) / (1.0 + c * gf @ y[:, 2]))
+    x_N, x_u = np.zeros(u.size), down.copy()
+    x_N[free], x_u[free] = y[:, 0], y[:, 1]
+    return float(np.sum((K @ x_N + b)[plate_z])), float(np.sum((K @ x_u)[plate_z]))
+
+
+def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: float = 0.1e-3,
+                       u_min_m: float | None = None, max_states: int = 400) -> Branch:
+    """The states holding the pull F1_N from `sealed` (a "pressed" state, sealed there at p_a, or
+    a sealed state) to detachment (module docstring). du_m: the plate step along the branch
+    (halved, down to du_m / 16, where a state cannot be found); u_min_m: the lowest plate
+    position (default -h1: the plate above the touching height, the suction holding the wall on
+    the plane). Raises ValueError for bad input; where no state is found even with the smallest
+    step, the branch ends there with reason "stopped: <why>" and no detachment."""
+    if not (isinstance(F1_N, (int, float)) and math.isfinite(F1_N)):
+        raise ValueError(f"F1_N: must be a finite number, got {F1_N!r}")
+    if not (math.isfinite(du_m) and 0.0 < du_m <= 0.1 * cup.h1_m):
+        raise ValueError(f"du_m: must be in (0, {0.1 * cup.h1_m * 1e3:.4g}] mm, got {du_m * 1e3:.4g} mm")
+    u_min = -cup.h1_m if u_min_m is None else float(u_min_m)
+    if not (u_min < sealed.u_m):
+        raise ValueError(f"u_min_m: must be below the sealed plate position {sealed.u_m * 1e3:.4g} mm, "
+                         f"got {u_min * 1e3:.4g} mm")
+    walk = _Walk(cup, float(F1_N))
+    start = _Trial(sealed.u_m, sealed.N, sealed.F1_N, sealed.state)
+    try:
+        first = walk.pull_to_force(start, du_m, u_min)
+    except RuntimeError as err:
+        return walk.result(None, f"stopped: {err}")
+    if first is None:
+        return walk.result(None, "not held")
+    trials, slopes = [first], [walk.slope(first)]
+    N_ref = abs(slopes[0]) * du_m if math.isfinite(slopes[0]) and slopes[0] else 1e-3 * first.N
+    tangent = walk.tangent(first, du_m, N_ref, None)
+    h = 1.0
+    while len(trials) < max_states:
+        prev = trials[-1]
+        u_pred, N_pred = prev.u_m + h * tangent[0] * du_m, prev.N + h * tangent[1] * N_ref
+        if u_pred < u_min:
+            return walk.result(None, "u_min", trials, slopes)
+        try:
+            if abs(tangent[0]) >= abs(tangent[1]):      # u leads: N is the unknown
+                s = walk.hold(prev, u_pred, N_pred)
+            else:                                        # N leads (near a turn of u): u is
+                s = walk.hold_u(prev, u_pred, N_pred)
+        except RuntimeError as err:
+            if h > 1.0 / 16.0 * (1 + 1e-9):
+                h *= 0.5
+                continue
+            # a snap? F1 falls by a finite amount as N rises at the held plate (a seal slips):
+            # under the held pull the plate then rises at that N until F1 is restored
+            try:
+                after = walk.solve(prev, prev.u_m, prev.N * (1.0 + SNAP_DN))
+                restored = after.F1_N < walk.F1 - SNAP_DROP * abs(walk.F1) and \
+                    walk.pull_to_force(after, du_m, u_min)
+            except RuntimeError:
+                restored = None
+            if not restored:
+                return walk.result(None, f"stopped: {err}", trials, slopes)
+            trials.append(restored)
+            slopes.append(walk.slope(restored))
+            tangent = walk.tangent(restored, du_m, N_ref, None)
+            walk.snaps += 1
+            h = 1.0
+            continue
+        h = min(1.0, 2.0 * h)
+        if _open(cup, s):
+            last = walk.opening(prev, s, tangent)
+            trials = trials + ([last] if last is not prev else [])
+            slopes = slopes + ([walk.slope(last)] if last is not prev else [])
+            return walk.result(last, "seal opened", trials, slopes)
+        t = walk.tangent(s, du_m, N_ref, tangent)
+        if t[1] < 0.0 < tangent[1]:                  # N passed its maximum along the branch
+            fold = walk.fold(prev, slopes[-1], s, walk.slope(s))
+            return walk.result(fold, "fold", trials + [fold], slopes + [walk.slope(fold)])
+        trials.append(s)
+        slopes.append(walk.slope(s))
+        tangent = t
+    raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
+
+
+def _open(cup: CupWithGas, s: "_Trial") -> bool:
+    """Whether no node of the cavity chain is on the plane (the cavity is open to the outside)."""
+    x = cup.mesh.doflocs + np.stack([s.step.u[0::2], s.step.u[1::2]])
+    return not np.any(x[1, cup.cavity.nodes] <= cup.cavity.tolerance_m)
+
+
+@dataclass(frozen=True, eq=False)
+class _Trial:
+    """A converged sealed state before its measurement: plate position, N, pull, solver state."""
+
+    u_m: float
+    N: float
+    F1_N: float
+    step: StepResult
+
+
+class _Walk:
+    """The state-to-state machinery of `equilibrium_branch`: solves, the F1 root, the costs."""
+
+    def __init__(self, cup: CupWithGas, F1_N: float):
+        self.cup, self.F1 = cup, F1_N
+        self.options = replace(cup.options, initial_step=1.0, max_step=1.0)
+        self.stats: SolverStats | None = None
+        self.snaps = 0
+        self.slopes: dict[_Trial, tuple[float, float]] = {}     # by identity
+        rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
+        # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
+        self.tolerance = cup.options.rtol * cup.p_a_Pa * math.pi * rim**2
+
+    def derivatives(self, s: _Trial) -> tuple[float, float]:
+        if s not in self.slopes:
+            self.slopes[s] = _sensitivities(self.cup, s.N, s.step)
+        return self.slopes[s]
+
+    def slope(self, s: _Trial) -> float:
+        """dN/du along the branch at s [1/m]."""
+        dF1_dN, dF1_du = self.derivatives(s)
+        return -dF1_du / dF1_dN
+
+    def tangent(self, s: _Trial, du_m: float, N_ref: float, previous) -> tuple[float, float]:
+        """The branch's unit tangent at s in (u / du_m, N / N_ref), dF1 = 0: along the previous
+        tangent (continuity), or with N rising if there is none."""
+        dF1_dN, dF1_du = self.derivatives(s)
+        t = np.array([dF1_dN * N_ref, -dF1_du * du_m])
+        t /= np.linalg.norm(t)
+        if (previous is None and t[1] < 0.0) or (previous is not None and t @ previous < 0.0):
+            t = -t
+        return float(t[0]), float(t[1])
+
+    def hold_u(self, prev: _Trial, u_guess: float, N: float) -> _Trial:
+        """The state at N whose pull is F1 (the plate position by Newton on F1(u), the secant
+        where it is slow), reached from prev."""
+        s = self.solve(prev, u_guess, N)
+        tried: list[tuple[float, float]] = [(s.u_m, s.F1_N - self.F1)]
+        for _ in range(12):
+            miss = s.F1_N - self.F1
+            if abs(miss) <= self.tolerance:
+                return s
+            u_new = s.u_m - miss / self.derivatives(s)[1]
+            if len(tried) >= 2 and abs(miss) > 0.5 * abs(tried[-2][1]):
+                (ua, fa), (ub, fb) = tried[-2:]
+                if fb != fa:
+                    u_new = ub - fb * (ub - ua) / (fb - fa)
+            s = self.solve(prev, u_new, N)
+            tried.append((s.u_m, s.F1_N - self.F1))
+        raise RuntimeError(f"F1_N = {self.F1:g} N: the plate position not found at N = {N:.6g} "
+                           f"(pull off by {s.F1_N - self.F1:.3g} N after {len(tried) - 1} corrections)")
+
+    def solve(self, start: _Trial, u_m: float, N: float) -> _Trial:
+        """The state at (u_m, N), reached from `start` with the plate and N on a line."""
+        u0, N0 = start.u_m, start.N
+        mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
+                            schedule=lambda t: N0 + t * (N - N0))
+        top = self.cup.cup.top
+        dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
+
+        def plate(t):
+            return dofs, np.concatenate([zeros, np.full(top.size, -(u0 + t * (u_m - u0)))])
+        last = []
+        stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
+                                options=self.options, on_step=last.append)
+        self.stats = stats if self.stats is None else _joined(self.stats, stats)
+        end = last[-1]
+        return _Trial(float(u_m), float(N), float(np.sum(end.r_int[2 * top + 1])), end)
+
+    def hold(self, prev: _Trial, u_m: float, N_guess: float) -> _Trial:
+        """The state at plate position u_m whose pull is F1 (N by Newton on F1(N), module
+        docstring), reached from prev."""
+        s = self.solve(prev, u_m, N_guess)
+        tried: list[tuple[float, float]] = [(s.N, s.F1_N - self.F1)]
+        for _ in range(12):
+            miss = s.F1_N - self.F1
+            if abs(miss) <= self.tolerance:
+                return s
+            N_new = s.N - miss / self.derivatives(s)[0]
+            if len(tried) >= 2 and abs(miss) > 0.5 * abs(tried[-2][1]):   # slow: secant
+                (Na, fa), (Nb, fb) = tried[-2:]
+                if fb != fa:
+                    N_new = Nb - fb * (Nb - Na) / (fb - fa)
+            if not N_new > 0.0:
+                break
+            s = self.solve(prev, u_m, N_new)
+            tried.append((s.N, s.F1_N - self.F1))
+        raise RuntimeError(f"F1_N = {self.F1:g} N: N not found at u = {u_m * 1e3:.4g} mm "
+                           f"(pull off by {s.F1_N - self.F1:.3g} N after {len(tried) - 1} corrections)")
+
+    def pull_to_force(self, sealed: _Trial, du_m: float, u_min: float) -> _Trial | None:
+        """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m
+        (Newton's with the exact dF1/du where it points up), each from the last state pulling
+        less than F1; a step that overshoots brackets the crossing, which regula falsi (Illinois)
+        closes. None if the plate reaches u_min first. The plate never moves down: with friction
+        a back-and-forth would enter the history."""
+        a, b = sealed, None
+        while b is None:
+            miss = a.F1_N - self.F1
+            if abs(miss) <= self.tolerance:
+                return a
+            dF1_du = self.derivatives(a)[1]
+            step = -miss / dF1_du if dF1_du < 0.0 else -du_m
+            u_new = a.u_m + float(np.clip(step, -du_m, -1e-6 * du_m))
+            if u_new < u_min:
+                return None
+            s = self.solve(a, u_new, a.N)
+            if s.F1_N - self.F1 > self.tolerance:
+                b = s
+            else:
+                a = s
+        fa, fb, side = a.F1_N - self.F1, b.F1_N - self.F1, 0
+        for _ in range(60):
+            u = b.u_m + (a.u_m - b.u_m) * fb / (fb - fa)
+            s = self.solve(a, u, a.N)
+            f = s.F1_N - self.F1
+            if abs(f) <= self.tolerance:
+                return s
+            if f < 0.0:
+                a, fa = s, f
+                fb *= 0.5 if side == -1 else 1.0
+                side = -1
+            else:
+                b, fb = s, f
+                fa *= 0.5 if side == 1 else 1.0
+                side = 1
+        raise RuntimeError(f"F1_N = {self.F1:g} N: the pull at fixed N0 not closed between "
+                           f"u = {b.u_m * 1e3:.6g} and {a.u_m * 1e3:.6g} mm")
+
+    def opening(self, closed: _Trial, opened: _Trial, tangent, halvings: int = 6) -> _Trial:
+        """The last state with the seal closed between `closed` and `opened` (bisection on the
+        line between them, each trial from `closed`, to 2^-halvings of their distance)."""
+        for _ in range(halvings):
+            u, N = 0.5 * (closed.u_m + opened.u_m), 0.5 * (closed.N + opened.N)
+            try:
+                s = self.hold(closed, u, N) if abs(tangent[0]) >= abs(tangent[1]) else \
+                    self.hold_u(closed, u, N)
+            except RuntimeError:
+                opened = _Trial(u, N, math.nan, opened.step)
+                continue
+            if _open(self.cup, s):
+                opened = s
+            else:
+                closed = s
+        return closed
+
+    def fold(self, a: _Trial, ka: float, b: _Trial, kb: float) -> _Trial:
+        """The state between a and b where dN/du = 0 on the branch (secant on dN/du)."""
+        for _ in range(8):
+            u = b.u_m + (a.u_m - b.u_m) * kb / (kb - ka)
+            s = self.hold(a, u, a.N + ka * (u - a.u_m))
+            k = self.slope(s)
+            if abs(k) <= 1e-3 * max(abs(ka), abs(kb)) or abs(u - a.u_m) < 1e-9 * self.cup.h1_m:
+                return s
+            if (k > 0.0) == (kb > 0.0):
+                b, kb = s, k
+            else:
+                a, ka = s, k
+        return s
+
+    def result(self, detachment, reason, trials=(), slopes=()) -> Branch:
+        """The measured branch (`fem.gas_path.CupWithGas.measure`)."""
+        states = {id(t): self.cup.measure(t.step, GasMechanics(self.cup.cup.mech, self.cup.cavity,
+                                                               self.cup._gas(t.N)), t.u_m, "held")
+                  for t in trials}
+        return Branch(self.F1, tuple(states[id(t)] for t in trials), np.array(slopes),
+                      None if detachment is None else states[id(detachment)], reason, self.stats,
+                      self.snaps)
