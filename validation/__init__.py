@@ -2,7 +2,7 @@
 
 The public nouns, imported on first use (``import validation`` imports no fem, skfem,
 matplotlib or dask): the FEM pipeline (`fem_stiffness`, `fem_path`, `fem_curve`, `neo_hookean`,
-`route_model`, `surface_uc_table`), the cup a curve was computed for (`resolve_cup`,
+`surface_uc_table`), every lifetime (`lifetimes`, `Lifetimes`, `route_options`, `ROUTES`), the cup a curve was computed for (`resolve_cup`,
 `CupChoice`), the hand-off (`stiffness_curve`, `write_sidecar`), the cache (`Cache`), the
 coupled route (`CoupledOptions`, `coupled_model`, `suction_table_for`) and scenes (`run_scene`).
 """
@@ -15,9 +15,10 @@ from typing import Any
 #: public name -> the module that defines it
 _WHERE = {
     "fem_stiffness": "validation.pipeline", "fem_path": "validation.pipeline", "fem_curve": "validation.pipeline",
-    "neo_hookean": "validation.pipeline", "route_model": "validation.pipeline",
+    "neo_hookean": "validation.pipeline",
+    "lifetimes": "validation.lifetimes", "Lifetimes": "validation.lifetimes", "route_options": "validation.lifetimes",
     "surface_uc_table": "validation.pipeline", "DEFAULT_SURFACE": "validation.pipeline",
-    "ROUTES": "validation.pipeline",
+    "ROUTES": "validation.lifetimes",
     "resolve_cup": "validation.design", "CupChoice": "validation.design",
     "stiffness_curve": "validation.handoff", "write_sidecar": "validation.handoff",
     "Cache": "validation.cache",

@@ -37,7 +37,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
-                                      contact_choice, load_cup_design, route_model)
+                                      contact_choice, cup_laws, load_cup_design)
 
 if TYPE_CHECKING:
     from fem.interface import ContactChoice
@@ -122,10 +122,9 @@ def _blank(value):
     return "" if value is None else value
 
 
-def coupled_lifetimes(args: argparse.Namespace, geometry, uc, choice, tmp: Path):
-    """The coupled route's lifetimes [CoupledLifetime] and largest holdable force [N]: the design's
-    suction table (read, or built and cached), copied to the output."""
-    from reduced.coupled import CoupledCavity
+def coupled_table(args: argparse.Namespace, geometry, tmp: Path):
+    """The design's suction table for the coupled route (read, or built and cached), copied to
+    the output."""
     from reduced.suction_table import SuctionTable
     from validation.coupled.build import suction_table_for
     from validation.output import terminal_progress
@@ -138,10 +137,7 @@ def coupled_lifetimes(args: argparse.Namespace, geometry, uc, choice, tmp: Path)
                                   cache_dir=None if args.no_cache else args.cache_dir,
                                   progress=terminal_progress("suction"))
     table.to_json(tmp / "suction_table.json")
-    u_start = table.h1_m - choice.cup.h_start_m
-    model = CoupledCavity(table, uc)
-    results = [model.lifetime(F, u_start) for F in FORCES_N]
-    return results, model.largest_holdable_force(u_start)
+    return table
 
 
 def _check_suction_table(args: argparse.Namespace, geometry) -> None:
@@ -193,9 +189,10 @@ def plot(series: dict, curve, cup, path: Path, title: str) -> None:
 def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
-    from reduced.lifetime import lifetime_sweep, reference_model
+    from reduced.lifetime import reference_model
     from validation import handoff
     from validation.design import resolve_cup
+    from validation.lifetimes import lifetimes, route_options
     from validation.output import atomic_directory, terminal_progress
 
     from fem.mesh import DEFAULT_FIDELITY
@@ -204,7 +201,7 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import check_outputs, command_inputs
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
-    cup_laws, seal = route_model(args, coupled=True)
+    laws = cup_laws(args, coupled=True)
     geometry, uc, uc_label = _inputs(args)
     _check_suction_table(args, geometry)
     from fem.solver import ConvergenceError
@@ -216,20 +213,24 @@ def run(args: argparse.Namespace) -> int:
         except ConvergenceError as exc:
             raise solver_failure(exc, Path(f"{Path(args.out)}.failure.json")) from None
         choice = resolve_cup(curve, r_start_mm=args.r_start_mm, l0_mm=args.l0_mm, l1_mm=args.l1_mm,
-                             curve_label="the FEM curve", laws=cup_laws)
+                             curve_label="the FEM curve", laws=laws)
         curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
         handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
         base = reference_model(choice.cup, uc)
-        if seal == "coupled":
-            results, holdable = coupled_lifetimes(args, geometry, uc, choice, tmp)
+        if args.route == "coupled":
+            model = replace(base, stiffness=None, suction=coupled_table(args, geometry, tmp), label="FEM-fed")
+            progress = None
         else:
-            model = replace(base, stiffness=curve, geometry=cup_laws, seal=seal, label="FEM-fed")
-            results = lifetime_sweep(model, FORCES_N, progress=terminal_progress("lifetime"), refine=4)
+            model = replace(base, stiffness=curve, label="FEM-fed")
+            progress = terminal_progress("lifetime")
+        results = lifetimes(model, FORCES_N, args.route, progress=progress,
+                            refine=1 if args.route == "coupled" else 4, **route_options(args.route, laws))
+        holdable = results.largest_force_N
         series = {f"FEM-fed, {args.route} route": results}
         if args.route != "paper":        # the same FEM F0 through the paper's strip, for comparison
-            series["FEM F0, paper route (strip, eqs 3-7)"] = lifetime_sweep(
-                replace(base, stiffness=curve, geometry="cone"), FORCES_N, refine=1)
-        series["Appendix A-fed, paper route (d0 2 mm)"] = lifetime_sweep(base, FORCES_N, refine=1)
+            series["FEM F0, paper route (strip, eqs 3-7)"] = lifetimes(
+                replace(base, stiffness=curve), FORCES_N, "paper", cup_laws="cone")
+        series["Appendix A-fed, paper route (d0 2 mm)"] = lifetimes(base, FORCES_N, "paper", cup_laws="cone")
         write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, args.route)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
              f"{choice.label}, FEM {args.contact_choice.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
@@ -239,27 +240,32 @@ def run(args: argparse.Namespace) -> int:
     crossed = {"profile": "the FEM's contact-pressure profiles" + (f", averaged over patches of {1e6 * patch:.0f} um"
                                                                  if patch else " (raw: the u_c table has no patch length)"),
                "coupled": "the contact-pressure profile of each (u, dp) state of the FEM suction table "
-                          f"(largest holdable force {holdable:.4g} N)" if seal == "coupled" else "",
+                          f"(largest holdable force {holdable:.4g} N)" if args.route == "coupled" else "",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
-                                                            if cup_laws == "cone" else "")}[seal]
+                                                            if laws == "cone" else "")}[_seal(args.route)]
     print(f"{choice.label}: FEM {args.contact_choice.contact.label()} stiffness (from the "
           f"{args.contact_choice.source}; {args.fidelity}, {response.stats.steps} steps), "
           f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
-          f"{_rv_source(seal, cup_laws)}; {args.route} route: the leak "
+          f"{_rv_source(args.route, laws)}; {args.route} route: the leak "
           f"crosses {crossed}")
     names = list(series)
     print(f"  {'F1 (N)':>7} " + " ".join(f"{n.split(',')[0] + ', ' + n.split(', ')[1].split(' ')[0]:>24}"
                                          for n in names) + "  end")
     for i, r in enumerate(results):
         print(f"  {r.force_N:7g} " + " ".join(f"{series[n][i].lifetime_s:24.4g}" for n in names) + f"  {r.reason}")
-    extra = ", suction_table.json" if seal == "coupled" else ""
+    extra = ", suction_table.json" if args.route == "coupled" else ""
     print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
           f"{extra} in {wall:.1f} s")
     return 0
 
 
-def _rv_source(seal: str, cup_laws: str) -> str:
-    if seal == "coupled":
+def _seal(route: str) -> str:
+    """What the leak crosses on `route` (the key of the printed description)."""
+    return {"paper": "strip", "profile": "profile", "coupled": "coupled"}[route]
+
+
+def _rv_source(route: str, laws: str) -> str:
+    if route == "coupled":
         return "FEM suction table"
-    return "FEM curve" if cup_laws == "curve" else "cone laws (3)-(4)"
+    return "FEM curve" if laws == "curve" else "cone laws (3)-(4)"

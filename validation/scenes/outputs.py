@@ -138,9 +138,9 @@ def _lifetime_table(results, products: Products, path: Path) -> Path:
         "route": s["stiffness"]["route"], "stiffness": s["stiffness"]["source"],
         "force_N": [r.force_N for r in results],
         "lifetime_s": [r.lifetime_s for r in results], "reason": [r.reason for r in results],
-        "ballistic_share": [r.ballistic_share for r in results],
-        "r_final_mm": [1e3 * float(r.r_m[-1]) for r in results],
-        "p_b_final_Pa": [float(r.p_b_Pa[-1]) for r in results]})
+        "ballistic_share": [r.details["ballistic_share"] for r in results],
+        "r_final_mm": [float(r.trajectory["r_mm"][-1]) for r in results],
+        "p_b_final_Pa": [float(r.trajectory["p_b_Pa"][-1]) for r in results]})
 
 
 def _sweep_table(products: Products, path: Path) -> Path:
@@ -150,7 +150,7 @@ def _sweep_table(products: Products, path: Path) -> Path:
     rows = [(value, r) for value, p in products.variants() for r in p.lifetimes()]
     return write_table(path, {key: [v for v, _ in rows], "force_N": [r.force_N for _, r in rows],
                               "lifetime_s": [r.lifetime_s for _, r in rows], "reason": [r.reason for _, r in rows],
-                              "ballistic_share": [r.ballistic_share for _, r in rows]}, stage="scene sweep")
+                              "ballistic_share": [r.details["ballistic_share"] for _, r in rows]}, stage="scene sweep")
 
 
 def _parameter_figure(products: Products):

@@ -98,14 +98,15 @@ def _fem_frames(cup_key: dict, material: dict, contact: dict, fidelity: str, u_m
 
 def _lifetimes(tables_key: dict, curve, uc, code: str, tables: dict | None = None, progress=None):
     COMPUTED["lifetimes"] += 1
-    from reduced.lifetime import lifetime_sweep
+    from validation.lifetimes import lifetimes, route_options
     model = _model(tables, curve, uc)
     forces = tables["loads"]["F1_N"]
+    route = tables["stiffness"]["route"]
 
     def each(fraction: float, message: str) -> None:
         if progress is not None:
             progress(f"lifetime {round(fraction * len(forces))} of {len(forces)} done ({message})")
-    return lifetime_sweep(model, forces, refine=2, progress=each)
+    return lifetimes(model, forces, route, refine=2, progress=each, **route_options(route))
 
 
 def _geometry(cup: dict):
@@ -121,22 +122,20 @@ def _model(tables: dict, curve, uc):
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel
     from reduced.viscoelastic import default_relaxation
-    from validation.pipeline import route_model
+    from validation.lifetimes import route_laws
 
-    loads, route = tables["loads"], tables["stiffness"]["route"]
-    laws, seal = route_model(route)
+    loads = tables["loads"]
     if curve.design is None:               # Appendix A of a Table 1 preset: no fem imported
         cup = CUPS[tables["cup"]["preset"]]
         if loads["r_start_mm"] is not None:
             cup = replace(cup, r_start_m=1e-3 * loads["r_start_mm"])
     else:
         from validation.design import resolve_cup
-        cup = resolve_cup(curve, r_start_mm=loads["r_start_mm"], laws=laws).cup
-    stiffness = curve.scaled(loads["kappa"]) if loads["kappa"] != 1.0 else curve
-    return LeakageModel(cup=cup, stiffness=stiffness, u_c=uc, gas=Gas(T_K=293.15), p_a_Pa=1e5,
-                        E_Pa=tables["material"]["E_MPa"] * 1e6,
+        cup = resolve_cup(curve, r_start_mm=loads["r_start_mm"], laws=route_laws(tables["stiffness"]["route"])).cup
+    return LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=Gas(T_K=293.15), p_a_Pa=1e5,
+                        E_Pa=tables["material"]["E_MPa"] * 1e6, kappa=loads["kappa"],
                         relaxation=default_relaxation() if tables["material"]["relaxation"] == "default" else None,
-                        geometry=laws, seal=seal, fluid=tables["fluid"]["kind"])
+                        fluid=tables["fluid"]["kind"])
 
 
 # ------------------------------------------------------------------ the lazy products

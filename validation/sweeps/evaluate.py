@@ -103,8 +103,9 @@ def _fem_quantities(response, curve, geometry, design) -> dict[str, Any]:
 
 
 def _lifetimes(curve, design, common) -> list[dict[str, Any]]:
-    from reduced.lifetime import LeakageModel, largest_holdable_force, lifetime
+    from reduced.lifetime import LeakageModel
     from validation.design import resolve_cup
+    from validation.lifetimes import lifetimes
     from validation.pipeline import surface_uc_table
 
     from reduced.cup import CUPS
@@ -114,15 +115,12 @@ def _lifetimes(curve, design, common) -> list[dict[str, Any]]:
     l1 = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
     choice = resolve_cup(curve, r_start_mm=design.get("r_start_mm"), l0_mm=l0, l1_mm=l1)
     model = LeakageModel(cup=choice.cup, stiffness=curve, u_c=surface_uc_table(design["surface"]),
-                         E_Pa=design["E_MPa"] * 1e6, geometry="cone")
+                         E_Pa=design["E_MPa"] * 1e6)
+    results = lifetimes(model, design["F1_N"], "paper", cup_laws="cone")
     h_start = choice.cup.h_start_m
     common = {**common, "r_start_mm": choice.cup.r_start_m / _MM, "l0_mm": l0, "l1_mm": l1,
               "r_c_start_mm": float(curve.contact_radius(h_start)) / _MM,
               "l_start_mm": float(curve.contact_width(h_start)) / _MM,
-              "largest_force_N": largest_holdable_force(model)}
-    rows = []
-    for F in design["F1_N"]:
-        r = lifetime(model, F)
-        rows.append({**common, "F1_N": F, "lifetime_s": r.lifetime_s if math.isfinite(r.lifetime_s) else None,
-                     "reason": r.reason, "failure": None})
-    return rows
+              "largest_force_N": results.largest_force_N}
+    return [{**common, "F1_N": F, "lifetime_s": r.lifetime_s if math.isfinite(r.lifetime_s) else None,
+             "reason": r.reason, "failure": None} for F, r in zip(design["F1_N"], results)]
