@@ -87,3 +87,9 @@ def test_a_cached_table_is_read_not_rebuilt(tmp_path):
     other = suction_table_for("A", fidelity="coarse", grid=SuctionGridSpec((0.1, 0.3), (0.0, 20.0)),
                               cache_dir=tmp_path)
     assert other.dp_Pa[-1] == 2e4            # another grid is another entry
+
+
+def test_suction_table_for_takes_the_contact_law_object():
+    """The contact law travels as one `fem.interface.ContactLaw`; its name alone is refused before any FEM."""
+    with pytest.raises(ValueError, match="contact: expected a fem.interface.ContactLaw"):
+        suction_table_for("A", fidelity="coarse", grid=SMALL, contact="sticking")

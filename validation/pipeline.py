@@ -89,8 +89,7 @@ def fem_path(geometry: CupGeometry | str | None, material: NeoHookean, contact: 
         mesh = cup_mesh(geometry, fidelity, element=element)
     if u_max_m is None and geometry is not None and not isinstance(geometry, str):
         u_max_m = 0.9 * geometry.h1_m
-    return compress_cup(mesh, material, contact=law.law, friction=law.friction, u_max_m=u_max_m,
-                        progress=progress, **solver_opts)
+    return compress_cup(mesh, material, contact=law, u_max_m=u_max_m, progress=progress, **solver_opts)
 
 
 def fem_curve(response: CupResponse, geometry: Mapping[str, Any], fidelity: str | None,

@@ -75,14 +75,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _inputs(args: argparse.Namespace):
-    """Every check before the solve: (the FEM geometry, u_c table, its label); the FEM's contact
-    law (`contact_choice`) goes to ``args.contact_choice``."""
+    """Every check before the solve: (the FEM geometry, its contact law (`contact_choice`), the
+    u_c table, its label)."""
     import os
 
     from validation.guards import check_design, check_uc_table
 
     design = load_cup_design(args)
-    args.contact_choice = contact_choice(args, design)
+    contact = contact_choice(args, design)
     geometry = design.geometry
     check_design(geometry.describe(), args.allow_unusual_design, source=geometry.name)
     if args.uc_table is not None:
@@ -91,10 +91,10 @@ def _inputs(args: argparse.Namespace):
         from reduced.critical_gap import UcTable
         table = UcTable.from_csv(args.uc_table)
         check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
-        return geometry, table, Path(args.uc_table).name
+        return geometry, contact, table, Path(args.uc_table).name
     from validation.pipeline import DEFAULT_SURFACE, surface_uc_table
     name = args.surface or DEFAULT_SURFACE
-    return geometry, surface_uc_table(name), name
+    return geometry, contact, surface_uc_table(name), name
 
 
 def fem_stiffness(geometry, contact: ContactChoice, fidelity: str, progress=None):
@@ -122,7 +122,7 @@ def _blank(value):
     return "" if value is None else value
 
 
-def coupled_table(args: argparse.Namespace, geometry, tmp: Path):
+def coupled_table(args: argparse.Namespace, geometry, contact: ContactChoice, tmp: Path):
     """The design's suction table for the coupled route (read, or built and cached), copied to
     the output."""
     from reduced.suction_table import SuctionTable
@@ -132,15 +132,14 @@ def coupled_table(args: argparse.Namespace, geometry, tmp: Path):
     if args.suction_table is not None:
         table = SuctionTable.from_json(args.suction_table)
     else:
-        law = args.contact_choice.contact
-        table = suction_table_for(geometry, fidelity=args.fidelity, contact=law.law, friction=law.friction,
+        table = suction_table_for(geometry, fidelity=args.fidelity, contact=contact.contact,
                                   cache_dir=None if args.no_cache else args.cache_dir,
                                   progress=terminal_progress("suction"))
     table.to_json(tmp / "suction_table.json")
     return table
 
 
-def _check_suction_table(args: argparse.Namespace, geometry) -> None:
+def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
     """--suction-table: only with the coupled route, an existing table of this very design."""
     if args.suction_table is None:
         return
@@ -153,7 +152,7 @@ def _check_suction_table(args: argparse.Namespace, geometry) -> None:
     if prov.get("geometry") != geometry.describe():
         raise ValueError(f"--suction-table: '{args.suction_table}' was built for another design than "
                          f"{geometry.name}; build it with `cupcheck suction` on the same --cup/--geometry")
-    law = args.contact_choice.contact
+    law = contact.contact
     built = (prov.get("contact"), float(prov.get("friction", 0.0)))
     if built != (law.law, law.friction):
         raise ValueError(f"--suction-table: '{args.suction_table}' was built with {built[0]} contact"
@@ -202,14 +201,14 @@ def run(args: argparse.Namespace) -> int:
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     laws = cup_laws(args, coupled=True)
-    geometry, uc, uc_label = _inputs(args)
-    _check_suction_table(args, geometry)
+    geometry, contact, uc, uc_label = _inputs(args)
+    _check_suction_table(args, geometry, contact)
     from fem.solver import ConvergenceError
     from validation.commands._failure import solver_failure
 
     with atomic_directory(args.out) as tmp:
         try:
-            response, curve = fem_stiffness(geometry, args.contact_choice, args.fidelity, terminal_progress("FEM"))
+            response, curve = fem_stiffness(geometry, contact, args.fidelity, terminal_progress("FEM"))
         except ConvergenceError as exc:
             raise solver_failure(exc, Path(f"{Path(args.out)}.failure.json")) from None
         choice = resolve_cup(curve, r_start_mm=args.r_start_mm, l0_mm=args.l0_mm, l1_mm=args.l1_mm,
@@ -218,13 +217,13 @@ def run(args: argparse.Namespace) -> int:
         handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
         base = reference_model(choice.cup, uc)
         if args.route == "coupled":
-            model = replace(base, stiffness=None, suction=coupled_table(args, geometry, tmp), label="FEM-fed")
+            model = replace(base, stiffness=None, suction=coupled_table(args, geometry, contact, tmp), label="FEM-fed")
             progress = None
         else:
             model = replace(base, stiffness=curve, label="FEM-fed")
             progress = terminal_progress("lifetime")
         results = lifetimes(model, FORCES_N, args.route, progress=progress,
-                            refine=1 if args.route == "coupled" else 4, **route_options(args.route, laws))
+                            refine=1 if args.route == "coupled" else 4, **route_options(args.route, args.cup_laws))
         holdable = results.largest_force_N
         series = {f"FEM-fed, {args.route} route": results}
         if args.route != "paper":        # the same FEM F0 through the paper's strip, for comparison
@@ -233,7 +232,7 @@ def run(args: argparse.Namespace) -> int:
         series["Appendix A-fed, paper route (d0 2 mm)"] = lifetimes(base, FORCES_N, "paper", cup_laws="cone")
         write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, args.route)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
-             f"{choice.label}, FEM {args.contact_choice.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
+             f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
     wall = time.perf_counter() - t0
     slope = float(curve.force(curve.h1_m - 1e-3))
     patch = getattr(uc, "patch_length_m", None)
@@ -243,8 +242,8 @@ def run(args: argparse.Namespace) -> int:
                           f"(largest holdable force {holdable:.4g} N)" if args.route == "coupled" else "",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
                                                             if laws == "cone" else "")}[_seal(args.route)]
-    print(f"{choice.label}: FEM {args.contact_choice.contact.label()} stiffness (from the "
-          f"{args.contact_choice.source}; {args.fidelity}, {response.stats.steps} steps), "
+    print(f"{choice.label}: FEM {contact.contact.label()} stiffness (from the "
+          f"{contact.source}; {args.fidelity}, {response.stats.steps} steps), "
           f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
           f"{_rv_source(args.route, laws)}; {args.route} route: the leak "

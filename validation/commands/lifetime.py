@@ -128,7 +128,7 @@ def build_model(args: argparse.Namespace) -> LifetimeCase:
     check_run_options(args)
     check_modulus(args.E_MPa, "--E-MPa")
     laws = cup_laws(args)
-    options = route_options(args.route, laws)
+    options = route_options(args.route, args.cup_laws)
     curve, choice = _curve_and_cup(args, laws)
     check_design(choice.design, args.allow_unusual_design, source=choice.label)
     cup = choice.cup

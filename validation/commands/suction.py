@@ -61,9 +61,8 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import atomic_file, terminal_progress
 
     try:
-        law = job["contact"].contact
-        grid = suction_grid(job["mesh"], job["material"], job["u_m"], job["dp_Pa"], contact=law.law,
-                            friction=law.friction, progress=terminal_progress("suction"))
+        grid = suction_grid(job["mesh"], job["material"], job["u_m"], job["dp_Pa"], contact=job["contact"].contact,
+                            progress=terminal_progress("suction"))
     except ConvergenceError as exc:
         raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
     table = suction_table(grid, {"geometry": job["geometry"], "fidelity": args.fidelity,

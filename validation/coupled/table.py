@@ -21,7 +21,7 @@ def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -
     from validation.handoff import contact_provenance
 
     m = grid.material
-    prov = {"source": "fem.suction", **contact_provenance(grid.contact, grid.friction), "E_Pa": m.E_Pa, "nu": m.nu,
+    prov = {"source": "fem.suction", **contact_provenance(grid.contact_law), "E_Pa": m.E_Pa, "nu": m.nu,
             "formulation": m.formulation, "h1_mm": 1e3 * grid.h1_m,
             "solver": {"newton_iterations": grid.stats.newton_iterations,
                        "wall_time_s": grid.stats.wall_time_s, "dofs": grid.stats.dofs},
