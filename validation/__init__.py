@@ -1,8 +1,10 @@
 """Cross-checks, benchmarks, scenes, figures and the `cupcheck` command line (composes fem and reduced).
 
 The public nouns, imported on first use (``import validation`` imports no fem, skfem,
-matplotlib or dask): the FEM pipeline (`fem_stiffness`, `fem_path`, `fem_curve`, `neo_hookean`,
-`surface_uc_table`), every lifetime (`lifetimes`, `Lifetimes`, `route_options`, `ROUTES`), the cup a curve was computed for (`resolve_cup`,
+matplotlib or dask): a case end to end (`Study` with its parts `CupDesign`, `Material`, `Contact`,
+`Surface`, `Loads`, and its lazy cached `Products`), the FEM pipeline (`fem_stiffness`,
+`fem_path`, `fem_curve`, `neo_hookean`, `surface_uc_table`), every lifetime (`lifetimes`,
+`Lifetimes`, `route_options`, `ROUTES`), the cup a curve was computed for (`resolve_cup`,
 `CupChoice`), the hand-off (`stiffness_curve`, `write_sidecar`), the cache (`Cache`), the
 coupled route (`CoupledOptions`, `coupled_model`, `suction_table_for`) and scenes (`run_scene`).
 """
@@ -25,6 +27,9 @@ _WHERE = {
     "CoupledOptions": "validation.coupled.route", "coupled_model": "validation.coupled.route",
     "suction_table_for": "validation.coupled.build",
     "run_scene": "validation.scenes.outputs",
+    "Study": "validation.study", "CupDesign": "validation.study", "Material": "validation.study",
+    "Contact": "validation.study", "Surface": "validation.study", "Loads": "validation.study",
+    "Products": "validation.products",
 }
 
 __all__ = sorted(_WHERE)

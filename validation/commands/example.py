@@ -26,6 +26,7 @@ Writes to DIR, atomically:
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
+  manifest.json           the files and the study (`validation.study.Study`) they were computed for
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from validation.commands._cup import (add_contact_arguments, add_cup_arguments, 
 
 if TYPE_CHECKING:
     from fem.interface import ContactChoice
+    from validation.study import Study
 
 NAME = "example"
 HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"
@@ -76,7 +78,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def _inputs(args: argparse.Namespace):
     """Every check before the solve: (the FEM geometry, its contact law (`contact_choice`), the
-    u_c table, its label)."""
+    u_c table's label)."""
     import os
 
     from validation.guards import check_design, check_uc_table
@@ -91,18 +93,11 @@ def _inputs(args: argparse.Namespace):
         from reduced.critical_gap import UcTable
         table = UcTable.from_csv(args.uc_table)
         check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
-        return geometry, contact, table, Path(args.uc_table).name
+        return geometry, contact, Path(args.uc_table).name
     from validation.pipeline import DEFAULT_SURFACE, surface_uc_table
     name = args.surface or DEFAULT_SURFACE
-    return geometry, contact, surface_uc_table(name), name
-
-
-def fem_stiffness(geometry, contact: ContactChoice, fidelity: str, progress=None):
-    """(CupResponse, StiffnessCurve) of the main job's FEM step: the design (`CupGeometry` or a
-    preset name) of E = 4 MPa, nu = 0.49 under `contact` to 0.9 h1 (`validation.pipeline`)."""
-    from validation.pipeline import fem_stiffness as pipeline_stiffness, neo_hookean
-
-    return pipeline_stiffness(geometry, neo_hookean(4e6, 0.49), contact, fidelity, progress=progress)
+    surface_uc_table(name)                 # an unknown preset is refused before the FEM
+    return geometry, contact, name
 
 
 def write_table(results, path: Path, cup: str, route: str) -> None:
@@ -122,21 +117,23 @@ def _blank(value):
     return "" if value is None else value
 
 
-def coupled_table(args: argparse.Namespace, geometry, contact: ContactChoice, tmp: Path):
-    """The design's suction table for the coupled route (read, or built and cached), copied to
-    the output."""
-    from reduced.suction_table import SuctionTable
-    from validation.coupled.build import suction_table_for
-    from validation.output import terminal_progress
+def study_of(args: argparse.Namespace, contact: ContactChoice) -> Study:
+    """The main job as a `validation.study.Study`: the design of --cup/--geometry (E = 4 MPa,
+    nu = 0.49, `contact`) at --fidelity, through --route on the surface, at F1 = 5, 10, ..., 80 N."""
+    from validation.pipeline import DEFAULT_SURFACE
+    from validation.study import Contact, CupDesign, Loads, Material, Study, Surface
 
-    if args.suction_table is not None:
-        table = SuctionTable.from_json(args.suction_table)
-    else:
-        table = suction_table_for(geometry, fidelity=args.fidelity, contact=contact.contact,
-                                  cache_dir=None if args.no_cache else args.cache_dir,
-                                  progress=terminal_progress("suction"))
-    table.to_json(tmp / "suction_table.json")
-    return table
+    law = contact.contact
+    return Study(design=CupDesign(preset=args.cup or "A", file=None if args.geometry is None else str(args.geometry),
+                                  l0_mm=args.l0_mm, l1_mm=args.l1_mm),
+                 material=Material(E_MPa=4.0, nu=0.49),
+                 contact=Contact(law=law.law, friction=law.friction if law.law == "coulomb" else None,
+                                 source=contact.source),
+                 fidelity=args.fidelity, stiffness="fem",
+                 surface=Surface(preset=None if args.uc_table else (args.surface or DEFAULT_SURFACE),
+                                 uc_table=args.uc_table),
+                 route=args.route, cup_laws=args.cup_laws, loads=Loads(forces_N=FORCES_N, r_start_mm=args.r_start_mm),
+                 refine=4, suction_table=args.suction_table)
 
 
 def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
@@ -188,11 +185,9 @@ def plot(series: dict, curve, cup, path: Path, title: str) -> None:
 def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
-    from reduced.lifetime import reference_model
     from validation import handoff
-    from validation.design import resolve_cup
-    from validation.lifetimes import lifetimes, route_options
     from validation.output import atomic_directory, terminal_progress
+    from validation.products import Products
 
     from fem.mesh import DEFAULT_FIDELITY
 
@@ -201,41 +196,39 @@ def run(args: argparse.Namespace) -> int:
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     laws = cup_laws(args, coupled=True)
-    geometry, contact, uc, uc_label = _inputs(args)
+    geometry, contact, uc_label = _inputs(args)
     _check_suction_table(args, geometry, contact)
+    study = study_of(args, contact)
+    products = Products(study, suction_cache_dir=None if args.no_cache else args.cache_dir,
+                        fem_progress=terminal_progress("FEM"))
     from fem.solver import ConvergenceError
     from validation.commands._failure import solver_failure
 
     with atomic_directory(args.out) as tmp:
         try:
-            response, curve = fem_stiffness(geometry, contact, args.fidelity, terminal_progress("FEM"))
+            response, curve = products.fem_path(None), products.curve()
         except ConvergenceError as exc:
             raise solver_failure(exc, Path(f"{Path(args.out)}.failure.json")) from None
-        choice = resolve_cup(curve, r_start_mm=args.r_start_mm, l0_mm=args.l0_mm, l1_mm=args.l1_mm,
-                             curve_label="the FEM curve", laws=laws)
+        choice = products.cup_choice()
         curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
         handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
-        base = reference_model(choice.cup, uc)
         if args.route == "coupled":
-            model = replace(base, stiffness=None, suction=coupled_table(args, geometry, contact, tmp), label="FEM-fed")
-            progress = None
-        else:
-            model = replace(base, stiffness=curve, label="FEM-fed")
-            progress = terminal_progress("lifetime")
-        results = lifetimes(model, FORCES_N, args.route, progress=progress,
-                            refine=1 if args.route == "coupled" else 4, **route_options(args.route, args.cup_laws))
+            products.suction_table().to_json(tmp / "suction_table.json")
+        results = products.lifetimes()
         holdable = results.largest_force_N
         series = {f"FEM-fed, {args.route} route": results}
         if args.route != "paper":        # the same FEM F0 through the paper's strip, for comparison
-            series["FEM F0, paper route (strip, eqs 3-7)"] = lifetimes(
-                replace(base, stiffness=curve), FORCES_N, "paper", cup_laws="cone")
-        series["Appendix A-fed, paper route (d0 2 mm)"] = lifetimes(base, FORCES_N, "paper", cup_laws="cone")
+            paper = replace(study, route="paper", cup_laws="cone", refine=1)
+            series["FEM F0, paper route (strip, eqs 3-7)"] = products.derived(
+                paper, inherit=("uc_table", "curve", "cup")).lifetimes()
+        series["Appendix A-fed, paper route (d0 2 mm)"] = products.appendix_a(refine=1).lifetimes()
         write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, args.route)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
              f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
+        _write_manifest(tmp, study)
     wall = time.perf_counter() - t0
     slope = float(curve.force(curve.h1_m - 1e-3))
-    patch = getattr(uc, "patch_length_m", None)
+    patch = getattr(products.uc_table(), "patch_length_m", None)
     crossed = {"profile": "the FEM's contact-pressure profiles" + (f", averaged over patches of {1e6 * patch:.0f} um"
                                                                  if patch else " (raw: the u_c table has no patch length)"),
                "coupled": "the contact-pressure profile of each (u, dp) state of the FEM suction table "
@@ -257,6 +250,17 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
           f"{extra} in {wall:.1f} s")
     return 0
+
+
+def _write_manifest(tmp: Path, study: Study) -> None:
+    """manifest.json: the files written and the study they were computed for."""
+    import json
+
+    from validation.output import MANIFEST, software_versions
+
+    files = sorted(p.name for p in tmp.iterdir() if p.is_file())
+    (tmp / MANIFEST).write_text(json.dumps({"files": [{"path": f} for f in files], "study": study.describe(),
+                                            "versions": software_versions()}, indent=1, default=str) + "\n")
 
 
 def _seal(route: str) -> str:

@@ -1,6 +1,7 @@
 """Writing a scene's outputs: curves, lifetimes, trajectories, 2D figures, and the manifest.
 
-Each output pulls only the products it needs (`validation.scenes.pipeline.Products`). Figures are
+Each output pulls only the products it needs (`validation.products.Products` of the scene's
+`validation.study.Study`). Figures are
 matplotlib (Agg) at the paper's column width (3.4 in), PNG and SVG, axes labelled with units.
 `run_scene` is the Python entry point (a scene file, a dict or a `Scene`; the results in memory,
 and on disk when given a directory, written atomically with ``manifest.json``).
@@ -15,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from validation.scenes.pipeline import Products
+from validation.products import Products
 from validation.scenes.schema import Scene, load_scene, scene_from_mapping
 
 __all__ = ["run_scene", "SceneResult"]
@@ -42,7 +43,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
         scene = scene_from_mapping(scene) if isinstance(scene, dict) else load_scene(scene)
     from validation.output import check_file_names
     check_file_names(planned_files(scene), reserved={"manifest.json": "the scene's manifest"})
-    products = Products(scene, cache_dir=cache_dir, progress=progress)
+    products = Products(scene.study(), cache_dir=cache_dir, progress=progress)
     t0 = time.perf_counter()
     def each(tmp):
         n = len(scene.outputs)
@@ -73,7 +74,7 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
             return []
         csv = curve.to_csv(tmp / f"{name}.csv")
         return [_file(name, kind, csv), _file(name, kind, csv.with_suffix(".json"))]
-    if kind == "lifetimes" and products.scene.sweep is not None:
+    if kind == "lifetimes" and products.study.sweep is not None:
         for _, variant in products.variants():
             variant.lifetimes()
         return [_file(name, kind, _sweep_table(products, tmp / f"{name}.csv"))] if tmp else []
@@ -133,9 +134,9 @@ def _file(name: str, kind: str, path: Path) -> dict[str, str]:
 def _lifetime_table(results, products: Products, path: Path) -> Path:
     from validation.output import write_table
 
-    s = products.scene
+    s = products.study
     return write_table(path, {
-        "route": s["stiffness"]["route"], "stiffness": s["stiffness"]["source"],
+        "route": s.route, "stiffness": s.stiffness,
         "force_N": [r.force_N for r in results],
         "lifetime_s": [r.lifetime_s for r in results], "reason": [r.reason for r in results],
         "ballistic_share": [r.details["ballistic_share"] for r in results],
@@ -146,7 +147,7 @@ def _lifetime_table(results, products: Products, path: Path) -> Path:
 def _sweep_table(products: Products, path: Path) -> Path:
     from validation.output import write_table
 
-    key = products.scene.sweep["key"].split(".")[1]
+    key = products.study.sweep.key.split(".")[1]
     rows = [(value, r) for value, p in products.variants() for r in p.lifetimes()]
     return write_table(path, {key: [v for v, _ in rows], "force_N": [r.force_N for _, r in rows],
                               "lifetime_s": [r.lifetime_s for _, r in rows], "reason": [r.reason for _, r in rows],
@@ -154,11 +155,11 @@ def _sweep_table(products: Products, path: Path) -> Path:
 
 
 def _parameter_figure(products: Products):
-    key = products.scene.sweep["key"].split(".")[1]
+    key = products.study.sweep.key.split(".")[1]
     variants = products.variants()
     numeric = all(isinstance(v, (int, float)) for v, _ in variants)
     fig, ax = _axes(key, "lifetime (s)")
-    for i, F in enumerate(products.scene["loads"]["F1_N"]):
+    for i, F in enumerate(products.study.loads.forces_N):
         pts = [(j if not numeric else v, p.lifetimes()[i].lifetime_s) for j, (v, p) in enumerate(variants)]
         pts = [(x, t) for x, t in pts if math.isfinite(t) and t > 0]
         if pts:
@@ -185,26 +186,27 @@ def _axes(xlabel: str, ylabel: str):
 
 def _lifetime_figure(products: Products):
     results = products.lifetimes()
-    s = products.scene
+    s = products.study
     fig, ax = _axes("pull force $F_1$ (N)", "lifetime (s)")
     pts = [(r.force_N, r.lifetime_s) for r in results if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
     if pts:
-        ax.semilogy(*zip(*pts), "o-", ms=3, label=f"{s['stiffness']['source']}-fed, {s['stiffness']['route']} route")
-    reference = products.appendix_a()           # a FEM scene of a Table 1 cup: Appendix A beside it
+        ax.semilogy(*zip(*pts), "o-", ms=3, label=f"{s.stiffness}-fed, {s.route} route")
+    # a FEM scene of a Table 1 cup: Appendix A beside it
+    reference = products.appendix_a() if not s.design.file and s.sweep is None else None
     if reference is not None:
         ref = [(r.force_N, r.lifetime_s) for r in reference.lifetimes() if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
         if ref:
             ax.semilogy(*zip(*ref), "s--", ms=3, label="appendix-a-fed, paper route")
     if pts or reference is not None:
         ax.legend(fontsize=6)
-    ax.set_title(f"cup {s['cup']['preset'] if not s['cup']['geometry'] else Path(s['cup']['geometry']).name}, "
-                 f"{s['surface']['preset'] if not s['surface']['uc_table'] else 'u_c table'}", fontsize=7)
+    ax.set_title(f"cup {s.design.preset if not s.design.file else Path(s.design.file).name}, "
+                 f"{s.surface.preset if not s.surface.uc_table else 'u_c table'}", fontsize=7)
     return fig
 
 
 def _lines(products: Products) -> list[tuple[str, Products]]:
     """(label, products) per line: one per swept value, or the scene itself."""
-    if products.scene.sweep is None:
+    if products.study.sweep is None:
         return [("", products)]
     return [(str(v), p) for v, p in products.variants()]
 
@@ -217,10 +219,10 @@ def _uc_figure(products: Products):
         table = p.uc_table()
         u = np.array([table(v) for v in x])
         ax.loglog(x[u > 0], 1e9 * u[u > 0], label=label or None)
-    if products.scene.sweep is not None:
+    if products.study.sweep is not None:
         ax.legend(fontsize=6)
     else:
-        ax.set_title(products.scene["surface"]["preset"] or "u_c table", fontsize=7)
+        ax.set_title(products.study.surface.preset or "u_c table", fontsize=7)
     return fig
 
 
@@ -229,11 +231,11 @@ def _F0_figure(products: Products):
     from reduced.cup import CUPS
     fig, ax = _axes("plate displacement $u$ (mm)", "stiffness force $F_0$ (N)")
     for i, (label, p) in enumerate(_lines(products)):
-        curve, s = p.curve(), p.scene
+        curve, s = p.curve(), p.study
         name = f"cup {label}: " if label else ""
-        line, = ax.plot(1e3 * curve.u_m, curve.F0_N, label=f"{name}{s['stiffness']['source']}")
-        if curve.design is None or not s["cup"]["geometry"]:
-            ref = appendix_a_curve(CUPS[s["cup"]["preset"]])
+        line, = ax.plot(1e3 * curve.u_m, curve.F0_N, label=f"{name}{s.stiffness}")
+        if curve.design is None or not s.design.file:
+            ref = appendix_a_curve(CUPS[s.design.preset])
             keep = ref.u_m <= curve.u_m[-1]
             ax.plot(1e3 * ref.u_m[keep], ref.F0_N[keep], "--", color=line.get_color(), label=f"{name}Appendix A")
     ax.legend(fontsize=6)
@@ -245,7 +247,7 @@ def _time_figure(products: Products, top: tuple[str, str, float], bottom: tuple[
     import matplotlib.pyplot as plt
     results = products.lifetimes()
     fig, axes = plt.subplots(2, 1, figsize=(COLUMN_IN[0], 1.6 * COLUMN_IN[1]), sharex=True, constrained_layout=True)
-    water = products.scene["fluid"]["kind"] == "water"
+    water = products.study.loads.fluid == "water"
     for r in results:
         cols = r.trajectory_columns()
         t = cols["t_s"]

@@ -1,0 +1,56 @@
+"""validation.study and validation.products: one typed study per case, its products lazy and cached
+by content; a scene file is one spelling of it."""
+
+from dataclasses import FrozenInstanceError, replace
+from pathlib import Path
+
+import pytest
+
+from validation import products as products_module
+from validation.products import Products
+from validation.scenes.schema import load_scene, scene_from_mapping
+from validation.study import Contact, Loads, Study, Surface
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Appendix A on cup A: the reduced model alone (no FEM), fast
+APPENDIX = Study(stiffness="appendix-a", loads=Loads(forces_N=(10.0, 40.0)))
+
+
+def test_a_scene_file_is_a_study():
+    study = load_scene(ROOT / "scenes" / "main.toml").study()
+    assert (study.route, study.fidelity, study.stiffness, study.design.preset) == ("profile", "medium", "fem", "A")
+    assert study.loads.forces_N == tuple(float(f) for f in range(5, 85, 5))
+    assert study.contact == Contact("frictionless", None, "scene file main.toml")
+    assert study.surface == Surface("pmma-1.89", None)
+    with pytest.raises(FrozenInstanceError):
+        study.route = "paper"
+
+
+def test_a_swept_scene_gives_one_study_per_value():
+    scene = scene_from_mapping({"stiffness": {"source": "appendix-a"}, "sweep": {"key": "cup.preset", "values": ["A", "B"]},
+                                "outputs": [{"kind": "lifetimes"}]})
+    variants = scene.study().variants()
+    assert [v for v, _ in variants] == ["A", "B"]
+    assert [s.design.preset for _, s in variants] == ["A", "B"] and all(s.sweep is None for _, s in variants)
+    kappa = replace(APPENDIX).with_value("loads.kappa", 2.0)
+    assert kappa.loads.kappa == 2.0 and kappa.loads.forces_N == APPENDIX.loads.forces_N
+
+
+def test_products_are_lazy_and_cached_by_content(tmp_path):
+    products_module.COMPUTED.clear()
+    first = Products(APPENDIX, cache_dir=tmp_path)
+    assert first.uc_table() is not None and dict(products_module.COMPUTED) == {"uc_table": 1}
+    life = first.lifetimes()
+    assert dict(products_module.COMPUTED) == {"uc_table": 1, "lifetimes": 1}
+    again = Products(replace(APPENDIX), cache_dir=tmp_path).lifetimes()
+    assert dict(products_module.COMPUTED) == {"uc_table": 1, "lifetimes": 1}        # nothing new
+    assert [r.lifetime_s for r in again] == [r.lifetime_s for r in life]
+    Products(replace(APPENDIX, loads=Loads(forces_N=(20.0,))), cache_dir=tmp_path).lifetimes()
+    assert products_module.COMPUTED["lifetimes"] == 2                               # other loads: computed
+
+
+def test_stiffer_study_holds_longer():
+    """The paper's stiffness factor (Fig. 1stiffnessFactor): at 10 N a stiffer cup lasts longer."""
+    soft, stiff = (Products(APPENDIX.with_value("loads.kappa", k)).lifetimes()[0].lifetime_s for k in (1.0, 2.0))
+    assert 0 < soft < stiff
