@@ -42,8 +42,10 @@ def test_coupled_example_lifetimes_are_the_librarys(coupled_example, table_file)
     from reduced.suction_table import SuctionTable
 
     rows = pd.read_csv(coupled_example / "lifetime_vs_force.csv", keep_default_na=False)
-    assert list(rows.columns) == ["cup", "route", "force_N", "lifetime_s", "reason", "u_final_mm",
-                                  "p_b_final_Pa"]
+    assert list(rows.columns) == ["cup", "route", "contact", "mesh", "surface", "force_N", "lifetime_s", "reason",
+                                  "u_final_mm", "p_b_final_Pa"]
+    assert {tuple(r) for r in rows[["route", "contact", "mesh", "surface"]].to_numpy()} == \
+        {("coupled", "frictionless", "coarse", "pmma-1.89")}
     table = SuctionTable.from_json(table_file)
     model = CoupledCavity(table, uc_table(preset("pmma-1.89").spectrum(), 0.5))
     u_start = table.h1_m - CUP_A.h_start_m

@@ -152,6 +152,13 @@ class Study:
             return []
         return [(v, self.with_value(self.sweep.key, v)) for v in self.sweep.values]
 
+    def record(self) -> dict[str, str]:
+        """What a table's rows were computed for, as its leading columns: design, contact (the
+        FEM's law; '' for Appendix A), mesh (the FEM's level; '' for Appendix A), route, surface."""
+        fem = self.stiffness == "fem"
+        return {"design": self.design.label, "contact": self.contact.label() if fem else "",
+                "mesh": self.fidelity if fem else "", "route": self.route, "surface": self.surface.label}
+
     def describe(self) -> dict[str, Any]:
         """Plain data (the manifest's record): every part with its values."""
         data = asdict(replace(self, outputs=(), design=replace(self.design, geometry=None)))

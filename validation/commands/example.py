@@ -21,8 +21,9 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
 
 Writes to DIR, atomically:
 
-  lifetime_vs_force.csv   cup, route, force_N, lifetime_s, reason, then ballistic_share, r_final_mm
-                          (paper, profile) or u_final_mm (coupled), and p_b_final_Pa
+  lifetime_vs_force.csv   cup, route, contact, mesh, surface, force_N, lifetime_s, reason, then
+                          ballistic_share, r_final_mm (paper, profile) or u_final_mm (coupled), and
+                          p_b_final_Pa
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
@@ -100,12 +101,15 @@ def _inputs(args: argparse.Namespace):
     return geometry, contact, name
 
 
-def write_table(results, path: Path, cup: str, route: str) -> None:
+def write_table(results, path: Path, cup: str, study: Study) -> None:
+    """The lifetimes, one row per force: the cup, what they were computed for (`Study.record`), the outcome."""
     from validation.output import write_table as write_csv
 
+    route = study.route
     s = [r.summary() for r in results]
     own = ("u_final_mm",) if route == "coupled" else ("ballistic_share", "r_final_mm")
-    write_csv(path, {"cup": cup, "route": route, "force_N": [r.force_N for r in results],
+    record = {k: v for k, v in study.record().items() if k not in ("design", "route")}
+    write_csv(path, {"cup": cup, "route": route, **record, "force_N": [r.force_N for r in results],
                      "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in s],
                      "reason": [r.reason for r in results],
                      **{key: [_blank(x[key]) for x in s] for key in (*own, "p_b_final_Pa")}},
@@ -158,28 +162,30 @@ def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactCho
 
 
 def plot(series: dict, curve, cup, path: Path, title: str) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
+    """Lifetime against F1 per series and the FEM's F0(u) beside Appendix A's, in the toolkit's
+    style; `title` names the design, contact law, mesh level, route and surface."""
     import matplotlib.pyplot as plt
 
     from reduced.appendix_a import appendix_a_force
+    from validation.style import COLUMN_WIDTH_IN, cupcheck_style, log_axis, save_figure
 
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4), constrained_layout=True)
-    for (label, res), style in zip(series.items(), ("o-", "s--", "^:")):
-        pts = [(r.force_N, r.lifetime_s) for r in res if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
-        if pts:
-            ax[0].semilogy(*zip(*pts), style, label=label)
-    ax[0].set(xlabel="pull force $F_1$ (N)", ylabel="lifetime (s)")
-    fig.suptitle(title, fontsize=9)
-    ax[0].legend(fontsize=8)
-    u = curve.u_m
-    ax[1].plot(1e3 * u, curve.F0_N, label="FEM")
-    ax[1].plot(1e3 * u, appendix_a_force(u, cup.alpha_deg, 4e6, 2e-3, cup.r0_m, cup.r1_m), "--",
-               label="Appendix A")
-    ax[1].set(xlabel="plate displacement u (mm)", ylabel="stiffness force $F_0$ (N)")
-    ax[1].legend(fontsize=8)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    with cupcheck_style():
+        fig, ax = plt.subplots(1, 2, figsize=(2 * COLUMN_WIDTH_IN, 2.6))
+        for (label, res), style in zip(series.items(), ("o-", "s--", "^:")):
+            pts = [(r.force_N, r.lifetime_s) for r in res if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
+            if pts:
+                ax[0].plot(*zip(*pts), style, label=label)
+        log_axis(ax[0], "y")
+        ax[0].set(xlabel="pull force $F_1$ (N)", ylabel="lifetime (s)")
+        fig.suptitle(title, fontsize=7)
+        ax[0].legend(fontsize=6)
+        u = curve.u_m
+        ax[1].plot(1e3 * u, curve.F0_N, label="FEM")
+        ax[1].plot(1e3 * u, appendix_a_force(u, cup.alpha_deg, 4e6, 2e-3, cup.r0_m, cup.r1_m), "--",
+                   label="Appendix A")
+        ax[1].set(xlabel="plate displacement u (mm)", ylabel="stiffness force $F_0$ (N)")
+        ax[1].legend(fontsize=6)
+        save_figure(fig, path)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -222,7 +228,7 @@ def run(args: argparse.Namespace) -> int:
             series["FEM F0, paper route (strip, eqs 3-7)"] = products.derived(
                 paper, inherit=("uc_table", "curve", "cup")).lifetimes()
         series["Appendix A-fed, paper route (d0 2 mm)"] = products.appendix_a(refine=1).lifetimes()
-        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, args.route)
+        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, study)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
              f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
         _write_manifest(tmp, study)
