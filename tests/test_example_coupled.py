@@ -9,7 +9,7 @@ import pytest
 
 from tests.cli import run_cli as _run
 from validation.cli import main
-from validation.coupled.build import SuctionGridSpec, suction_table_for
+from validation.bridge.coupled.build import SuctionGridSpec, suction_table_for
 
 #: a small grid that still spans cup A's start (u_start = 4.8 mm on the coarse mesh) and 100 kPa
 SMALL = SuctionGridSpec((0.005, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8),

@@ -1,4 +1,4 @@
-"""validation.study and validation.products: one typed study per case, its products lazy and cached
+"""validation.bridge.study and validation.bridge.products: one typed study per case, its products lazy and cached
 by content; a scene file is one spelling of it."""
 
 from dataclasses import FrozenInstanceError, replace
@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from validation import products as products_module
-from validation.products import Products
+from validation.bridge import products as products_module
+from validation.bridge.products import Products
 from validation.scenes.schema import load_scene, scene_from_mapping
-from validation.study import Contact, Loads, Study, Surface
+from validation.bridge.study import Contact, Loads, Study, Surface
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -263,7 +263,7 @@ def test_quick_report_paper_numbers(quick_report):
     from reduced.coupled import CoupledCavity
     from reduced.cup import CUP_A
     from reduced.gas import Gas
-    from validation.coupled.build import QUICK_GRID, suction_table_for
+    from validation.bridge.coupled.build import QUICK_GRID, suction_table_for
     from validation.crosscheck.context import pmma_uc_table
 
     coupled = table[table["route"].str.startswith("coupled")].set_index("claim")

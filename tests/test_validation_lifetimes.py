@@ -1,4 +1,4 @@
-"""validation.lifetimes: the one way the toolkit asks for lifetimes (reduced.solve_lifetime per force,
+"""validation.bridge.lifetimes: the one way the toolkit asks for lifetimes (reduced.solve_lifetime per force,
 reduced.largest_holdable_force once), checked against second methods."""
 
 import math
@@ -9,7 +9,7 @@ import pytest
 
 import reduced
 from reduced.lifetime import lifetime_by_quadrature
-from validation.lifetimes import ROUTES, lifetimes, route_laws, route_options
+from validation.bridge.lifetimes import ROUTES, lifetimes, route_laws, route_options
 
 
 @pytest.fixture(scope="module")

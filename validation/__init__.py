@@ -16,20 +16,20 @@ from typing import Any
 
 #: public name -> the module that defines it
 _WHERE = {
-    "fem_stiffness": "validation.pipeline", "fem_path": "validation.pipeline", "fem_curve": "validation.pipeline",
-    "neo_hookean": "validation.pipeline",
-    "lifetimes": "validation.lifetimes", "Lifetimes": "validation.lifetimes", "route_options": "validation.lifetimes",
-    "surface_uc_table": "validation.pipeline", "DEFAULT_SURFACE": "validation.pipeline",
-    "ROUTES": "validation.lifetimes",
-    "resolve_cup": "validation.design", "CupChoice": "validation.design",
-    "stiffness_curve": "validation.handoff", "write_sidecar": "validation.handoff",
-    "Cache": "validation.cache",
-    "CoupledOptions": "validation.coupled.route", "coupled_model": "validation.coupled.route",
-    "suction_table_for": "validation.coupled.build",
+    "fem_stiffness": "validation.bridge.pipeline", "fem_path": "validation.bridge.pipeline", "fem_curve": "validation.bridge.pipeline",
+    "neo_hookean": "validation.bridge.pipeline",
+    "lifetimes": "validation.bridge.lifetimes", "Lifetimes": "validation.bridge.lifetimes", "route_options": "validation.bridge.lifetimes",
+    "surface_uc_table": "validation.bridge.pipeline", "DEFAULT_SURFACE": "validation.bridge.pipeline",
+    "ROUTES": "validation.bridge.lifetimes",
+    "resolve_cup": "validation.bridge.design", "CupChoice": "validation.bridge.design",
+    "stiffness_curve": "validation.bridge.handoff", "write_sidecar": "validation.bridge.handoff",
+    "Cache": "validation.bridge.cache",
+    "CoupledOptions": "validation.bridge.coupled.route", "coupled_model": "validation.bridge.coupled.route",
+    "suction_table_for": "validation.bridge.coupled.build",
     "run_scene": "validation.scenes.outputs",
-    "Study": "validation.study", "CupDesign": "validation.study", "Material": "validation.study",
-    "Contact": "validation.study", "Surface": "validation.study", "Loads": "validation.study",
-    "Products": "validation.products",
+    "Study": "validation.bridge.study", "CupDesign": "validation.bridge.study", "Material": "validation.bridge.study",
+    "Contact": "validation.bridge.study", "Surface": "validation.bridge.study", "Loads": "validation.bridge.study",
+    "Products": "validation.bridge.products",
 }
 
 __all__ = sorted(_WHERE)

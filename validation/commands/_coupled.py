@@ -1,4 +1,4 @@
-"""`cupcheck lifetime --route coupled`: the options read into `validation.coupled.route.CoupledOptions`,
+"""`cupcheck lifetime --route coupled`: the options read into `validation.bridge.coupled.route.CoupledOptions`,
 the lifetimes from the FEM suction table, printed and written as for the other routes."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ _NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--fluid", "fluid", "a
 
 def coupled_options(args: argparse.Namespace):
     """The typed options of the command line (every check; ValueError naming the option)."""
-    from validation.coupled.route import CoupledOptions
+    from validation.bridge.coupled.route import CoupledOptions
 
     if args.reference_mode:
         raise ValueError("--reference-mode: the reference conventions are the paper route's; "
@@ -55,8 +55,8 @@ def _relaxation(args: argparse.Namespace):
 
 def run_coupled(args: argparse.Namespace) -> int:
     """The coupled route of `cupcheck lifetime` (its table, --json and --out as for the others)."""
-    from validation.coupled.route import coupled_model
-    from validation.lifetimes import lifetimes
+    from validation.bridge.coupled.route import coupled_model
+    from validation.bridge.lifetimes import lifetimes
     from validation.output import atomic_directory, write_table
 
     options = coupled_options(args)

@@ -19,7 +19,7 @@ if TYPE_CHECKING:                          # building the parser imports no fem
     from fem.interface import ContactChoice
 
 from reduced.cup import CUPS
-from validation.lifetimes import ROUTES
+from validation.bridge.lifetimes import ROUTES
 
 
 def cup_name(value: str) -> str:
@@ -86,9 +86,9 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = 
 
 def cup_laws(args: argparse.Namespace, coupled: bool = False) -> str:
     """Where r(h), V(h), l(h) come from for the --route and --cup-laws given
-    (`validation.lifetimes.route_laws`: the route's default, or --cup-laws checked against it).
+    (`validation.bridge.lifetimes.route_laws`: the route's default, or --cup-laws checked against it).
     `coupled`: the command runs the coupled route itself (else it is refused here)."""
-    from validation.lifetimes import route_laws
+    from validation.bridge.lifetimes import route_laws
 
     if args.route == "coupled" and not coupled:
         raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")

@@ -17,7 +17,7 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
      built here and cached in --cache-dir, or read from --suction-table): F1, V and the profile of
      every state from the FEM, replacing eqs (3)-(7) and beta (`reduced.coupled`). Building the
      table takes ~3 min (coarse) to ~8 min (medium) once per design and law.
-   Another design (--geometry FILE) runs the same chain on its own geometry (`validation.design`).
+   Another design (--geometry FILE) runs the same chain on its own geometry (`validation.bridge.design`).
 
 Writes to DIR, atomically:
 
@@ -27,7 +27,7 @@ Writes to DIR, atomically:
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
-  manifest.json           the files and the study (`validation.study.Study`) they were computed for
+  manifest.json           the files and the study (`validation.bridge.study.Study`) they were computed for
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ from validation.commands._cup import (add_contact_arguments, add_cup_arguments, 
 
 if TYPE_CHECKING:
     from fem.interface import ContactChoice
-    from validation.study import Study
+    from validation.bridge.study import Study
 
 NAME = "example"
 HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"
@@ -95,7 +95,7 @@ def _inputs(args: argparse.Namespace):
         table = UcTable.from_csv(args.uc_table)
         check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
         return geometry, contact, Path(args.uc_table).name
-    from validation.pipeline import DEFAULT_SURFACE, surface_uc_table
+    from validation.bridge.pipeline import DEFAULT_SURFACE, surface_uc_table
     name = args.surface or DEFAULT_SURFACE
     surface_uc_table(name)                 # an unknown preset is refused before the FEM
     return geometry, contact, name
@@ -122,10 +122,10 @@ def _blank(value):
 
 
 def study_of(args: argparse.Namespace, contact: ContactChoice) -> Study:
-    """The main job as a `validation.study.Study`: the design of --cup/--geometry (E = 4 MPa,
+    """The main job as a `validation.bridge.study.Study`: the design of --cup/--geometry (E = 4 MPa,
     nu = 0.49, `contact`) at --fidelity, through --route on the surface, at F1 = 5, 10, ..., 80 N."""
-    from validation.pipeline import DEFAULT_SURFACE
-    from validation.study import Contact, CupDesign, Loads, Material, Study, Surface
+    from validation.bridge.pipeline import DEFAULT_SURFACE
+    from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
 
     law = contact.contact
     return Study(design=CupDesign(preset=args.cup or "A", file=None if args.geometry is None else str(args.geometry),
@@ -191,9 +191,9 @@ def plot(series: dict, curve, cup, path: Path, title: str) -> None:
 def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
-    from validation import handoff
+    from validation.bridge import handoff
     from validation.output import atomic_directory, terminal_progress
-    from validation.products import Products
+    from validation.bridge.products import Products
 
     from fem.mesh import DEFAULT_FIDELITY
 

@@ -105,7 +105,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 @dataclass(frozen=True)
 class LifetimeCase:
     """What the command line asks for: the model, the cup it was built for (`CupChoice`), where
-    r, V, l come from (cup_laws) and the route's options for `validation.lifetimes.lifetimes`."""
+    r, V, l come from (cup_laws) and the route's options for `validation.bridge.lifetimes.lifetimes`."""
 
     model: Any
     choice: Any
@@ -117,13 +117,13 @@ def build_model(args: argparse.Namespace) -> LifetimeCase:
     """Validate the options and build the `LeakageModel` (cheap; raises ValueError on bad input).
 
     The cup comes from the stiffness curve's recorded design, else from --geometry / --cup
-    (`validation.design`).
+    (`validation.bridge.design`).
     """
     from reduced.appendix_a import appendix_a_curve
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel, reference_model
     from validation.guards import check_design, check_modulus
-    from validation.lifetimes import lifetimes, route_options
+    from validation.bridge.lifetimes import lifetimes, route_options
 
     check_run_options(args)
     check_modulus(args.E_MPa, "--E-MPa")
@@ -171,7 +171,7 @@ def build_model(args: argparse.Namespace) -> LifetimeCase:
 def _curve_and_cup(args: argparse.Namespace, laws: str):
     """(the stiffness curve or None for Appendix A, the `CupChoice`)."""
     from reduced.stiffness_curve import StiffnessCurve
-    from validation.design import explicit_design, resolve_cup
+    from validation.bridge.design import explicit_design, resolve_cup
 
     options = dict(cup=args.cup, geometry_file=args.geometry, r_start_mm=args.r_start_mm,
                    l0_mm=args.l0_mm, l1_mm=args.l1_mm)
@@ -216,7 +216,7 @@ def summaries(results, cup: dict) -> list[dict]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from validation.lifetimes import lifetimes
+    from validation.bridge.lifetimes import lifetimes
     from validation.output import atomic_directory, terminal_progress
 
     from validation.output import check_file_names, check_outputs, command_inputs

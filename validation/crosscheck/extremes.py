@@ -244,7 +244,7 @@ def scaling_row(ctx: Context, runs: list[FemRun]) -> list:
 def reduced_rows(ctx: Context) -> list[list]:
     from reduced.critical_gap import UcTable
     from reduced.lifetime import reference_model
-    from validation.lifetimes import lifetimes
+    from validation.bridge.lifetimes import lifetimes
 
     uc = pmma_uc_table()
     model = reference_model(CUP_A, uc)
@@ -266,7 +266,7 @@ def water_rows(ctx: Context, uc) -> list[list]:
     from dataclasses import replace
 
     from reduced.lifetime import reference_model
-    from validation.lifetimes import lifetimes
+    from validation.bridge.lifetimes import lifetimes
 
     rows = []
     for p_cav in (None, VAPOUR_PRESSURE_PA):
@@ -282,7 +282,7 @@ def water_rows(ctx: Context, uc) -> list[list]:
 def _reduced_case(ctx: Context, label: str, model, F1: float, judge) -> list:
     """One reduced-model case: its lifetime judged by `judge(model, result, F1) -> (outcome,
     checks, details)`, or the error it fails fast with."""
-    from validation.lifetimes import lifetimes
+    from validation.bridge.lifetimes import lifetimes
 
     ctx.progress(0.0, f"reduced: {label}")
     try:

@@ -245,7 +245,7 @@ def _geometry_table(ctx: Context, runs: dict) -> None:
 
 def _lifetimes(ctx: Context, runs: dict) -> None:
     from validation.crosscheck.lifetimes import fem_width, leakage_model
-    from validation.lifetimes import lifetimes
+    from validation.bridge.lifetimes import lifetimes
 
     uc = pmma_uc_table()
     forces = QUICK_FORCES_N if ctx.quick else FORCES_N

@@ -85,7 +85,7 @@ def eq5_width(curve):
 
 
 def run(ctx: Context) -> None:
-    from validation.lifetimes import lifetimes
+    from validation.bridge.lifetimes import lifetimes
 
     rep = ctx.report
     rep.text(NAME, __doc__.split("\n\n", 1)[1])

@@ -82,7 +82,7 @@ def routes(ctx: Context) -> list[Route]:
 
 def _model_route(name: str, curve: Callable[[str], object], route: str, stiffness: bool = False) -> Route:
     """A route of `reduced.solve_lifetime` fed by the stiffness curve of each cup."""
-    from validation.lifetimes import lifetimes, route_options
+    from validation.bridge.lifetimes import lifetimes, route_options
 
     options = route_options(route)
 
@@ -102,8 +102,8 @@ def coupled_route(ctx: Context) -> Route:
     code version, in the run memo's cache directory when there is one); r(t) is the seal radius r_k
     of the table, interpolated at the trajectory's (u, dp / kappa(t)); the route has no ballistic
     share and no water."""
-    from validation.coupled.build import DEFAULT_GRID, QUICK_GRID, suction_table_for
-    from validation.lifetimes import lifetimes
+    from validation.bridge.coupled.build import DEFAULT_GRID, QUICK_GRID, suction_table_for
+    from validation.bridge.lifetimes import lifetimes
 
     cache = None if ctx.memo.cache_dir is None else ctx.memo.cache_dir / "suction"
 

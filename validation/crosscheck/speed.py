@@ -70,7 +70,7 @@ def _median_time(fn, repeat: int = 5) -> tuple[float, object]:
 
 def fem_level(ctx: Context, contact: str, fidelity: str, element: str, uc) -> dict | str:
     """The level's quantities, or the one-line failure message of its FEM run."""
-    from validation.lifetimes import lifetimes
+    from validation.bridge.lifetimes import lifetimes
 
     res = ctx.outcome(FemRun(cup="A", contact=contact, fidelity=fidelity, element=element))
     if isinstance(res, Exception):
@@ -86,7 +86,7 @@ def fem_level(ctx: Context, contact: str, fidelity: str, element: str, uc) -> di
 def run(ctx: Context) -> None:
     from reduced.appendix_a import appendix_a_curve
     from reduced.lifetime import lifetime_by_quadrature, reference_model
-    from validation.lifetimes import lifetimes
+    from validation.bridge.lifetimes import lifetimes
 
     rep = ctx.report
     rep.text(NAME, __doc__.split("\n\n", 1)[1])

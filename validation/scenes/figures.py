@@ -1,6 +1,6 @@
 """The 2D figures a scene can ask for, drawn in the toolkit's style (`validation.style`).
 
-Each takes the scene's `validation.products.Products` and returns a figure (drawn inside
+Each takes the scene's `validation.bridge.products.Products` and returns a figure (drawn inside
 `cupcheck_style()`; `draw` writes it with `save_figure`). Every figure's title names what it was
 computed for: the design, the stiffness (the FEM's contact law and mesh level, or Appendix A), the
 route and the surface (`caption`); a swept parameter gives one line per value.
@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from validation.products import Products
+from validation.bridge.products import Products
 
 __all__ = ["FIGURES", "caption", "draw"]
 

@@ -1,7 +1,7 @@
 """Writing a scene's outputs: curves, lifetimes, trajectories, 2D figures, and the manifest.
 
-Each output pulls only the products it needs (`validation.products.Products` of the scene's
-`validation.study.Study`). Figures (`validation.scenes.figures`) are drawn in the toolkit's style,
+Each output pulls only the products it needs (`validation.bridge.products.Products` of the scene's
+`validation.bridge.study.Study`). Figures (`validation.scenes.figures`) are drawn in the toolkit's style,
 PNG and SVG, axes labelled with units; tables name design, contact law, mesh, route and surface.
 `run_scene` is the Python entry point (a scene file, a dict or a `Scene`; the results in memory,
 and on disk when given a directory, written atomically with ``manifest.json``).
@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from validation.products import Products
+from validation.bridge.products import Products
 from validation.scenes.schema import Scene, load_scene, scene_from_mapping
 
 __all__ = ["run_scene", "SceneResult"]

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from validation.study import Contact, CupDesign, Loads, Material, Study, Surface, Sweep
+from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface, Sweep
 
 __all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES"]
 
@@ -83,7 +83,7 @@ class Scene:
     contact_source: str = "default"     # who chose the contact law: the scene, the design file, default
 
     def study(self) -> Study:
-        """The scene as a `validation.study.Study` (its sweep, if any, included)."""
+        """The scene as a `validation.bridge.study.Study` (its sweep, if any, included)."""
         t = self.tables
         return Study(design=CupDesign(preset=t["cup"]["preset"], file=t["cup"]["geometry"]),
                      material=Material(E_MPa=t["material"]["E_MPa"], nu=t["material"]["nu"]),

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from validation.products import Products
+from validation.bridge.products import Products
 
 __all__ = ["write_view"]
 

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 from validation.sweeps.spec import design_hash
 
 if TYPE_CHECKING:
-    from validation.study import Study
+    from validation.bridge.study import Study
 
 __all__ = ["evaluate_design", "study_of", "geometry_of", "material_volume_mm3"]
 
@@ -57,11 +57,11 @@ def material_volume_mm3(geometry) -> float:
 
 
 def study_of(design: dict[str, Any], geometry) -> Study:
-    """The `validation.study.Study` of one design of a sweep: its geometry, material, contact law
+    """The `validation.bridge.study.Study` of one design of a sweep: its geometry, material, contact law
     and mesh level, the paper's route with the cone laws and eq (5)'s l0, l1 (Table 1's unless
     given) on its surface, at its pull forces."""
     from reduced.cup import CUPS
-    from validation.study import Contact, CupDesign, Loads, Material, Study, Surface
+    from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
 
     table1 = CUPS[design["cup"]]
     l0 = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
@@ -84,7 +84,7 @@ def evaluate_design(design: dict[str, Any]) -> list[dict[str, Any]]:
     stage = "geometry"
     try:
         from validation.guards import check_design
-        from validation.products import Products
+        from validation.bridge.products import Products
 
         geometry = geometry_of(design)
         check_design(geometry.describe(), design["allow_unusual_design"], source="design")

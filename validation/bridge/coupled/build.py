@@ -5,8 +5,8 @@ u = 0 up to 0.8 h1, dp = 0, 1, ..., 100 kPa; halving the u spacing moves cup A's
 <= 0.2 %, the dp spacing by <= 0.8 %, benchmarks/bench_coupled.py) and a coarse one for quick checks
 (`QUICK_GRID`).
 `suction_table_for` runs `fem.suction.suction_grid` on a design and converts it to the reduced
-model's `SuctionTable`; with a cache directory the table goes through `validation.cache`, keyed by the
-design, the law, the grid and a hash of the sources that make it (`fem`, `validation.coupled` and
+model's `SuctionTable`; with a cache directory the table goes through `validation.bridge.cache`, keyed by the
+design, the law, the grid and a hash of the sources that make it (`fem`, `validation.bridge.coupled` and
 the table's data types in `reduced`), so a second call computes nothing and a change to that code
 recomputes (a change to the leak, which reads the table, does not).
 """
@@ -66,7 +66,7 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw
     FEM runs. Raises `fem.solver.ConvergenceError` where a state does not converge."""
     from fem.geometry import cup_geometry
     from fem.interface import ContactLaw
-    from validation.cache import Cache, source_hash
+    from validation.bridge.cache import Cache, source_hash
 
     if isinstance(geometry, str):
         geometry = cup_geometry(geometry)
@@ -74,7 +74,7 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw
     if not isinstance(contact, ContactLaw):
         raise ValueError(f"contact: expected a fem.interface.ContactLaw, got {type(contact).__name__}")
     build = Cache(cache_dir).cached(_build, ignore=["progress"])
-    code = source_hash("fem", "validation/coupled", *_TABLE_TYPES)
+    code = source_hash("fem", "validation/bridge/coupled", *_TABLE_TYPES)
     return build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=progress)
 
 
@@ -88,7 +88,7 @@ def _build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=None):
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
     from fem.suction import suction_grid
-    from validation.coupled.table import suction_table
+    from validation.bridge.coupled.table import suction_table
 
     mesh = cup_mesh(geometry, fidelity)
     result = suction_grid(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), grid.u_m(cup_height(mesh)), grid.dp_Pa,

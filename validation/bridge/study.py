@@ -9,7 +9,7 @@ and who chose it, the mesh level, where the stiffness comes from, the surface, t
 the loads) and the outputs asked of it. It is plain frozen data: the command line (`cupcheck
 example`), scene files (`cupcheck run`) and sweep files (`cupcheck sweep`) are three spellings of
 it. Its products (curve, u_c table, suction table, lifetimes, figures) are computed lazily and
-cached by content by `validation.products.Products`.
+cached by content by `validation.bridge.products.Products`.
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ class CupDesign:
 
 @dataclass(frozen=True)
 class Material:
-    """The wall's compressible neo-Hookean material (the formulation by nu: `validation.pipeline`)."""
+    """The wall's compressible neo-Hookean material (the formulation by nu: `validation.bridge.pipeline`)."""
 
     E_MPa: float = 4.0
     nu: float = 0.49
@@ -115,8 +115,8 @@ class Sweep:
 @dataclass(frozen=True)
 class Study:
     """One case end to end (module docstring). stiffness: "fem" or "appendix-a" (d0 = 2 mm);
-    route: a lifetime route (`validation.lifetimes.ROUTES`); cup_laws: the paper route's r, V, l
-    ("cone" or "curve", `validation.lifetimes.route_laws`; None: the route's own); refine: output points per integration
+    route: a lifetime route (`validation.bridge.lifetimes.ROUTES`); cup_laws: the paper route's r, V, l
+    ("cone" or "curve", `validation.bridge.lifetimes.route_laws`; None: the route's own); refine: output points per integration
     step of the lifetimes; suction_table: the coupled route's table file (None: built from the
     design at `fidelity`); outputs: what to write (the scene's [[outputs]])."""
 

@@ -17,7 +17,7 @@ class CoupledOptions:
     """What the coupled route needs besides u_c (units in the names).
 
     suction_table: the table's JSON file; cup, geometry_file, r_start_mm: the cup as
-    `validation.design.resolve_cup` reads them (the table's recorded design wins); interface: the
+    `validation.bridge.design.resolve_cup` reads them (the table's recorded design wins); interface: the
     gas pressure next to the seal ("linear", "p_b", "p_a"); kappa: the stiffness factor;
     relaxation: a `reduced.viscoelastic.RelaxationModulus` or None; phi0_s: the measurement's
     contact time (None: the cup's default, with relaxation only).
@@ -37,7 +37,7 @@ class CoupledOptions:
 
 @dataclass(frozen=True)
 class _TableDesign:
-    """What `validation.design.resolve_cup` reads of a curve: the recorded design and h1."""
+    """What `validation.bridge.design.resolve_cup` reads of a curve: the recorded design and h1."""
 
     design: dict[str, Any] | None
     h1_m: float
@@ -50,7 +50,7 @@ def coupled_model(options: CoupledOptions, uc: Callable[[float], float]):
     from reduced.lifetime import LeakageModel
     from reduced.suction_table import SuctionTable
     from reduced.viscoelastic import measurement_contact_time
-    from validation.design import resolve_cup
+    from validation.bridge.design import resolve_cup
 
     table = SuctionTable.from_json(options.suction_table)
     h1 = table.h1_m

@@ -94,10 +94,10 @@ def fem_path(geometry: CupGeometry | str | None, material: NeoHookean, contact: 
 
 def fem_curve(response: CupResponse, geometry: Mapping[str, Any], fidelity: str | None,
               contact_source: str | None = None, mesh: Mapping[str, Any] | None = None) -> StiffnessCurve:
-    """The hand-off `StiffnessCurve` of an FEM path, with its provenance (`validation.handoff`):
+    """The hand-off `StiffnessCurve` of an FEM path, with its provenance (`validation.bridge.handoff`):
     the design's description, the mesh (`mesh_record` of the path's mesh unless given) and who
     chose the contact law."""
-    from validation import handoff
+    from validation.bridge import handoff
 
     record = dict(mesh) if mesh is not None else mesh_record(response.mesh, fidelity)
     prov = handoff.provenance(response, geometry=geometry, mesh=record, fidelity=fidelity,

@@ -1,9 +1,9 @@
-"""The products of a `validation.study.Study`, each computed on first use and cached by content.
+"""The products of a `validation.bridge.study.Study`, each computed on first use and cached by content.
 
 `Products` computes a product the first time something asks for it and keeps it: a study whose
 outputs need only the u_c table never builds a curve, and a lifetime fed by Appendix A never
 imports `fem`. The expensive products (u_c table, FEM path, curve, frames, lifetimes) go through
-`validation.cache`: the key is the function's code, its arguments with every input file (design
+`validation.bridge.cache`: the key is the function's code, its arguments with every input file (design
 file, u_c table) by the sha256 of its bytes instead of its path, and a hash of the sources that
 compute the product. `COMPUTED` counts the products actually computed in this process (a second
 run of the same study computes none).
@@ -18,8 +18,8 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from validation.cache import Cache, file_digest, source_hash
-from validation.study import Contact, Study
+from validation.bridge.cache import Cache, file_digest, source_hash
+from validation.bridge.study import Contact, Study
 
 __all__ = ["Products", "COMPUTED"]
 
@@ -50,7 +50,7 @@ def _uc_table(surface_key: dict, code: str, surface=None):
     from reduced.critical_gap import UcTable
     if surface.uc_table is not None:
         return UcTable.from_csv(surface.uc_table)
-    from validation.pipeline import surface_uc_table
+    from validation.bridge.pipeline import surface_uc_table
     return surface_uc_table(surface.preset)
 
 
@@ -60,7 +60,7 @@ def _fem_path(design_key: dict, material: dict, contact: dict, fidelity: str, u_
     converged step). Keyed only by what it depends on, so a curve, a render, a footprint and a
     squeeze ending at the same u share one run."""
     COMPUTED["fem_path"] += 1
-    from validation.pipeline import fem_path, neo_hookean
+    from validation.bridge.pipeline import fem_path, neo_hookean
     return fem_path(design.cup_geometry(), neo_hookean(material["E_MPa"] * 1e6, material["nu"]),
                     Contact(**contact).contact_law(), fidelity, u_max_m, progress)
 
@@ -70,7 +70,7 @@ def _fem_curve(design_key: dict, material: dict, contact: dict, fidelity: str, u
     """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`, not part of the key);
     its provenance says who chose the contact law."""
     COMPUTED["fem_curve"] += 1
-    from validation.pipeline import fem_curve
+    from validation.bridge.pipeline import fem_curve
     return fem_curve(path(), design.cup_geometry().describe(), fidelity, contact_source)
 
 
@@ -91,9 +91,9 @@ def _fem_frames(design_key: dict, material: dict, contact: dict, fidelity: str, 
 
 
 def _lifetimes(study_key: dict, stiffness, uc, cup, code: str, study=None, progress=None):
-    """The study's lifetimes (`validation.lifetimes.Lifetimes`) on its route."""
+    """The study's lifetimes (`validation.bridge.lifetimes.Lifetimes`) on its route."""
     COMPUTED["lifetimes"] += 1
-    from validation.lifetimes import lifetimes, route_options
+    from validation.bridge.lifetimes import lifetimes, route_options
     forces = study.loads.forces_N
 
     def each(fraction: float, message: str) -> None:
@@ -124,7 +124,7 @@ class Products:
 
     progress(message): a line per product, FEM step and force; fem_progress(fraction, message):
     the FEM's and suction table's own progress instead (a terminal's status line); suction_cache_dir:
-    where the coupled route's suction tables are kept (`validation.coupled.build`; None: not kept)."""
+    where the coupled route's suction tables are kept (`validation.bridge.coupled.build`; None: not kept)."""
 
     def __init__(self, study: Study, cache_dir: str | Path | None = None,
                  progress: Callable[[str], None] | None = None, suction_cache_dir: str | Path | None = None,
@@ -187,14 +187,14 @@ class Products:
         return appendix_a_curve(self.cup(), E_Pa=self.study.material.E_MPa * 1e6, d0_m=2e-3)
 
     def cup_choice(self):
-        """The cup the FEM curve was computed for (`validation.design.CupChoice`: the curve's design
+        """The cup the FEM curve was computed for (`validation.bridge.design.CupChoice`: the curve's design
         with the study's r_start, l0, l1); None for Appendix A."""
         if self.study.stiffness == "appendix-a":
             return None
 
         def compute():
-            from validation.design import resolve_cup
-            from validation.lifetimes import route_laws
+            from validation.bridge.design import resolve_cup
+            from validation.bridge.lifetimes import route_laws
             s = self.study
             return resolve_cup(self.curve(), r_start_mm=s.loads.r_start_mm, l0_mm=s.design.l0_mm,
                                l1_mm=s.design.l1_mm, curve_label="the FEM curve",
@@ -225,7 +225,7 @@ class Products:
         """The FEM path to u_mm (None: 0.9 h1), computed once per end point and study (`_fem_path`)."""
         u_max_m = self._u_max_m(u_mm)
         return self._get(f"fem_path_{1e3 * u_max_m:.6g}mm", lambda: self._cached(_fem_path, ignore=["design", "progress"])(
-            *self._fem_args(u_max_m), source_hash("fem", "validation/pipeline.py"), design=self.study.design,
+            *self._fem_args(u_max_m), source_hash("fem", "validation/bridge/pipeline.py"), design=self.study.design,
             progress=self._fem_progress))
 
     def fem_frames(self, u_mm: float, n_frames: int = 1) -> list:
@@ -244,7 +244,7 @@ class Products:
             s = self.study
             if s.suction_table is not None:
                 return SuctionTable.from_json(s.suction_table)
-            from validation.coupled.build import suction_table_for
+            from validation.bridge.coupled.build import suction_table_for
             return suction_table_for(s.design.cup_geometry(), fidelity=s.fidelity, contact=s.contact.contact_law(),
                                      E_Pa=s.material.E_MPa * 1e6, nu=s.material.nu,
                                      cache_dir=self._suction_cache_dir,
@@ -252,7 +252,7 @@ class Products:
         return self._get("suction_table", compute)
 
     def lifetimes(self):
-        """The lifetimes (`validation.lifetimes.Lifetimes`) of the study's forces on its route."""
+        """The lifetimes (`validation.bridge.lifetimes.Lifetimes`) of the study's forces on its route."""
         s = self.study
         def compute():
             feed = self.suction_table() if s.route == "coupled" else self.curve()
