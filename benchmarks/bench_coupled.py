@@ -31,10 +31,10 @@ from reduced.lifetime import lifetime
 from reduced.suction_table import SuctionTable
 from validation.cli import build_parser
 from validation.commands.lifetime import build_model, build_uc
-from validation.coupled.build import DEFAULT_GRID
+from validation.bridge.coupled.build import DEFAULT_GRID
 
 U_FRACTIONS, DP_KPA = DEFAULT_GRID.u_fractions, DEFAULT_GRID.dp_kPa
-from validation.coupled.table import fem_beta, suction_table
+from validation.bridge.coupled.table import fem_beta, suction_table
 
 FORCES_N = (5.0, 10.0, 20.0, 30.0)
 

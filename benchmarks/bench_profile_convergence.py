@@ -4,7 +4,7 @@
                                                                      [--scales 0.5 2]
 
 Reference conventions (no relaxation, E = 4 MPa in p/E, air at 293.15 K, p_a = 1e5 Pa). For each
-FEM level (`fem.cup.compress_cup` up to 0.9 h1, `validation.handoff.stiffness_curve`): the rim
+FEM level (`fem.cup.compress_cup` up to 0.9 h1, `validation.bridge.handoff.stiffness_curve`): the rim
 corner at the first contact sample (its lumped pressure and its neighbours' distances: the point
 load that grows under refinement), then the profile route's lifetimes at F1 = 5, 10, 20, 40, 80 N
 
@@ -33,7 +33,7 @@ from reduced.cup import CUP_A
 from reduced.lifetime import lifetime, reference_model
 from reduced.roughness import preset
 from reduced.roughness.persson import patch_length
-from validation import handoff
+from validation.bridge import handoff
 from validation.crosscheck.context import pmma_uc_table
 
 FORCES_N = (5.0, 10.0, 20.0, 40.0, 80.0)

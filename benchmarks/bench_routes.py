@@ -8,7 +8,7 @@ p_a = 1e5 Pa). For each FEM level: the FEM path's time, then per route the lifet
 20, 40, 80 N on pmma-1.89 and at 10 N on the table surface, with the route's cost:
 - paper: the FEM's F0 through eq (6)'s strip and the cone laws (3)-(5);
 - profile: the FEM's F0, r_c, V and contact-pressure profiles at dp = 0, beta (p_a - p_b) added;
-- coupled: the FEM suction table on the default (u, dp) grid (`validation.coupled.build`, cached in
+- coupled: the FEM suction table on the default (u, dp) grid (`validation.bridge.coupled.build`, cached in
   --cache-dir; the table's cost is the FEM time it recorded when it was built), the cup's
   state and profile from the table (`reduced.coupled`).
 Last, the raw (not patch-averaged) profile's molecule flow at fixed states (p_b = 50 kPa) along the path, which shows
@@ -33,8 +33,8 @@ from reduced.cup import CUP_A
 from reduced.gas import AIR
 from reduced.lifetime import largest_holdable_force, lifetime, reference_model
 from reduced.profile_leak import profile_leak_rate, ring_gaps
-from validation import handoff
-from validation.coupled.build import suction_table_for
+from validation.bridge import handoff
+from validation.bridge.coupled.build import suction_table_for
 from validation.crosscheck.context import pmma_uc_table
 
 FORCES_N = (5.0, 10.0, 20.0, 40.0, 80.0)

@@ -210,7 +210,7 @@ class StiffnessCurve:
         provenance to the JSON sidecar ``path.with_suffix('.json')`` (key ``provenance``).
 
         Each file appears atomically (written to a temporary file and renamed). A caller that
-        writes a richer sidecar itself (`validation.handoff`) passes ``sidecar=False``.
+        writes a richer sidecar itself (`validation.bridge.handoff`) passes ``sidecar=False``.
         """
         cols = {"u_mm": self.u_m * 1e3, "h_mm": self.h_m * 1e3, "F0_N": self.F0_N}
         for csv_name, (name, factor) in CSV_COLUMNS.items():

@@ -1,4 +1,4 @@
-"""The test suite keeps its caches to itself: every cupcheck cache (`validation.cache.user_cache_dir`)
+"""The test suite keeps its caches to itself: every cupcheck cache (`validation.bridge.cache.user_cache_dir`)
 goes to one temporary directory per session, never the user's."""
 
 import pytest

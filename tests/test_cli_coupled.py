@@ -18,7 +18,7 @@ from reduced.suction_table import SuctionTable
 from reduced.viscoelastic import default_relaxation, measurement_contact_time
 from tests.cli import run_cli as _run
 from validation.cli import main
-from validation.coupled.table import fem_beta
+from validation.bridge.coupled.table import fem_beta
 
 
 

@@ -83,10 +83,11 @@ def test_example_writes_table_and_figure(capsys, tmp_path):
     code, stdout, _ = _run(capsys, "example", "--out", str(tmp_path / "ex"))
     assert code == 0
     lines = (tmp_path / "ex" / "lifetime_vs_force.csv").read_text().splitlines()
-    assert lines[0].startswith("cup,route,force_N,lifetime_s,reason")
+    assert lines[0].startswith("cup,route,contact,mesh,surface,force_N,lifetime_s,reason")
     assert len(lines) == 17                                   # 5, 10, ..., 80 N
-    assert all(l.startswith("A,profile,") for l in lines[1:])          # the default route
-    lives = [float(l.split(",")[3]) for l in lines[1:]]
+    # the default route, contact law, mesh level and surface, named on every row
+    assert all(l.startswith("A,profile,frictionless,medium,pmma-1.89,") for l in lines[1:])
+    lives = [float(l.split(",")[6]) for l in lines[1:]]
     assert all(math.isfinite(t) and t > 0 for t in lives)
     png = (tmp_path / "ex" / "lifetime_vs_force.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000

@@ -127,13 +127,13 @@ def test_displacement_formulation_refuses_nu_where_it_locks(tmp_path, capsys):
 
 
 def test_formulation_follows_nu_unless_given(tmp_path):
-    # one rule for the command line, scenes and sweeps (validation.pipeline.neo_hookean): not
+    # one rule for the command line, scenes and sweeps (validation.bridge.pipeline.neo_hookean): not
     # given, nu above 0.495 takes the mixed formulation, where the displacement elements lock
     out = str(tmp_path / "c.csv")
     assert stiffness_prepare(["--nu", "0.495", "--out", out])["material"].formulation == "displacement"
     assert stiffness_prepare(["--nu", "0.4999", "--out", out])["material"].formulation == "mixed"
     assert stiffness_prepare(["--nu", "0.3", "--formulation", "mixed", "--out", out])["material"].formulation == "mixed"
-    from validation.pipeline import neo_hookean
+    from validation.bridge.pipeline import neo_hookean
     assert neo_hookean(4e6, 0.4999).formulation == "mixed" and neo_hookean(4e6, 0.49).formulation == "displacement"
 
 

@@ -48,7 +48,7 @@ def test_lifetime_defaults_to_the_calibrated_surface(capsys):
 def test_one_default_surface_and_contact_law():
     """The scene, the sweep and the commands default to the same surface and contact law."""
     from validation.cli import build_parser
-    from validation.pipeline import DEFAULT_SURFACE
+    from validation.bridge.pipeline import DEFAULT_SURFACE
     from validation.scenes.schema import scene_from_mapping
     from validation.sweeps.spec import sweep_from_mapping
 
@@ -82,7 +82,7 @@ def test_every_documented_key_is_parsed():
 
 
 def test_user_cache_dir(monkeypatch, tmp_path):
-    from validation.cache import user_cache_dir
+    from validation.bridge.cache import user_cache_dir
 
     monkeypatch.setenv("CUPCHECK_CACHE_DIR", str(tmp_path / "mine"))
     assert user_cache_dir("scenes") == tmp_path / "mine" / "scenes"

@@ -123,7 +123,7 @@ def test_a_lifetime_refuses_a_design_file_whose_contact_contradicts_the_curve(ca
             and "sticky.toml says sticking; drop the option" in err), err
     assert not (tmp_path / "life").exists()
     # the same design file is accepted, and the lifetime's cup record names the curve's interface
-    from validation.design import resolve_cup
+    from validation.bridge.design import resolve_cup
     choice = resolve_cup(StiffnessCurve.from_csv(tmp_path / "c.csv"), geometry_file=design)
     assert choice.describe()["contact"] == {"law": "coulomb", "friction": 0.3, "source": "geometry file d.toml"}
 

@@ -9,7 +9,7 @@ import pytest
 
 from tests.cli import run_cli as _run
 from validation.cli import main
-from validation.coupled.build import SuctionGridSpec, suction_table_for
+from validation.bridge.coupled.build import SuctionGridSpec, suction_table_for
 
 #: a small grid that still spans cup A's start (u_start = 4.8 mm on the coarse mesh) and 100 kPa
 SMALL = SuctionGridSpec((0.005, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8),
@@ -42,8 +42,10 @@ def test_coupled_example_lifetimes_are_the_librarys(coupled_example, table_file)
     from reduced.suction_table import SuctionTable
 
     rows = pd.read_csv(coupled_example / "lifetime_vs_force.csv", keep_default_na=False)
-    assert list(rows.columns) == ["cup", "route", "force_N", "lifetime_s", "reason", "u_final_mm",
-                                  "p_b_final_Pa"]
+    assert list(rows.columns) == ["cup", "route", "contact", "mesh", "surface", "force_N", "lifetime_s", "reason",
+                                  "u_final_mm", "p_b_final_Pa"]
+    assert {tuple(r) for r in rows[["route", "contact", "mesh", "surface"]].to_numpy()} == \
+        {("coupled", "frictionless", "coarse", "pmma-1.89")}
     table = SuctionTable.from_json(table_file)
     model = CoupledCavity(table, uc_table(preset("pmma-1.89").spectrum(), 0.5))
     u_start = table.h1_m - CUP_A.h_start_m
@@ -87,3 +89,9 @@ def test_a_cached_table_is_read_not_rebuilt(tmp_path):
     other = suction_table_for("A", fidelity="coarse", grid=SuctionGridSpec((0.1, 0.3), (0.0, 20.0)),
                               cache_dir=tmp_path)
     assert other.dp_Pa[-1] == 2e4            # another grid is another entry
+
+
+def test_suction_table_for_takes_the_contact_law_object():
+    """The contact law travels as one `fem.interface.ContactLaw`; its name alone is refused before any FEM."""
+    with pytest.raises(ValueError, match="contact: expected a fem.interface.ContactLaw"):
+        suction_table_for("A", fidelity="coarse", grid=SMALL, contact="sticking")

@@ -55,7 +55,7 @@ def _same(stated: str, default, text: str = "") -> bool:
 
 
 def _cases():
-    from validation.pipeline import DEFAULT_SURFACE
+    from validation.bridge.pipeline import DEFAULT_SURFACE
     from fem.mesh import DEFAULT_FIDELITY
 
     assert RESOLVED[("example", "--fidelity")] == DEFAULT_FIDELITY

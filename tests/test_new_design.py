@@ -13,7 +13,7 @@ from reduced.appendix_a import appendix_a_curve
 from reduced.cup import CUP_A
 from reduced.stiffness_curve import StiffnessCurve
 from tests.cli import run_cli as _run
-from validation.design import preset_design
+from validation.bridge.design import preset_design
 
 DESIGNER_TOML = """r1_mm = 25
 alpha_deg = 40

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from validation.cli import main
-from validation.scenes import pipeline
+from validation.bridge import products as pipeline
 from validation.scenes.outputs import run_scene
 from validation.scenes.schema import scene_from_mapping
 
@@ -132,7 +132,7 @@ def test_the_cache_keys_input_files_by_content(tmp_path, capsys):
 _LAZY = """
 import sys
 from validation.scenes.outputs import run_scene
-from validation.scenes import pipeline
+from validation.bridge import products as pipeline
 run_scene({scene!r}, None)
 print(",".join(sorted(m for m in ("fem", "skfem") if m in sys.modules)), dict(pipeline.COMPUTED))
 """

@@ -263,7 +263,7 @@ def test_quick_report_paper_numbers(quick_report):
     from reduced.coupled import CoupledCavity
     from reduced.cup import CUP_A
     from reduced.gas import Gas
-    from validation.coupled.build import QUICK_GRID, suction_table_for
+    from validation.bridge.coupled.build import QUICK_GRID, suction_table_for
     from validation.crosscheck.context import pmma_uc_table
 
     coupled = table[table["route"].str.startswith("coupled")].set_index("claim")
@@ -306,7 +306,7 @@ def test_stall_criterion_tells_a_stall_from_a_ramp():
     from validation.crosscheck.paper import _grows_continuously
 
     t = np.linspace(0.0, 100.0, 201)
-    ramp = SimpleNamespace(reason="reached_r1", lifetime_s=100.0, t_s=t, r_m=12e-3 + 7e-3 * (t / 100) ** 2)
-    stall = SimpleNamespace(reason="reached_r1", lifetime_s=100.0, t_s=t,
-                            r_m=np.where(t < 95, 12.5e-3, 12.5e-3 + 6.5e-3 * (t - 95) / 5))
-    assert _grows_continuously(ramp) and not _grows_continuously(stall)
+    result = SimpleNamespace(reason="reached_r1", lifetime_s=100.0, trajectory={"t_s": t})
+    ramp = 12 + 7 * (t / 100) ** 2                                      # r [mm]
+    stall = np.where(t < 95, 12.5, 12.5 + 6.5 * (t - 95) / 5)
+    assert _grows_continuously(result, ramp) and not _grows_continuously(result, stall)

@@ -1,4 +1,4 @@
-"""`cupcheck lifetime --route coupled`: the options read into `validation.coupled.route.CoupledOptions`,
+"""`cupcheck lifetime --route coupled`: the options read into `validation.bridge.coupled.route.CoupledOptions`,
 the lifetimes from the FEM suction table, printed and written as for the other routes."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ _NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--fluid", "fluid", "a
 
 def coupled_options(args: argparse.Namespace):
     """The typed options of the command line (every check; ValueError naming the option)."""
-    from validation.coupled.route import CoupledOptions
+    from validation.bridge.coupled.route import CoupledOptions
 
     if args.reference_mode:
         raise ValueError("--reference-mode: the reference conventions are the paper route's; "
@@ -55,16 +55,22 @@ def _relaxation(args: argparse.Namespace):
 
 def run_coupled(args: argparse.Namespace) -> int:
     """The coupled route of `cupcheck lifetime` (its table, --json and --out as for the others)."""
-    from validation.coupled.route import coupled_model
+    from validation.bridge.coupled.route import coupled_model
+    from validation.bridge.lifetimes import lifetimes
     from validation.output import atomic_directory, write_table
 
     options = coupled_options(args)
-    model, u_start, choice, cup = coupled_model(options, build_uc(args))
+    model, choice, cup = coupled_model(options, build_uc(args))
     for note in choice.notes:
         print(f"note: {note}", file=sys.stderr)
+    lifetimes(model, [], "coupled")        # builds the cavity: a table or u_c that does not fit is refused now
+
+    def compute():
+        return lifetimes(model, args.force_N, "coupled", t_max_s=args.t_max_s, rtol=args.rtol)
+
     if args.out:
         with atomic_directory(args.out) as tmp:
-            results = [_lifetime(model, F, u_start, args) for F in args.force_N]
+            results = compute()
             for r in results:
                 write_table(tmp / f"trajectory_F1_{r.force_N:g}N.csv",
                             {"cup": cup["name"], **r.trajectory_columns()},
@@ -72,25 +78,22 @@ def run_coupled(args: argparse.Namespace) -> int:
             (tmp / "summary.json").write_text(json.dumps([{**r.summary(), "cup": cup} for r in results],
                                                          indent=2, allow_nan=False) + "\n")
     else:
-        results = [_lifetime(model, F, u_start, args) for F in args.force_N]
+        results = compute()
     if args.json:
         print(json.dumps([{**r.summary(), "cup": cup} for r in results], indent=2))
         return 0
-    print(f"cup: {choice.label}; released at u = {1e3 * u_start:.4g} mm (r_start "
+    print(f"cup: {choice.label}; released at u = {cup['u_start_mm']:.4g} mm (r_start "
           f"{cup['r_start_mm']:.4g} mm by eq 3); route coupled: F1, V and the contact profile from "
           f"{args.suction_table}, interface gas {args.interface}{_relaxation_note(cup)}; largest "
-          f"holdable force {model.largest_holdable_force(u_start):.4g} N")
+          f"holdable force {results.largest_force_N:.4g} N")
     print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'u_end_mm':>8} {'p_b_end_kPa':>11}")
     for r in results:
         life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"
-        u_end = f"{1e3 * r.u_m[-1]:8.3f}" if r.u_m.size else f"{'-':>8}"
-        pb = f"{r.p_b_Pa[-1] / 1e3:11.4g}" if r.dp_Pa.size else f"{'-':>11}"
+        u_end, pb = r.details["u_final_mm"], r.details["p_b_final_Pa"]
+        u_end = f"{u_end:8.3f}" if u_end is not None else f"{'-':>8}"
+        pb = f"{pb / 1e3:11.4g}" if pb is not None else f"{'-':>11}"
         print(f"{r.force_N:8.4g} {life:>12} {r.reason:>11} {u_end} {pb}")
     return 0
-
-
-def _lifetime(model, F1: float, u_start: float, args: argparse.Namespace):
-    return model.lifetime(F1, u_start, t_max_s=args.t_max_s, rtol=args.rtol)
 
 
 def _relaxation_note(cup: dict[str, Any]) -> str:

@@ -19,7 +19,7 @@ if TYPE_CHECKING:                          # building the parser imports no fem
     from fem.interface import ContactChoice
 
 from reduced.cup import CUPS
-from validation.pipeline import ROUTES
+from validation.bridge.lifetimes import ROUTES
 
 
 def cup_name(value: str) -> str:
@@ -84,16 +84,15 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = 
                    help="eq (5)'s strip width at r1 in mm (with --l0-mm)")
 
 
-def route_model(args: argparse.Namespace, coupled: bool = False) -> tuple[str, str]:
-    """(geometry, seal) of the `LeakageModel` the route and cup-law options ask for
-    (`validation.pipeline.route_model`); fills ``args.cup_laws`` with the route's default.
+def cup_laws(args: argparse.Namespace, coupled: bool = False) -> str:
+    """Where r(h), V(h), l(h) come from for the --route and --cup-laws given
+    (`validation.bridge.lifetimes.route_laws`: the route's default, or --cup-laws checked against it).
     `coupled`: the command runs the coupled route itself (else it is refused here)."""
-    from validation.pipeline import route_model as model_of
+    from validation.bridge.lifetimes import route_laws
 
     if args.route == "coupled" and not coupled:
         raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
-    args.cup_laws, seal = model_of(args.route, args.cup_laws)
-    return args.cup_laws, seal
+    return route_laws(args.route, args.cup_laws)
 
 
 #: `fem.interface.CONTACT_LAWS`, spelled out so that building the parser imports no fem (a test pins them equal)

@@ -21,7 +21,7 @@ def build_uc(args: argparse.Namespace) -> Callable[[float], float]:
     """The critical gap u_c(p/E) [m] the options ask for (the one place that builds it)."""
     from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
     from validation.guards import check_spectrum, check_uc_table
-    from validation.pipeline import DEFAULT_SURFACE
+    from validation.bridge.pipeline import DEFAULT_SURFACE
     if args.surface == ILLUSTRATIVE:                  # asked for by name only
         return UcTable.from_csv(ILLUSTRATIVE_UC_CSV)
     if not has_surface(args) and args.uc_table is None:

@@ -18,15 +18,17 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
      built here and cached in --cache-dir, or read from --suction-table): F1, V and the profile of
      every state from the FEM, replacing eqs (3)-(7) and beta (`reduced.coupled`). Building the
      table takes ~3 min (coarse) to ~8 min (medium) once per design and law.
-   Another design (--geometry FILE) runs the same chain on its own geometry (`validation.design`).
+   Another design (--geometry FILE) runs the same chain on its own geometry (`validation.bridge.design`).
 
 Writes to DIR, atomically:
 
-  lifetime_vs_force.csv   cup, route, force_N, lifetime_s, reason, then ballistic_share, r_final_mm
-                          (paper, profile) or u_final_mm (coupled), and p_b_final_Pa
+  lifetime_vs_force.csv   cup, route, contact, mesh, surface, force_N, lifetime_s, reason, then
+                          ballistic_share, r_final_mm (paper, profile) or u_final_mm (coupled), and
+                          p_b_final_Pa
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
+  manifest.json           the files and the study (`validation.bridge.study.Study`) they were computed for
 """
 
 from __future__ import annotations
@@ -37,12 +39,13 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from validation.cache import user_cache_dir
+from validation.bridge.cache import user_cache_dir
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
-                                      contact_choice, load_cup_design, route_model)
+                                      contact_choice, cup_laws, load_cup_design)
 
 if TYPE_CHECKING:
     from fem.interface import ContactChoice
+    from validation.bridge.study import Study
 
 NAME = "example"
 HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"
@@ -78,14 +81,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _inputs(args: argparse.Namespace):
-    """Every check before the solve: (the FEM geometry, u_c table, its label); the FEM's contact
-    law (`contact_choice`) goes to ``args.contact_choice``."""
+    """Every check before the solve: (the FEM geometry, its contact law (`contact_choice`), the
+    u_c table's label)."""
     import os
 
     from validation.guards import check_design, check_uc_table
 
     design = load_cup_design(args)
-    args.contact_choice = contact_choice(args, design)
+    contact = contact_choice(args, design)
     geometry = design.geometry
     check_design(geometry.describe(), args.allow_unusual_design, source=geometry.name)
     if args.uc_table is not None:
@@ -94,26 +97,22 @@ def _inputs(args: argparse.Namespace):
         from reduced.critical_gap import UcTable
         table = UcTable.from_csv(args.uc_table)
         check_uc_table(table.p_over_E, table.u_c_m, "uc-table: u_c_m")
-        return geometry, table, Path(args.uc_table).name
-    from validation.pipeline import DEFAULT_SURFACE, surface_uc_table
+        return geometry, contact, Path(args.uc_table).name
+    from validation.bridge.pipeline import DEFAULT_SURFACE, surface_uc_table
     name = args.surface or DEFAULT_SURFACE
-    return geometry, surface_uc_table(name), name
+    surface_uc_table(name)                 # an unknown preset is refused before the FEM
+    return geometry, contact, name
 
 
-def fem_stiffness(geometry, contact: ContactChoice, fidelity: str, progress=None):
-    """(CupResponse, StiffnessCurve) of the main job's FEM step: the design (`CupGeometry` or a
-    preset name) of E = 4 MPa, nu = 0.49 under `contact` to 0.9 h1 (`validation.pipeline`)."""
-    from validation.pipeline import fem_stiffness as pipeline_stiffness, neo_hookean
-
-    return pipeline_stiffness(geometry, neo_hookean(4e6, 0.49), contact, fidelity, progress=progress)
-
-
-def write_table(results, path: Path, cup: str, route: str) -> None:
+def write_table(results, path: Path, cup: str, study: Study) -> None:
+    """The lifetimes, one row per force: the cup, what they were computed for (`Study.record`), the outcome."""
     from validation.output import write_table as write_csv
 
+    route = study.route
     s = [r.summary() for r in results]
     own = ("u_final_mm",) if route == "coupled" else ("ballistic_share", "r_final_mm")
-    write_csv(path, {"cup": cup, "route": route, "force_N": [r.force_N for r in results],
+    record = {k: v for k, v in study.record().items() if k not in ("design", "route")}
+    write_csv(path, {"cup": cup, "route": route, **record, "force_N": [r.force_N for r in results],
                      "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in s],
                      "reason": [r.reason for r in results],
                      **{key: [_blank(x[key]) for x in s] for key in (*own, "p_b_final_Pa")}},
@@ -125,29 +124,26 @@ def _blank(value):
     return "" if value is None else value
 
 
-def coupled_lifetimes(args: argparse.Namespace, geometry, uc, choice, tmp: Path):
-    """The coupled route's lifetimes [CoupledLifetime] and largest holdable force [N]: the design's
-    suction table (read, or built and cached), copied to the output."""
-    from reduced.coupled import CoupledCavity
-    from reduced.suction_table import SuctionTable
-    from validation.coupled.build import suction_table_for
-    from validation.output import terminal_progress
+def study_of(args: argparse.Namespace, contact: ContactChoice) -> Study:
+    """The main job as a `validation.bridge.study.Study`: the design of --cup/--geometry (E = 4 MPa,
+    nu = 0.49, `contact`) at --fidelity, through --route on the surface, at F1 = 5, 10, ..., 80 N."""
+    from validation.bridge.pipeline import DEFAULT_SURFACE
+    from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
 
-    if args.suction_table is not None:
-        table = SuctionTable.from_json(args.suction_table)
-    else:
-        law = args.contact_choice.contact
-        table = suction_table_for(geometry, fidelity=args.fidelity, contact=law.law, friction=law.friction,
-                                  cache_dir=None if args.no_cache else args.cache_dir,
-                                  progress=terminal_progress("suction"))
-    table.to_json(tmp / "suction_table.json")
-    u_start = table.h1_m - choice.cup.h_start_m
-    model = CoupledCavity(table, uc)
-    results = [model.lifetime(F, u_start) for F in FORCES_N]
-    return results, model.largest_holdable_force(u_start)
+    law = contact.contact
+    return Study(design=CupDesign(preset=args.cup or "A", file=None if args.geometry is None else str(args.geometry),
+                                  l0_mm=args.l0_mm, l1_mm=args.l1_mm),
+                 material=Material(E_MPa=4.0, nu=0.49),
+                 contact=Contact(law=law.law, friction=law.friction if law.law == "coulomb" else None,
+                                 source=contact.source),
+                 fidelity=args.fidelity, stiffness="fem",
+                 surface=Surface(preset=None if args.uc_table else (args.surface or DEFAULT_SURFACE),
+                                 uc_table=args.uc_table),
+                 route=args.route, cup_laws=args.cup_laws, loads=Loads(forces_N=FORCES_N, r_start_mm=args.r_start_mm),
+                 refine=4, suction_table=args.suction_table)
 
 
-def _check_suction_table(args: argparse.Namespace, geometry) -> None:
+def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
     """--suction-table: only with the coupled route, an existing table of this very design."""
     if args.suction_table is None:
         return
@@ -160,7 +156,7 @@ def _check_suction_table(args: argparse.Namespace, geometry) -> None:
     if prov.get("geometry") != geometry.describe():
         raise ValueError(f"--suction-table: '{args.suction_table}' was built for another design than "
                          f"{geometry.name}; build it with `cupcheck suction` on the same --cup/--geometry")
-    law = args.contact_choice.contact
+    law = contact.contact
     built = (prov.get("contact"), float(prov.get("friction", 0.0)))
     if built != (law.law, law.friction):
         raise ValueError(f"--suction-table: '{args.suction_table}' was built with {built[0]} contact"
@@ -169,37 +165,38 @@ def _check_suction_table(args: argparse.Namespace, geometry) -> None:
 
 
 def plot(series: dict, curve, cup, path: Path, title: str) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
+    """Lifetime against F1 per series and the FEM's F0(u) beside Appendix A's, in the toolkit's
+    style; `title` names the design, contact law, mesh level, route and surface."""
     import matplotlib.pyplot as plt
 
     from reduced.appendix_a import appendix_a_force
+    from validation.style import COLUMN_WIDTH_IN, cupcheck_style, log_axis, save_figure
 
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4), constrained_layout=True)
-    for (label, res), style in zip(series.items(), ("o-", "s--", "^:")):
-        pts = [(r.force_N, r.lifetime_s) for r in res if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
-        if pts:
-            ax[0].semilogy(*zip(*pts), style, label=label)
-    ax[0].set(xlabel="pull force $F_1$ (N)", ylabel="lifetime (s)")
-    fig.suptitle(title, fontsize=9)
-    ax[0].legend(fontsize=8)
-    u = curve.u_m
-    ax[1].plot(1e3 * u, curve.F0_N, label="FEM")
-    ax[1].plot(1e3 * u, appendix_a_force(u, cup.alpha_deg, 4e6, 2e-3, cup.r0_m, cup.r1_m), "--",
-               label="Appendix A")
-    ax[1].set(xlabel="plate displacement u (mm)", ylabel="stiffness force $F_0$ (N)")
-    ax[1].legend(fontsize=8)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    with cupcheck_style():
+        fig, ax = plt.subplots(1, 2, figsize=(2 * COLUMN_WIDTH_IN, 2.6))
+        for (label, res), style in zip(series.items(), ("o-", "s--", "^:")):
+            pts = [(r.force_N, r.lifetime_s) for r in res if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
+            if pts:
+                ax[0].plot(*zip(*pts), style, label=label)
+        log_axis(ax[0], "y")
+        ax[0].set(xlabel="pull force $F_1$ (N)", ylabel="lifetime (s)")
+        fig.suptitle(title, fontsize=7)
+        ax[0].legend(fontsize=6)
+        u = curve.u_m
+        ax[1].plot(1e3 * u, curve.F0_N, label="FEM")
+        ax[1].plot(1e3 * u, appendix_a_force(u, cup.alpha_deg, 4e6, 2e-3, cup.r0_m, cup.r1_m), "--",
+                   label="Appendix A")
+        ax[1].set(xlabel="plate displacement u (mm)", ylabel="stiffness force $F_0$ (N)")
+        ax[1].legend(fontsize=6)
+        save_figure(fig, path)
 
 
 def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
-    from reduced.lifetime import lifetime_sweep, reference_model
-    from validation import handoff
-    from validation.design import resolve_cup
+    from validation.bridge import handoff
     from validation.output import atomic_directory, terminal_progress
+    from validation.bridge.products import Products
 
     from fem.mesh import DEFAULT_FIDELITY
 
@@ -207,62 +204,80 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import check_outputs, command_inputs
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
-    cup_laws, seal = route_model(args, coupled=True)
-    geometry, uc, uc_label = _inputs(args)
-    _check_suction_table(args, geometry)
+    laws = cup_laws(args, coupled=True)
+    geometry, contact, uc_label = _inputs(args)
+    _check_suction_table(args, geometry, contact)
+    study = study_of(args, contact)
+    products = Products(study, suction_cache_dir=None if args.no_cache else args.cache_dir,
+                        fem_progress=terminal_progress("FEM"))
     from fem.solver import ConvergenceError
     from validation.commands._failure import solver_failure
 
     with atomic_directory(args.out) as tmp:
         try:
-            response, curve = fem_stiffness(geometry, args.contact_choice, args.fidelity, terminal_progress("FEM"))
+            response, curve = products.fem_path(None), products.curve()
         except ConvergenceError as exc:
             raise solver_failure(exc, Path(f"{Path(args.out)}.failure.json")) from None
-        choice = resolve_cup(curve, r_start_mm=args.r_start_mm, l0_mm=args.l0_mm, l1_mm=args.l1_mm,
-                             curve_label="the FEM curve", laws=cup_laws)
+        choice = products.cup_choice()
         curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
         handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
-        base = reference_model(choice.cup, uc)
-        if seal == "coupled":
-            results, holdable = coupled_lifetimes(args, geometry, uc, choice, tmp)
-        else:
-            model = replace(base, stiffness=curve, geometry=cup_laws, seal=seal, label="FEM-fed")
-            results = lifetime_sweep(model, FORCES_N, progress=terminal_progress("lifetime"), refine=4)
+        if args.route == "coupled":
+            products.suction_table().to_json(tmp / "suction_table.json")
+        results = products.lifetimes()
+        holdable = results.largest_force_N
         series = {f"FEM-fed, {args.route} route": results}
         if args.route != "paper":        # the same FEM F0 through the paper's strip, for comparison
-            series["FEM F0, paper route (strip, eqs 3-7)"] = lifetime_sweep(
-                replace(base, stiffness=curve, geometry="cone"), FORCES_N, refine=1)
-        series["Appendix A-fed, paper route (d0 2 mm)"] = lifetime_sweep(base, FORCES_N, refine=1)
-        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, args.route)
+            paper = replace(study, route="paper", cup_laws="cone", refine=1)
+            series["FEM F0, paper route (strip, eqs 3-7)"] = products.derived(
+                paper, inherit=("uc_table", "curve", "cup")).lifetimes()
+        series["Appendix A-fed, paper route (d0 2 mm)"] = products.appendix_a(refine=1).lifetimes()
+        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, study)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
-             f"{choice.label}, FEM {args.contact_choice.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
+             f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
+        _write_manifest(tmp, study)
     wall = time.perf_counter() - t0
     slope = float(curve.force(curve.h1_m - 1e-3))
-    patch = getattr(uc, "patch_length_m", None)
+    patch = getattr(products.uc_table(), "patch_length_m", None)
     crossed = {"profile": "the FEM's contact-pressure profiles" + (f", averaged over patches of {1e6 * patch:.0f} um"
                                                                  if patch else " (raw: the u_c table has no patch length)"),
                "coupled": "the contact-pressure profile of each (u, dp) state of the FEM suction table "
-                          f"(largest holdable force {holdable:.4g} N)" if seal == "coupled" else "",
+                          f"(largest holdable force {holdable:.4g} N)" if args.route == "coupled" else "",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
-                                                            if cup_laws == "cone" else "")}[seal]
-    print(f"{choice.label}: FEM {args.contact_choice.contact.label()} stiffness (from the "
-          f"{args.contact_choice.source}; {args.fidelity}, {response.stats.steps} steps), "
+                                                            if laws == "cone" else "")}[_seal(args.route)]
+    print(f"{choice.label}: FEM {contact.contact.label()} stiffness (from the "
+          f"{contact.source}; {args.fidelity}, {response.stats.steps} steps), "
           f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
-          f"{_rv_source(seal, cup_laws)}; {args.route} route: the leak "
+          f"{_rv_source(args.route, laws)}; {args.route} route: the leak "
           f"crosses {crossed}")
     names = list(series)
     print(f"  {'F1 (N)':>7} " + " ".join(f"{n.split(',')[0] + ', ' + n.split(', ')[1].split(' ')[0]:>24}"
                                          for n in names) + "  end")
     for i, r in enumerate(results):
         print(f"  {r.force_N:7g} " + " ".join(f"{series[n][i].lifetime_s:24.4g}" for n in names) + f"  {r.reason}")
-    extra = ", suction_table.json" if seal == "coupled" else ""
+    extra = ", suction_table.json" if args.route == "coupled" else ""
     print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
           f"{extra} in {wall:.1f} s")
     return 0
 
 
-def _rv_source(seal: str, cup_laws: str) -> str:
-    if seal == "coupled":
+def _write_manifest(tmp: Path, study: Study) -> None:
+    """manifest.json: the files written and the study they were computed for."""
+    import json
+
+    from validation.output import MANIFEST, software_versions
+
+    files = sorted(p.name for p in tmp.iterdir() if p.is_file())
+    (tmp / MANIFEST).write_text(json.dumps({"files": [{"path": f} for f in files], "study": study.describe(),
+                                            "versions": software_versions()}, indent=1, default=str) + "\n")
+
+
+def _seal(route: str) -> str:
+    """What the leak crosses on `route` (the key of the printed description)."""
+    return {"paper": "strip", "profile": "profile", "coupled": "coupled"}[route]
+
+
+def _rv_source(route: str, laws: str) -> str:
+    if route == "coupled":
         return "FEM suction table"
-    return "FEM curve" if cup_laws == "curve" else "cone laws (3)-(4)"
+    return "FEM curve" if laws == "curve" else "cone laws (3)-(4)"

@@ -21,9 +21,11 @@ import argparse
 import json
 import math
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from validation.commands._cup import add_cup_arguments, add_cup_law_arguments, route_model
+from validation.commands._cup import add_cup_arguments, add_cup_law_arguments, cup_laws
 from validation.commands._reduced_options import ILLUSTRATIVE, build_uc, check_run_options, relaxation_law
 from validation.commands._surface import add_surface_arguments
 
@@ -102,38 +104,50 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "summary.json to DIR, atomically")
 
 
-def build_model(args: argparse.Namespace):
+@dataclass(frozen=True)
+class LifetimeCase:
+    """What the command line asks for: the model, the cup it was built for (`CupChoice`), where
+    r, V, l come from (cup_laws) and the route's options for `validation.bridge.lifetimes.lifetimes`."""
+
+    model: Any
+    choice: Any
+    cup_laws: str
+    options: dict
+
+
+def build_model(args: argparse.Namespace) -> LifetimeCase:
     """Validate the options and build the `LeakageModel` (cheap; raises ValueError on bad input).
 
     The cup comes from the stiffness curve's recorded design, else from --geometry / --cup
-    (`validation.design`); the chosen `CupChoice` is kept on ``args.cup_choice`` for the outputs.
+    (`validation.bridge.design`).
     """
     from reduced.appendix_a import appendix_a_curve
     from reduced.gas import Gas
-    from reduced.lifetime import LeakageModel, largest_holdable_force, reference_model
+    from reduced.lifetime import LeakageModel, reference_model
     from validation.guards import check_design, check_modulus, check_stiffness_curve
+    from validation.bridge.lifetimes import lifetimes, route_options
 
     check_run_options(args)
     check_modulus(args.E_MPa, "--E-MPa")
-    geometry, seal = route_model(args)
-    curve, choice = _curve_and_cup(args)
+    laws = cup_laws(args)
+    options = route_options(args.route, args.cup_laws)
+    curve, choice = _curve_and_cup(args, laws)
     check_design(choice.design, args.allow_unusual_design, source=choice.label)
     check_stiffness_curve(curve, choice.design["h1_mm"], f"--stiffness '{args.stiffness}'", args.E_MPa)
-    args.cup_choice = choice
     cup = choice.cup
     uc = build_uc(args)
     if args.reference_mode:
         changed = [opt for opt, val, default in (
             ("--stiffness", args.stiffness, "appendix-a"), ("--E-MPa", args.E_MPa, 4.0),
             ("--d0-mm", args.d0_mm, 2.0), ("--relaxation", args.relaxation, "none"),
-            ("--cup-laws", args.cup_laws, "cone"), ("--route", args.route, "paper"), ("--T-K", args.T_K, 293.15),
+            ("--cup-laws", laws, "cone"), ("--route", args.route, "paper"), ("--T-K", args.T_K, 293.15),
             ("--p-a-Pa", args.p_a_Pa, 1e5), ("--phi0-s", args.phi0_s, None),
             ("--fluid", args.fluid, "air"), ("--cavitation-kPa", args.cavitation_kPa, None),
             ("--kappa", args.kappa, 1.0))
             if val != default]
         if changed:
             raise ValueError(f"--reference-mode: fixes {', '.join(changed)}; drop them")
-        return reference_model(cup, uc)
+        return LifetimeCase(reference_model(cup, uc), choice, laws, options)
     p_cav = args.cavitation_kPa
     if p_cav is not None and args.fluid != "water":
         raise ValueError("--cavitation-kPa: only with --fluid water")
@@ -144,36 +158,35 @@ def build_model(args: argparse.Namespace):
         if not (math.isfinite(args.d0_mm) and args.d0_mm > 0):
             raise ValueError(f"--d0-mm: wall thickness must be > 0 mm, got {args.d0_mm:g}")
         curve = appendix_a_curve(cup, E_Pa=1e6 * args.E_MPa, d0_m=1e-3 * args.d0_mm)
-    if args.kappa != 1.0:
-        curve = curve.scaled(args.kappa)
+    if not (math.isfinite(args.kappa) and args.kappa > 0):
+        raise ValueError(f"kappa: stiffness scale factor must be > 0, got {args.kappa}")
     relax = relaxation_law(args.relaxation)
     gas = Gas(T_K=args.T_K)
     model = LeakageModel(cup=cup, stiffness=curve, u_c=uc, gas=gas, p_a_Pa=args.p_a_Pa,
-                         E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s,
-                         geometry=geometry, seal=seal, fluid=args.fluid,
-                         liquid_viscosity_Pa_s=args.liquid_viscosity,
+                         E_Pa=1e6 * args.E_MPa, relaxation=relax, phi0_s=args.phi0_s, kappa=args.kappa,
+                         fluid=args.fluid, liquid_viscosity_Pa_s=args.liquid_viscosity,
                          cavitation_pressure_Pa=None if p_cav is None else 1e3 * p_cav,
                          label=choice.label)
-    largest_holdable_force(model)   # builds the start state: checks geometry and curve range now
-    return model
+    lifetimes(model, [], args.route, **options)   # builds the start state: checks geometry and curve range now
+    return LifetimeCase(model, choice, laws, options)
 
 
-def _curve_and_cup(args: argparse.Namespace):
+def _curve_and_cup(args: argparse.Namespace, laws: str):
     """(the stiffness curve or None for Appendix A, the `CupChoice`)."""
     from reduced.stiffness_curve import StiffnessCurve
-    from validation.design import explicit_design, resolve_cup
+    from validation.bridge.design import explicit_design, resolve_cup
 
     options = dict(cup=args.cup, geometry_file=args.geometry, r_start_mm=args.r_start_mm,
                    l0_mm=args.l0_mm, l1_mm=args.l1_mm)
     if args.stiffness == "appendix-a":
-        if args.cup_laws == "curve":
+        if laws == "curve":
             raise ValueError(f"--{'route' if args.route == 'profile' else 'cup-laws'}: "
                              f"'{args.route if args.route == 'profile' else 'curve'}' needs an FEM "
                              f"stiffness curve (--stiffness FILE.csv with r_c_mm, V_mm3, l_mm)")
         return None, resolve_cup(None, **options)
     h1 = None if _has_h(args.stiffness) else 1e-3 * explicit_design(args.cup, args.geometry)["h1_mm"]
     curve = StiffnessCurve.from_csv(args.stiffness, h1_m=h1)
-    return curve, resolve_cup(curve, curve_label=f"'{args.stiffness}'", laws=args.cup_laws, **options)
+    return curve, resolve_cup(curve, curve_label=f"'{args.stiffness}'", laws=laws, **options)
 
 
 def _has_h(path: str) -> bool:
@@ -206,7 +219,7 @@ def summaries(results, cup: dict) -> list[dict]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from reduced.lifetime import lifetime_sweep
+    from validation.bridge.lifetimes import lifetimes
     from validation.output import atomic_directory, terminal_progress
 
     from validation.output import check_file_names, check_outputs, command_inputs
@@ -219,9 +232,9 @@ def run(args: argparse.Namespace) -> int:
                                    ("--interface", args.interface, "linear")):
         if value != default:
             raise ValueError(f"{option}: applies to --route coupled only")
-    model = build_model(args)
-    choice = args.cup_choice
-    cup = {**choice.describe(), "laws": args.cup_laws, "route": args.route}
+    case = build_model(args)
+    model, choice = case.model, case.choice
+    cup = {**choice.describe(), "laws": case.cup_laws, "route": args.route}
     for note in choice.notes:
         print(f"note: {note}", file=sys.stderr)
     if args.surface == ILLUSTRATIVE and not args.json:
@@ -231,7 +244,8 @@ def run(args: argparse.Namespace) -> int:
     progress = terminal_progress("lifetime") if cost >= 100 else None
 
     def compute():
-        return lifetime_sweep(model, args.force_N, progress=progress, t_max_s=args.t_max_s, rtol=args.rtol)
+        return lifetimes(model, args.force_N, args.route, progress=progress, t_max_s=args.t_max_s,
+                         rtol=args.rtol, **case.options)
 
     if args.out:
         with atomic_directory(args.out) as tmp:
@@ -242,14 +256,14 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(summaries(results, cup), indent=2))
     else:
-        laws = "cone laws (3)-(5)" if args.cup_laws == "cone" else "the stiffness curve"
+        laws = "cone laws (3)-(5)" if case.cup_laws == "cone" else "the stiffness curve"
         seal = ("the curve's contact-pressure profiles" if args.route == "profile" else
-                "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})" if args.cup_laws == "cone" else ""))
+                "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})" if case.cup_laws == "cone" else ""))
         print(f"cup: {choice.label} from the {choice.source}; r_start {cup['r_start_mm']:.4g} mm; "
               f"r, V from {laws}; route {args.route}: the leak crosses {seal}")
         print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'ballistic':>9} {'r_end_mm':>8}")
         for r in results:
             life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"
-            print(f"{r.force_N:8.4g} {life:>12} {r.reason:>11} {r.ballistic_share:9.3f} "
-                  f"{1e3 * r.r_m[-1]:8.3f}")
+            print(f"{r.force_N:8.4g} {life:>12} {r.reason:>11} {r.details['ballistic_share']:9.3f} "
+                  f"{r.trajectory['r_mm'][-1]:8.3f}")
     return 0

@@ -17,7 +17,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from validation.cache import CACHE_ENV, user_cache_dir
+from validation.bridge.cache import CACHE_ENV, user_cache_dir
 
 NAME = "run"
 HELP = "run a scene file: the curves, lifetimes and figures it asks for (cached)"

@@ -30,7 +30,7 @@ from typing import Any
 
 from validation.commands._cup import add_contact_arguments, add_cup_arguments, contact_choice, load_cup_design
 from validation.commands._paths import check_writable
-from validation.pipeline import LOCKING_NU
+from validation.bridge.pipeline import LOCKING_NU
 
 NAME = "stiffness"
 HELP = "FEM stiffness curve F0(h), r_c, l, V of cup A, B or your own design (CSV + JSON sidecar)"
@@ -76,9 +76,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     job = _prepare(args)                     # every check happens here, before the solve
     from fem.postprocess import BIOT_STRETCH
-    from validation import handoff
+    from validation.bridge import handoff
     from validation.output import atomic_file, terminal_progress
-    from validation.pipeline import fem_curve, fem_path
+    from validation.bridge.pipeline import fem_curve, fem_path
 
     from fem.solver import ConvergenceError
     from validation.commands._failure import solver_failure
@@ -113,7 +113,7 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     """Validate every input and build the mesh and material (cheap); raise ValueError."""
     from fem.cup import cup_height
     from fem.mesh import DEFAULT_FIDELITY, cup_mesh, read_mesh
-    from validation.pipeline import mesh_record, neo_hookean
+    from validation.bridge.pipeline import mesh_record, neo_hookean
 
     out = Path(args.out)
     if out.suffix.lower() != ".csv":

@@ -28,7 +28,7 @@ from validation.commands._cup import add_contact_arguments, add_cup_arguments, c
 NAME = "suction"
 HELP = "FEM response to the cavity suction on a (u, dp) grid, for lifetime --route coupled (JSON)"
 
-from validation.coupled.build import DEFAULT_GRID
+from validation.bridge.coupled.build import DEFAULT_GRID
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -57,13 +57,12 @@ def run(args: argparse.Namespace) -> int:
     from fem.solver import ConvergenceError
     from fem.suction import suction_grid
     from validation.commands._failure import solver_failure
-    from validation.coupled.table import suction_table
+    from validation.bridge.coupled.table import suction_table
     from validation.output import atomic_file, terminal_progress
 
     try:
-        law = job["contact"].contact
-        grid = suction_grid(job["mesh"], job["material"], job["u_m"], job["dp_Pa"], contact=law.law,
-                            friction=law.friction, progress=terminal_progress("suction"))
+        grid = suction_grid(job["mesh"], job["material"], job["u_m"], job["dp_Pa"], contact=job["contact"].contact,
+                            progress=terminal_progress("suction"))
     except ConvergenceError as exc:
         raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
     table = suction_table(grid, {"geometry": job["geometry"], "fidelity": args.fidelity,
@@ -83,7 +82,7 @@ def _prepare(args: argparse.Namespace) -> dict:
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
     from validation.commands._paths import check_writable
-    from validation.pipeline import LOCKING_NU
+    from validation.bridge.pipeline import LOCKING_NU
     from validation.guards import check_design, check_modulus
 
     out = Path(args.out)

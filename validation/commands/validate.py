@@ -21,7 +21,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from validation.cache import user_cache_dir
+from validation.bridge.cache import user_cache_dir
 
 NAME = "validate"
 HELP = ("cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes, the paper's "

@@ -243,11 +243,12 @@ def scaling_row(ctx: Context, runs: list[FemRun]) -> list:
 
 def reduced_rows(ctx: Context) -> list[list]:
     from reduced.critical_gap import UcTable
-    from reduced.lifetime import largest_holdable_force, reference_model
+    from reduced.lifetime import reference_model
+    from validation.bridge.lifetimes import lifetimes
 
     uc = pmma_uc_table()
     model = reference_model(CUP_A, uc)
-    Fmax = largest_holdable_force(model)
+    Fmax = lifetimes(model, [], "paper", cup_laws="cone").largest_force_N
     cases = [("F1 = 1 mN (-> 0)", model, 1e-3),
              (f"F1 = (1 - 1e-3) F_max = {(1 - 1e-3) * Fmax:.4g} N", model, (1 - 1e-3) * Fmax),
              (f"F1 = F_max = {Fmax:.4g} N", model, Fmax)]
@@ -264,13 +265,15 @@ def water_rows(ctx: Context, uc) -> list[list]:
     vapour pressure, from a moderate pull to beyond the largest holdable force."""
     from dataclasses import replace
 
-    from reduced.lifetime import largest_holdable_force, reference_model
+    from reduced.lifetime import reference_model
+    from validation.bridge.lifetimes import lifetimes
 
     rows = []
     for p_cav in (None, VAPOUR_PRESSURE_PA):
         model = replace(reference_model(CUP_A, uc), fluid="water", cavitation_pressure_Pa=p_cav)
         kind = "metastable (any tension)" if p_cav is None else f"cavitation at {p_cav / 1e3:g} kPa"
-        F_cav = largest_holdable_force(replace(model, cavitation_pressure_Pa=VAPOUR_PRESSURE_PA))
+        F_cav = lifetimes(replace(model, cavitation_pressure_Pa=VAPOUR_PRESSURE_PA), [], "paper",
+                          cup_laws="cone").largest_force_N
         rows += [_reduced_case(ctx, f"water, {kind}, F1 = {F1:.4g} N", model, F1, _water_verdict)
                  for F1 in (20.0, 60.0, 100.0, 1.05 * F_cav)]
     return rows
@@ -279,11 +282,11 @@ def water_rows(ctx: Context, uc) -> list[list]:
 def _reduced_case(ctx: Context, label: str, model, F1: float, judge) -> list:
     """One reduced-model case: its lifetime judged by `judge(model, result, F1) -> (outcome,
     checks, details)`, or the error it fails fast with."""
-    from reduced.lifetime import lifetime
+    from validation.bridge.lifetimes import lifetimes
 
     ctx.progress(0.0, f"reduced: {label}")
     try:
-        r = lifetime(model, F1)
+        r = lifetimes(model, [F1], "paper", cup_laws="cone")[0]
     except (ValueError, RuntimeError) as exc:
         return ["reduced", label, "failed fast", "", _first_line(exc)]
     return ["reduced", label, *judge(model, r, F1)]
@@ -312,20 +315,22 @@ def _water_verdict(model, r, F1: float) -> tuple[str, str, str]:
     """Checks: p_b(0) from the force balance (7) at the start height (h_start, or h_c after
     cavitation), never below the cavitation pressure, and the quadrature lifetime."""
     p_cav = model.cavitation_pressure_Pa
-    note = f"lifetime {r.lifetime_s:.4g} s ({r.reason}), p_b(0) = {r.p_b_Pa[0] / 1e3:.4g} kPa"
+    p_b = r.trajectory["p_b_Pa"]
+    note = f"lifetime {r.lifetime_s:.4g} s ({r.reason}), p_b(0) = {p_b[0] / 1e3:.4g} kPa"
     if r.reason == "over_force":
         checks = {"lifetime at F1 >= F_max": (r.lifetime_s, 0.0)}
         return (*_verdict(checks), note + f"; F_max = {r.largest_force_N:.4g} N")
-    radius = CUP_A.radius(r.h_m[0])
-    pb = model.p_a_Pa - (float(model.stiffness.force(r.h_m[0])) + F1) / (math.pi * radius * radius)
-    checks = {"p_b(0) force balance": (abs(r.p_b_Pa[0] - pb) / model.p_a_Pa, 1e-9),
+    h0 = r.trajectory["h_mm"][0] / 1e3
+    radius = CUP_A.radius(h0)
+    pb = model.p_a_Pa - (float(model.stiffness.force(h0)) + F1) / (math.pi * radius * radius)
+    checks = {"p_b(0) force balance": (abs(p_b[0] - pb) / model.p_a_Pa, 1e-9),
               "quadrature": (_quadrature_error(model, r, F1), 1e-4)}
     if p_cav is not None:
-        checks["p_b >= p_cav"] = (max(0.0, (p_cav - r.p_b_Pa.min()) / model.p_a_Pa), 1e-9)
+        checks["p_b >= p_cav"] = (max(0.0, (p_cav - p_b.min()) / model.p_a_Pa), 1e-9)
         if "cavitation" in r.message:
             note += f"; {r.message.split('; ', 1)[1]}"
-    elif r.p_b_Pa.min() < VAPOUR_PRESSURE_PA:
-        note += (f"; p_b reaches {r.p_b_Pa.min() / 1e3:.4g} kPa, below water's vapour pressure: a "
+    elif p_b.min() < VAPOUR_PRESSURE_PA:
+        note += (f"; p_b reaches {p_b.min() / 1e3:.4g} kPa, below water's vapour pressure: a "
                  f"metastable liquid under tension (the paper's Sec. 6; see the cavitation rows)")
     return (*_verdict(checks), note)
 

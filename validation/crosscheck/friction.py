@@ -244,8 +244,8 @@ def _geometry_table(ctx: Context, runs: dict) -> None:
 
 
 def _lifetimes(ctx: Context, runs: dict) -> None:
-    from reduced.lifetime import lifetime
     from validation.crosscheck.lifetimes import fem_width, leakage_model
+    from validation.bridge.lifetimes import lifetimes
 
     uc = pmma_uc_table()
     forces = QUICK_FORCES_N if ctx.quick else FORCES_N
@@ -253,10 +253,10 @@ def _lifetimes(ctx: Context, runs: dict) -> None:
     for k, r in runs.items():
         curve = r.stiffness_curve()
         for geometry, src, tag in (("cone", curve, "cone"), ("curve", fem_width(curve), "own")):
-            model = leakage_model(src, geometry, uc, f"{k}, {tag}")
+            model = leakage_model(src, uc, f"{k}, {tag}")
             ctx.progress(0.0, f"friction lifetimes {k} {tag}")
             try:
-                res = [lifetime(model, F) for F in forces]
+                res = lifetimes(model, forces, "paper", cup_laws=geometry)
                 columns.append([(x.lifetime_s, x.reason) for x in res])
             except (ValueError, RuntimeError, ArithmeticError) as exc:
                 columns.append([(math.nan, f"failed: {str(exc).splitlines()[0][:80]}")] * len(forces))

@@ -39,16 +39,16 @@ def requests(quick: bool) -> tuple[FemRun, ...]:
     return tuple(FemRun(cup="A", contact=k, fidelity=CROSSCHECK_FIDELITY) for k in ("frictionless", "sticking"))
 
 
-def leakage_model(stiffness, geometry: str, uc, label: str):
-    """The reference-convention `LeakageModel` of cup A with another stiffness (and geometry) source."""
+def leakage_model(stiffness, uc, label: str):
+    """The reference-convention `LeakageModel` of cup A with another stiffness source."""
     from dataclasses import replace
 
     from reduced.lifetime import reference_model
-    return replace(reference_model(CUP_A, uc), stiffness=stiffness, geometry=geometry, label=label)
+    return replace(reference_model(CUP_A, uc), stiffness=stiffness, label=label)
 
 
 def sources(ctx: Context, fidelity: str = CROSSCHECK_FIDELITY) -> dict[str, tuple]:
-    """label -> (StiffnessCurve, geometry) of the four sources."""
+    """label -> (StiffnessCurve, where r, V, l come from: the paper route's cup_laws) of the sources."""
     from reduced.appendix_a import appendix_a_curve
 
     fric = ctx.fem(FemRun(cup="A", contact="frictionless", fidelity=fidelity)).stiffness_curve()
@@ -85,7 +85,7 @@ def eq5_width(curve):
 
 
 def run(ctx: Context) -> None:
-    from reduced.lifetime import largest_holdable_force, lifetime
+    from validation.bridge.lifetimes import lifetimes
 
     rep = ctx.report
     rep.text(NAME, __doc__.split("\n\n", 1)[1])
@@ -94,17 +94,17 @@ def run(ctx: Context) -> None:
     table, series = {}, {}
     srcs = sources(ctx)
     for label, (curve, geometry) in srcs.items():
-        model = leakage_model(curve, geometry, uc, label)
+        model = leakage_model(curve, uc, label)
         ctx.progress(0.0, f"lifetimes {label}")
         try:
-            results = [lifetime(model, F) for F in forces]
+            results = lifetimes(model, forces, "paper", cup_laws=geometry)
         except (ValueError, RuntimeError, ArithmeticError) as exc:   # e.g. leaves the curve, or l = 0
             rep.text(NAME, f"*{label} failed:* {type(exc).__name__}: {str(exc).splitlines()[0]}"
                            + (" (eq 6 with a strip width l = 0 from the FEM curve)"
                               if isinstance(exc, ZeroDivisionError) else ""))
             continue
         series[label] = results
-        table[label] = (largest_holdable_force(model), results)
+        table[label] = (results.largest_force_N, results)
     rows = []
     for i, F in enumerate(forces):
         rows.append([F] + [table[k][1][i].lifetime_s for k in table] + [table[k][1][i].reason for k in table])

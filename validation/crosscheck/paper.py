@@ -46,20 +46,18 @@ def requests(quick: bool) -> tuple[FemRun, ...]:
     return tuple(FemRun(cup=c, contact=k, fidelity=CROSSCHECK_FIDELITY) for c in "AB" for k in laws)
 
 
-PROFILE = {"geometry": "curve", "seal": "profile"}
-
-
 @dataclass(frozen=True)
 class Route:
     """One way to the paper's lifetimes: `life(cup, surface, F1, kappa=1, fluid="air", **options)`
-    (options: of `reduced.lifetime.lifetime`, where the route has them) returns a
-    result with lifetime_s, reason, t_s, r_m and ballistic_share (None where the route has no
-    such number); `holdable(cup)` the largest load held [N]; `stiffness(cup)` the F0 curve, for the
-    stiffness rows of the stiffness sources (None for the routes that reuse one)."""
+    (options: the run options of `reduced.solve_lifetime`) returns a `reduced.Lifetime`;
+    `holdable(cup)` the largest load held [N]; `radius(cup, result)` the contact radius r(t) [mm]
+    along a result's trajectory; `stiffness(cup)` the F0 curve, for the stiffness rows of the
+    stiffness sources (None for the routes that reuse one)."""
 
     name: str
     life: Callable[..., object]
     holdable: Callable[[str], float]
+    radius: Callable[[str, object], np.ndarray]
     fluids: tuple[str, ...] = ("air", "water")
     stiffness: Callable[[str], object] | None = None
 
@@ -74,29 +72,38 @@ def routes(ctx: Context) -> list[Route]:
             lambda cup: ctx.fem(FemRun(cup=cup, contact=law, fidelity=CROSSCHECK_FIDELITY)).stiffness_curve())
 
     out = [_model_route("appendix-a", functools.cache(
-        lambda cup: appendix_a_curve(CUPS[cup], E_Pa=4e6, d0_m=2e-3)), {}, stiffness=True)]
+        lambda cup: appendix_a_curve(CUPS[cup], E_Pa=4e6, d0_m=2e-3)), "paper", stiffness=True)]
     for law in ("frictionless",) if ctx.quick else ("frictionless", "sticking"):
-        out.append(_model_route(f"fem-{law}", fem(law), {}, stiffness=True))
-    out.append(_model_route("profile (fem-frictionless)", fem("frictionless"), PROFILE))
+        out.append(_model_route(f"fem-{law}", fem(law), "paper", stiffness=True))
+    out.append(_model_route("profile (fem-frictionless)", fem("frictionless"), "profile"))
     out.append(coupled_route(ctx))
     return out
 
 
-def _model_route(name: str, curve: Callable[[str], object], kw: dict, stiffness: bool = False) -> Route:
-    """A route through `reduced.lifetime.LeakageModel` with the curve of each cup."""
-    from reduced.lifetime import largest_holdable_force, lifetime
+def _model_route(name: str, curve: Callable[[str], object], route: str, stiffness: bool = False) -> Route:
+    """A route of `reduced.solve_lifetime` fed by the stiffness curve of each cup."""
+    from validation.bridge.lifetimes import lifetimes, route_options
 
-    def life(cup, surface, F1, kappa=1.0, fluid="air", **options):
-        return lifetime(model(curve(cup), cup, surface, fluid=fluid, kappa=kappa, **kw), F1, **options)
+    options = route_options(route)
 
-    return Route(name, life, lambda cup: largest_holdable_force(model(curve(cup), cup, "pmma-1.89", **kw)),
+    def life(cup, surface, F1, kappa=1.0, fluid="air", **run):
+        return lifetimes(model(curve(cup), cup, surface, fluid=fluid, kappa=kappa), [F1], route, **run,
+                         **options)[0]
+
+    def holdable(cup):
+        return lifetimes(model(curve(cup), cup, "pmma-1.89"), [], route, **options).largest_force_N
+
+    return Route(name, life, holdable, lambda cup, result: result.trajectory["r_mm"],
                  stiffness=curve if stiffness else None)
 
 
 def coupled_route(ctx: Context) -> Route:
     """The coupled route on the frictionless FEM's suction tables of cups A and B (built once per
-    code version, in the run memo's cache directory when there is one)."""
-    from validation.coupled.build import DEFAULT_GRID, QUICK_GRID, suction_table_for
+    code version, in the run memo's cache directory when there is one); r(t) is the seal radius r_k
+    of the table, interpolated at the trajectory's (u, dp / kappa(t)); the route has no ballistic
+    share and no water."""
+    from validation.bridge.coupled.build import DEFAULT_GRID, QUICK_GRID, suction_table_for
+    from validation.bridge.lifetimes import lifetimes
 
     cache = None if ctx.memo.cache_dir is None else ctx.memo.cache_dir / "suction"
 
@@ -108,53 +115,41 @@ def coupled_route(ctx: Context) -> Route:
 
     @functools.cache
     def cavity(cup, surface, kappa):
-        from reduced.coupled import CoupledCavity
         from reduced.gas import Gas
-
+        from reduced.lifetime import LeakageModel
         from reduced.viscoelastic import default_relaxation, measurement_contact_time
 
-        t = table(cup)
-        return CoupledCavity(t, pmma_uc_table(surface), Gas(T_K=293.15), P_A, kappa=kappa,
-                             relaxation=default_relaxation(), phi0_s=measurement_contact_time(CUPS[cup])), \
-            t.h1_m - CUPS[cup].h_start_m
+        return LeakageModel(cup=CUPS[cup], suction=table(cup), u_c=pmma_uc_table(surface), gas=Gas(T_K=293.15),
+                            p_a_Pa=P_A, kappa=kappa, relaxation=default_relaxation(),
+                            phi0_s=measurement_contact_time(CUPS[cup]))
 
-    def life(cup, surface, F1, kappa=1.0, fluid="air", **options):
-        m, u_start = cavity(cup, surface, kappa)
-        return _CoupledResult(m.lifetime(F1, u_start, **options), table(cup), kappa)
+    def life(cup, surface, F1, kappa=1.0, fluid="air", **run):
+        return lifetimes(cavity(cup, surface, kappa), [F1], "coupled", **run)[0]
 
     def holdable(cup):
-        m, u_start = cavity(cup, "pmma-1.89", 1.0)
-        return m.largest_holdable_force(u_start)
+        return lifetimes(cavity(cup, "pmma-1.89", 1.0), [], "coupled").largest_force_N
 
-    return Route("coupled (fem-frictionless)", life, holdable, fluids=("air",))
-
-
-class _CoupledResult:
-    """A coupled lifetime as the rows read it: r(t) is the seal radius r_k of the table, interpolated
-    at the trajectory's (u, dp / kappa(t)); the route has no ballistic share."""
-
-    ballistic_share = None
-
-    def __init__(self, result, table, kappa: float):
+    def radius(cup, result):
         from scipy.interpolate import RegularGridInterpolator
 
-        self.lifetime_s, self.reason, self.t_s = result.lifetime_s, result.reason, result.t_s
-        seal = RegularGridInterpolator((table.u_m, table.dp_Pa), table.seal_r_m)
-        k = result.kappa if result.kappa is not None else kappa
-        self.r_m = seal(np.column_stack([result.u_m, result.dp_Pa / k])) if result.u_m.size else result.u_m
+        t, cols = table(cup), result.trajectory
+        if not cols["u_mm"].size:
+            return cols["u_mm"]
+        seal = RegularGridInterpolator((t.u_m, t.dp_Pa), t.seal_r_m)
+        return 1e3 * seal(np.column_stack([1e-3 * cols["u_mm"], (P_A - cols["p_b_Pa"]) / cols["kappa"]]))
+
+    return Route("coupled (fem-frictionless)", life, holdable, radius, fluids=("air",))
 
 
-def model(curve, cup: str, surface: str, *, fluid: str = "air", kappa: float = 1.0,
-          geometry: str = "cone", seal: str = "strip"):
-    """The paper's own lifetime calculation (module docstring) for one stiffness curve, through
-    the given route (cone laws and eq 6's strip, or the FEM's r_c, V and profiles)."""
+def model(curve, cup: str, surface: str, *, fluid: str = "air", kappa: float = 1.0):
+    """The paper's own lifetime calculation (module docstring) for one stiffness curve: Table 1's
+    cup, relaxation in air, E = 4 MPa in water."""
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel
     from reduced.viscoelastic import default_relaxation
 
-    stiffness = curve.scaled(kappa) if kappa != 1.0 else curve
-    return LeakageModel(cup=CUPS[cup], stiffness=stiffness, u_c=pmma_uc_table(surface), gas=Gas(T_K=293.15),
-                        p_a_Pa=P_A, E_Pa=4e6, geometry=geometry, seal=seal, fluid=fluid,
+    return LeakageModel(cup=CUPS[cup], stiffness=curve, u_c=pmma_uc_table(surface), gas=Gas(T_K=293.15),
+                        p_a_Pa=P_A, E_Pa=4e6, fluid=fluid, kappa=kappa,
                         relaxation=default_relaxation() if fluid == "air" else None)
 
 
@@ -273,17 +268,18 @@ def _lifetimes(rows: Rows, route: Route, quick: bool) -> None:
     rows.add("lifetime at 10 N on a rough surface", "Sec. 2", "of order 100 s", name,
              by_surface["pmma-1.89"].lifetime_s, "s", (30.0, 300.0), ref=100.0,
              reason="pmma-1.89, cup A, F1 = 10 N")
-    share = by_surface["pmma-1.89"].ballistic_share
+    share = by_surface["pmma-1.89"].details.get("ballistic_share")
     if share is not None:
         rows.add("air flow on pmma-1.89 mainly diffusive (ballistic share < 0.5)", "Sec. 5.4", "yes", name,
                  "yes" if share < 0.5 else "no", "-", expect="yes", reason=f"ballistic share {share:.2f}")
     above = [s for s, rms in SURFACES_RMS_UM.items() if rms > 1.0]
-    grows = [s for s in above if _grows_continuously(by_surface[s])]
+    grows = [s for s in above if _grows_continuously(by_surface[s], route.radius("A", by_surface[s]))]
     rows.add("r(t) grows continuously for rms > 1 um", "Sec. 5.4", "yes", name,
              "yes" if len(grows) == len(above) else "no", "-", expect="yes",
              reason=f"continuous on {', '.join(grows) or 'none'} of {', '.join(above)}")
     rows.add("r(t) stalls for rms < 1 um (pmma-0.77)", "Sec. 5.4", "yes (measured)", name,
-             "no" if _grows_continuously(by_surface["pmma-0.77"]) else "yes", "-", expect="yes",
+             "no" if _grows_continuously(by_surface["pmma-0.77"], route.radius("A", by_surface["pmma-0.77"]))
+             else "yes", "-", expect="yes",
              reason="the measured stall is plasticizer filling the constrictions (the paper's "
                     "explanation); neither the paper's theory nor cupcheck models it")
     dry = by_surface["table"]
@@ -319,11 +315,11 @@ def _lifetimes(rows: Rows, route: Route, quick: bool) -> None:
                     f"decides alone, which a stiffer cup narrows")
 
 
-def _grows_continuously(result) -> bool:
+def _grows_continuously(result, r: np.ndarray) -> bool:
     """r(t) grows on the way rather than stalling and jumping (the paper's observation below
     1 um rms): a stall is r moving by less than 10 % of its total rise during the first 90 % of the
-    lifetime, the detachment a "rapid increase" at the end."""
-    r, t = result.r_m, result.t_s
+    lifetime, the detachment a "rapid increase" at the end. `r`: the radius along the trajectory."""
+    t = result.trajectory["t_s"]
     if result.reason not in ("reached_r1", "fold", "table_edge") or r.size < 3:
         return False
     early = t <= 0.9 * result.lifetime_s

@@ -4,7 +4,7 @@ A section of the validation report declares the cup compressions it needs as `Fe
 (frozen, hashable: the memo's key). `RunMemo.get` runs a request the first time it is asked for
 and returns the stored `FemResult` (or re-raises the stored failure) afterwards, so sections share
 runs and a subset of sections runs only what it needs. With `cache_dir`, results also persist on
-disk (`validation.cache`), keyed by the request and a hash of the `fem` sources and the pipeline
+disk (`validation.bridge.cache`), keyed by the request and a hash of the `fem` sources and the pipeline
 (a code change invalidates them).
 
 Geometry of a request: the preset cup (`fem.geometry.cup_geometry`) with, optionally, another cone
@@ -105,7 +105,7 @@ class FemRun:
         return self.alpha_deg if self.alpha_deg is not None else PRESETS[self.cup.upper()]["alpha_deg"]
 
     def material(self):
-        from validation.pipeline import neo_hookean
+        from validation.bridge.pipeline import neo_hookean
         return neo_hookean(self.E_Pa, self.nu, self.formulation)
 
 
@@ -152,8 +152,8 @@ class FemResult:
         return PchipInterpolator(self.u_m, y, extrapolate=False)
 
     def stiffness_curve(self):
-        """The hand-off `StiffnessCurve` (u, F0, r_c, l, V), built by `validation.handoff`."""
-        from validation.handoff import stiffness_curve
+        """The hand-off `StiffnessCurve` (u, F0, r_c, l, V), built by `validation.bridge.handoff`."""
+        from validation.bridge.handoff import stiffness_curve
         return stiffness_curve(self, {"source": "fem", **asdict(self.request)})
 
 
@@ -161,7 +161,7 @@ def compute(request: FemRun, progress: Callable[[float, str], None] | None = Non
     """Run the request: mesh, compress, and keep the plain arrays (raises ValueError/RuntimeError)."""
     from fem.interface import ContactLaw
     from fem.mesh import cup_mesh
-    from validation.pipeline import fem_path
+    from validation.bridge.pipeline import fem_path
 
     geometry = request.geometry()
     mesh = cup_mesh(geometry, request.fidelity, element=request.element)
@@ -212,7 +212,7 @@ def _outcome(request: FemRun, code: str, runner: Callable[[FemRun], FemResult] |
 
 class RunMemo:
     """Runs each distinct `FemRun` once per memo; optionally persists results in `cache_dir`
-    (`validation.cache`, keyed by the request and the sources of fem and of this pipeline).
+    (`validation.bridge.cache`, keyed by the request and the sources of fem and of this pipeline).
 
     `get(request)` returns the `FemResult` or raises the run's failure (ValueError for an invalid
     geometry or input, RuntimeError for a solver failure), the same one on every call.
@@ -221,7 +221,7 @@ class RunMemo:
 
     def __init__(self, cache_dir: str | Path | None = None,
                  runner: Callable[[FemRun], FemResult] = compute):
-        from validation.cache import Cache, source_hash
+        from validation.bridge.cache import Cache, source_hash
 
         self._runner = runner
         self._store: dict[FemRun, FemResult | Exception] = {}
@@ -229,7 +229,7 @@ class RunMemo:
         self.computed = 0
         self.cache_hits = 0
         self._cached = Cache(cache_dir).cached(_outcome, ignore=["runner"])
-        self._version = source_hash("fem", "validation/pipeline.py") if cache_dir is not None else ""
+        self._version = source_hash("fem", "validation/bridge/pipeline.py") if cache_dir is not None else ""
 
     def get(self, request: FemRun) -> FemResult:
         if request not in self._store:

@@ -70,13 +70,13 @@ def _median_time(fn, repeat: int = 5) -> tuple[float, object]:
 
 def fem_level(ctx: Context, contact: str, fidelity: str, element: str, uc) -> dict | str:
     """The level's quantities, or the one-line failure message of its FEM run."""
-    from reduced.lifetime import lifetime
+    from validation.bridge.lifetimes import lifetimes
 
     res = ctx.outcome(FemRun(cup="A", contact=contact, fidelity=fidelity, element=element))
     if isinstance(res, Exception):
         return f"{type(res).__name__}: {str(res).splitlines()[0][:160]}"
-    model = leakage_model(res.stiffness_curve(), "cone", uc, f"FEM {fidelity}")
-    life = lifetime(model, F1_N)
+    model = leakage_model(res.stiffness_curve(), uc, f"FEM {fidelity}")
+    life = lifetimes(model, [F1_N], "paper", cup_laws="cone")[0]
     return {"level": f"FEM {fidelity} {'Q2' if element == 'quad' else 'P2 tri'}", "contact": contact,
             "wall_s": res.wall_s,
             "dofs": res.dofs, "F0_1mm_N": float(res.F0_at(U_1MM)), "F0_start_N": float(res.F0_at(U_START)),
@@ -85,7 +85,8 @@ def fem_level(ctx: Context, contact: str, fidelity: str, element: str, uc) -> di
 
 def run(ctx: Context) -> None:
     from reduced.appendix_a import appendix_a_curve
-    from reduced.lifetime import lifetime, lifetime_by_quadrature, reference_model
+    from reduced.lifetime import lifetime_by_quadrature, reference_model
+    from validation.bridge.lifetimes import lifetimes
 
     rep = ctx.report
     rep.text(NAME, __doc__.split("\n\n", 1)[1])
@@ -95,7 +96,8 @@ def run(ctx: Context) -> None:
     app = {"level": "Appendix A (d0 2 mm)", "wall_s": t_app, "dofs": 0,
            "F0_1mm_N": float(curve.force(CUP_A.h1_m - U_1MM)), "F0_start_N": float(curve.force(CUP_A.h_start_m)),
            "l_start_mm": 1e3 * CUP_A.contact_width(CUP_A.r_start_m),
-           "lifetime_20N_s": lifetime(leakage_model(curve, "cone", uc, "Appendix A"), F1_N).lifetime_s}
+           "lifetime_20N_s": lifetimes(leakage_model(curve, uc, "Appendix A"), [F1_N], "paper",
+                                       cup_laws="cone")[0].lifetime_s}
     if ctx.quick:
         rep.text(NAME, "*Quick run: one FEM level, which is its own reference, so its errors are 0 by "
                        "construction; the full run extrapolates from three levels.*")
@@ -128,13 +130,13 @@ def run(ctx: Context) -> None:
 
     # reduced model: rtol levels on the reference model (Appendix A stiffness, pmma-1.89)
     model = reference_model(CUP_A, uc)
-    ref_life = lifetime(model, F1_N, rtol=RTOL_REF).lifetime_s
+    ref_life = lifetimes(model, [F1_N], "paper", rtol=RTOL_REF, cup_laws="cone")[0].lifetime_s
     with warnings.catch_warnings():          # quad's round-off warning; the agreement is reported
         warnings.simplefilter("ignore")
         quad_life = lifetime_by_quadrature(model, F1_N)
     rrows = []
     for rtol in RTOLS:
-        t, res = _median_time(lambda: lifetime(model, F1_N, rtol=rtol), 7)
+        t, res = _median_time(lambda: lifetimes(model, [F1_N], "paper", rtol=rtol, cup_laws="cone")[0], 7)
         rrows.append([rtol, t, res.steps, res.lifetime_s, abs(res.lifetime_s / ref_life - 1)])
     rep.table(NAME, "speed_accuracy_reduced", ["rtol", "wall_s", "steps", "lifetime_20N_s", "rel_err"], rrows,
               f"Reduced model (cup A, F1 = 20 N, {SURFACE}): reference rtol = {RTOL_REF:g} gives "

@@ -12,7 +12,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from validation.cache import user_cache_dir
+from validation.bridge.cache import user_cache_dir
 from validation.scenes.outputs import run_scene
 from validation.scenes.schema import load_scene
 

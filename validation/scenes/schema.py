@@ -24,7 +24,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from validation.pipeline import DEFAULT_SURFACE
+from validation.bridge.pipeline import DEFAULT_SURFACE
+from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface, Sweep
 
 __all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES", "key_rows"]
 
@@ -117,13 +118,21 @@ class Scene:
     sweep: dict[str, Any] | None = None
     contact_source: str = "default"     # who chose the contact law: the scene, the design file, default
 
-    def variant(self, value: Any) -> "Scene":
-        """The scene with the swept parameter set to `value` (and no sweep)."""
-        table, key = self.sweep["key"].split(".")
-        tables = {k: dict(v) for k, v in self.tables.items()}
-        tables[table][key] = value
-        source = self.contact_source if key != "friction" else f"{self.contact_source} (law), sweep (friction)"
-        return Scene(tables=tables, outputs=self.outputs, source=self.source, contact_source=source)
+    def study(self) -> Study:
+        """The scene as a `validation.bridge.study.Study` (its sweep, if any, included)."""
+        t = self.tables
+        return Study(design=CupDesign(preset=t["cup"]["preset"], file=t["cup"]["geometry"]),
+                     material=Material(E_MPa=t["material"]["E_MPa"], nu=t["material"]["nu"]),
+                     contact=Contact(law=t["contact"]["law"], friction=t["contact"]["friction"],
+                                     source=self.contact_source),
+                     fidelity=t["stiffness"]["fidelity"], stiffness=t["stiffness"]["source"],
+                     surface=Surface(preset=t["surface"]["preset"], uc_table=t["surface"]["uc_table"]),
+                     route=t["stiffness"]["route"],
+                     loads=Loads(forces_N=tuple(t["loads"]["F1_N"]), kappa=t["loads"]["kappa"],
+                                 r_start_mm=t["loads"]["r_start_mm"], relaxation=t["material"]["relaxation"],
+                                 fluid=t["fluid"]["kind"]),
+                     outputs=self.outputs,
+                     sweep=None if self.sweep is None else Sweep(self.sweep["key"], tuple(self.sweep["values"])))
 
     def __getitem__(self, table: str) -> dict[str, Any]:
         return self.tables[table]

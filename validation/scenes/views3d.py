@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from validation.scenes.pipeline import Products
+from validation.bridge.products import Products
 
 __all__ = ["write_view"]
 
@@ -24,8 +24,8 @@ def write_view(output: dict, products: Products, tmp: Path | None) -> list[dict[
         return []
     from validation.render import views
 
-    scene = products.scene
-    law = scene["contact"]["law"] + (f", mu = {scene['contact']['friction']:g}" if scene["contact"]["law"] == "coulomb"
+    contact = products.study.contact
+    law = contact.law + (f", mu = {contact.friction:g}" if contact.law == "coulomb"
                                      else "")
     files = []
     if kind == "render":

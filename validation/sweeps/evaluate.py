@@ -20,11 +20,14 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from validation.sweeps.spec import design_hash
 
-__all__ = ["evaluate_design", "geometry_of", "material_volume_mm3"]
+if TYPE_CHECKING:
+    from validation.bridge.study import Study
+
+__all__ = ["evaluate_design", "study_of", "geometry_of", "material_volume_mm3"]
 
 _MM = 1e-3
 
@@ -53,6 +56,26 @@ def material_volume_mm3(geometry) -> float:
                                          for a, b, p, q in zip(z, z2, r, r2)))) / _MM ** 3
 
 
+def study_of(design: dict[str, Any], geometry) -> Study:
+    """The `validation.bridge.study.Study` of one design of a sweep: its geometry, material, contact law
+    and mesh level, the paper's route with the cone laws and eq (5)'s l0, l1 (Table 1's unless
+    given) on its surface, at its pull forces."""
+    from reduced.cup import CUPS
+    from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
+
+    table1 = CUPS[design["cup"]]
+    l0 = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
+    l1 = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
+    coulomb = design["contact"] == "coulomb"
+    return Study(design=CupDesign(preset=design["cup"], geometry=geometry, l0_mm=l0, l1_mm=l1),
+                 material=Material(E_MPa=design["E_MPa"], nu=design["nu"]),
+                 contact=Contact(law=design["contact"], friction=design.get("friction", 0.0) if coulomb else None,
+                                 source="sweep file"),
+                 fidelity=design["fidelity"], stiffness="fem", surface=Surface(preset=design["surface"]),
+                 route="paper", cup_laws="cone",
+                 loads=Loads(forces_N=tuple(design["F1_N"]), r_start_mm=design.get("r_start_mm")), refine=1)
+
+
 def evaluate_design(design: dict[str, Any]) -> list[dict[str, Any]]:
     """Rows (one per pull force) of one design: its parameters, hash, quantities or failure."""
     start = time.perf_counter()
@@ -61,15 +84,17 @@ def evaluate_design(design: dict[str, Any]) -> list[dict[str, Any]]:
     stage = "geometry"
     try:
         from validation.guards import check_design
+        from validation.bridge.products import Products
 
         geometry = geometry_of(design)
         check_design(geometry.describe(), design["allow_unusual_design"], source="design")
         common["volume_mm3"] = material_volume_mm3(geometry)
         stage = "fem"
-        response, curve = _stiffness(geometry, design)
+        products = Products(study_of(design, geometry))
+        response, curve = products.fem_path(None), products.curve()
         common.update(_fem_quantities(response, curve, geometry, design))
         stage = "lifetime"
-        rows = _lifetimes(curve, design, common)
+        rows = _lifetimes(products, design, common)
     except (ValueError, RuntimeError, ArithmeticError) as exc:
         reason = f"{stage}: {type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
         rows = [{**common, "F1_N": F, "failure": reason} for F in design["F1_N"]]
@@ -77,14 +102,6 @@ def evaluate_design(design: dict[str, Any]) -> list[dict[str, Any]]:
     for row in rows:
         row["wall_time_s"] = wall
     return rows
-
-
-def _stiffness(geometry, design: dict[str, Any]):
-    from fem.interface import ContactLaw
-    from validation.pipeline import fem_stiffness, neo_hookean
-
-    contact = ContactLaw(design["contact"], design.get("friction", 0.0) if design["contact"] == "coulomb" else 0.0)
-    return fem_stiffness(geometry, neo_hookean(design["E_MPa"] * 1e6, design["nu"]), contact, design["fidelity"])
 
 
 def _fem_quantities(response, curve, geometry, design) -> dict[str, Any]:
@@ -102,27 +119,14 @@ def _fem_quantities(response, curve, geometry, design) -> dict[str, Any]:
     return out
 
 
-def _lifetimes(curve, design, common) -> list[dict[str, Any]]:
-    from reduced.lifetime import LeakageModel, largest_holdable_force, lifetime
-    from validation.design import resolve_cup
-    from validation.pipeline import surface_uc_table
-
-    from reduced.cup import CUPS
-
-    table1 = CUPS[design["cup"]]
-    l0 = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
-    l1 = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
-    choice = resolve_cup(curve, r_start_mm=design.get("r_start_mm"), l0_mm=l0, l1_mm=l1)
-    model = LeakageModel(cup=choice.cup, stiffness=curve, u_c=surface_uc_table(design["surface"]),
-                         E_Pa=design["E_MPa"] * 1e6, geometry="cone")
-    h_start = choice.cup.h_start_m
-    common = {**common, "r_start_mm": choice.cup.r_start_m / _MM, "l0_mm": l0, "l1_mm": l1,
+def _lifetimes(products, design, common) -> list[dict[str, Any]]:
+    curve, cup = products.curve(), products.cup()
+    h_start = cup.h_start_m
+    common = {**common, "r_start_mm": cup.r_start_m / _MM, "l0_mm": products.study.design.l0_mm,
+              "l1_mm": products.study.design.l1_mm,
               "r_c_start_mm": float(curve.contact_radius(h_start)) / _MM,
-              "l_start_mm": float(curve.contact_width(h_start)) / _MM,
-              "largest_force_N": largest_holdable_force(model)}
-    rows = []
-    for F in design["F1_N"]:
-        r = lifetime(model, F)
-        rows.append({**common, "F1_N": F, "lifetime_s": r.lifetime_s if math.isfinite(r.lifetime_s) else None,
-                     "reason": r.reason, "failure": None})
-    return rows
+              "l_start_mm": float(curve.contact_width(h_start)) / _MM}
+    results = products.lifetimes()
+    common["largest_force_N"] = results.largest_force_N
+    return [{**common, "F1_N": F, "lifetime_s": r.lifetime_s if math.isfinite(r.lifetime_s) else None,
+             "reason": r.reason, "failure": None} for F, r in zip(design["F1_N"], results)]

@@ -54,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from validation.pipeline import DEFAULT_SURFACE
+from validation.bridge.pipeline import DEFAULT_SURFACE
 
 __all__ = ["SweepSpec", "load_sweep", "sweep_from_mapping", "NUMERIC_AXES", "design_hash", "MAX_DESIGNS",
            "lock_store", "key_rows"]

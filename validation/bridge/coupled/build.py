@@ -5,8 +5,8 @@ u = 0 up to 0.8 h1, dp = 0, 1, ..., 100 kPa; halving the u spacing moves cup A's
 <= 0.2 %, the dp spacing by <= 0.8 %, benchmarks/bench_coupled.py) and a coarse one for quick checks
 (`QUICK_GRID`).
 `suction_table_for` runs `fem.suction.suction_grid` on a design and converts it to the reduced
-model's `SuctionTable`; with a cache directory the table goes through `validation.cache`, keyed by the
-design, the law, the grid and a hash of the sources that make it (`fem`, `validation.coupled` and
+model's `SuctionTable`; with a cache directory the table goes through `validation.bridge.cache`, keyed by the
+design, the law, the grid and a hash of the sources that make it (`fem`, `validation.bridge.coupled` and
 the table's data types in `reduced`), so a second call computes nothing and a change to that code
 recomputes (a change to the leak, which reads the table, does not).
 """
@@ -16,8 +16,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from fem.interface import ContactLaw
 
 __all__ = ["SuctionGridSpec", "DEFAULT_GRID", "QUICK_GRID", "suction_table_for"]
 
@@ -52,21 +56,26 @@ DEFAULT_GRID = SuctionGridSpec(_halved(_halved(_U_COARSE)), tuple(float(x) for x
 QUICK_GRID = SuctionGridSpec(_U_COARSE, tuple(float(x) for x in range(0, 101, 5)))
 
 
-def suction_table_for(geometry, *, fidelity: str = "coarse", contact: str = "frictionless",
-                      friction: float = 0.0, E_Pa: float = 4e6, nu: float = 0.49,
+def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw | None = None,
+                      E_Pa: float = 4e6, nu: float = 0.49,
                       grid: SuctionGridSpec = DEFAULT_GRID, cache_dir: str | Path | None = None,
                       progress: Callable[[float, str], None] | None = None):
     """The `SuctionTable` of a design (`fem.geometry.CupGeometry` or a preset name 'A', 'B') at a
-    mesh level, contact law and grid (module docstring); `progress(fraction, message)` while the
+    mesh level, contact law (a `fem.interface.ContactLaw`, None: frictionless) and grid (module
+    docstring); `progress(fraction, message)` while the
     FEM runs. Raises `fem.solver.ConvergenceError` where a state does not converge."""
     from fem.geometry import cup_geometry
-    from validation.cache import Cache, source_hash
+    from fem.interface import ContactLaw
+    from validation.bridge.cache import Cache, source_hash
 
     if isinstance(geometry, str):
         geometry = cup_geometry(geometry)
+    contact = ContactLaw() if contact is None else contact
+    if not isinstance(contact, ContactLaw):
+        raise ValueError(f"contact: expected a fem.interface.ContactLaw, got {type(contact).__name__}")
     build = Cache(cache_dir).cached(_build, ignore=["progress"])
-    code = source_hash("fem", "validation/coupled", *_TABLE_TYPES)
-    return build(geometry, fidelity, contact, friction, E_Pa, nu, grid, code, progress=progress)
+    code = source_hash("fem", "validation/bridge/coupled", *_TABLE_TYPES)
+    return build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=progress)
 
 
 #: the `reduced` modules a table is made of (part of its key; the rest of `reduced`, the leak
@@ -74,15 +83,15 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: str = "fri
 _TABLE_TYPES = ("reduced/suction_table.py", "reduced/stiffness_curve.py")
 
 
-def _build(geometry, fidelity, contact, friction, E_Pa, nu, grid, code, progress=None):
+def _build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=None):
     from fem.cup import cup_height
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
     from fem.suction import suction_grid
-    from validation.coupled.table import suction_table
+    from validation.bridge.coupled.table import suction_table
 
     mesh = cup_mesh(geometry, fidelity)
     result = suction_grid(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), grid.u_m(cup_height(mesh)), grid.dp_Pa,
-                          contact=contact, friction=friction, progress=progress)
+                          contact=contact, progress=progress)
     return suction_table(result, {"geometry": geometry.describe(), "fidelity": fidelity,
                                   "grid": grid.describe()})

@@ -17,7 +17,7 @@ class CoupledOptions:
     """What the coupled route needs besides u_c (units in the names).
 
     suction_table: the table's JSON file; cup, geometry_file, r_start_mm: the cup as
-    `validation.design.resolve_cup` reads them (the table's recorded design wins); interface: the
+    `validation.bridge.design.resolve_cup` reads them (the table's recorded design wins); interface: the
     gas pressure next to the seal ("linear", "p_b", "p_a"); kappa: the stiffness factor;
     relaxation: a `reduced.viscoelastic.RelaxationModulus` or None; phi0_s: the measurement's
     contact time (None: the cup's default, with relaxation only).
@@ -37,20 +37,20 @@ class CoupledOptions:
 
 @dataclass(frozen=True)
 class _TableDesign:
-    """What `validation.design.resolve_cup` reads of a curve: the recorded design and h1."""
+    """What `validation.bridge.design.resolve_cup` reads of a curve: the recorded design and h1."""
 
     design: dict[str, Any] | None
     h1_m: float
 
 
 def coupled_model(options: CoupledOptions, uc: Callable[[float], float]):
-    """(CoupledCavity, u_start [m], the `CupChoice`, the cup's description for the outputs);
-    ValueError on a table or cup that does not fit."""
-    from reduced.coupled import CoupledCavity
+    """(the `reduced.LeakageModel` of the coupled route, the `CupChoice`, the cup's description
+    for the outputs); ValueError on a table or cup that does not fit."""
     from reduced.gas import Gas
+    from reduced.lifetime import LeakageModel
     from reduced.suction_table import SuctionTable
     from reduced.viscoelastic import measurement_contact_time
-    from validation.design import resolve_cup
+    from validation.bridge.design import resolve_cup
 
     table = SuctionTable.from_json(options.suction_table)
     h1 = table.h1_m
@@ -63,9 +63,10 @@ def coupled_model(options: CoupledOptions, uc: Callable[[float], float]):
     relaxation = options.relaxation
     phi0 = None if relaxation is None else (
         options.phi0_s if options.phi0_s is not None else measurement_contact_time(cup))
-    model = CoupledCavity(table, uc, Gas(T_K=options.T_K), options.p_a_Pa, kappa=options.kappa,
-                          interface=options.interface, relaxation=relaxation, phi0_s=phi0)
+    model = LeakageModel(cup=cup, suction=table, u_c=uc, gas=Gas(T_K=options.T_K), p_a_Pa=options.p_a_Pa,
+                         kappa=options.kappa, interface=options.interface, relaxation=relaxation,
+                         phi0_s=phi0, label=choice.label)
     description = {**choice.describe(), "route": "coupled", "u_start_mm": 1e3 * u_start,
                    "interface": options.interface, "suction_table": str(options.suction_table),
                    **({} if relaxation is None else {"relaxation": relaxation.provenance, "phi0_s": phi0})}
-    return model, u_start, choice, description
+    return model, choice, description

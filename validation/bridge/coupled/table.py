@@ -18,10 +18,10 @@ def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -
     pressures (provenance: the grid's law and mu, material, h1, solver, then `provenance`),
     converted as the stiffness sidecar's are (`profiles_from_lists`: a node shared by
     two facets merged, fewer than two points or no pressure is None)."""
-    from validation.handoff import contact_provenance
+    from validation.bridge.handoff import contact_provenance
 
     m = grid.material
-    prov = {"source": "fem.suction", **contact_provenance(grid.contact, grid.friction), "E_Pa": m.E_Pa, "nu": m.nu,
+    prov = {"source": "fem.suction", **contact_provenance(grid.contact_law), "E_Pa": m.E_Pa, "nu": m.nu,
             "formulation": m.formulation, "h1_mm": 1e3 * grid.h1_m,
             "solver": {"newton_iterations": grid.stats.newton_iterations,
                        "wall_time_s": grid.stats.wall_time_s, "dofs": grid.stats.dofs},

@@ -8,7 +8,6 @@ Every command, scene, sweep and report section that needs an FEM path or a stiff
 * the formulation by nu (`neo_hookean`): not given, nu above `LOCKING_NU` takes the mixed u-p
   formulation (the displacement elements lock there); the displacement formulation given with
   nu above it is refused;
-* the route -> (geometry, seal) of `reduced.lifetime.LeakageModel` (`route_model`);
 * the default surface and its u_c table (`DEFAULT_SURFACE`, `surface_uc_table`: Persson theory,
   EMT, nu = 0.5);
 * the contact law: a `fem.interface.ContactLaw` (or a `ContactChoice`, which also says who chose
@@ -30,17 +29,13 @@ if TYPE_CHECKING:                          # importing this module imports no fe
     from reduced.critical_gap import UcTable
     from reduced.stiffness_curve import StiffnessCurve
 
-__all__ = ["LOCKING_NU", "DEFAULT_SURFACE", "ROUTES", "neo_hookean", "route_model", "surface_uc_table",
+__all__ = ["LOCKING_NU", "DEFAULT_SURFACE", "neo_hookean", "surface_uc_table",
            "mesh_record", "fem_path", "fem_curve", "fem_stiffness"]
 
 #: above this Poisson's ratio the displacement (Q2) formulation locks (F0 stiffens)
 LOCKING_NU = 0.495
 #: the calibrated surface used where none is named: sandblasted PMMA, 1.89 um rms (the paper's Figs.)
 DEFAULT_SURFACE = "pmma-1.89"
-#: route -> (geometry, seal) of `reduced.lifetime.LeakageModel`; "coupled" runs `reduced.coupled`
-ROUTES: dict[str, tuple[str, str]] = {"paper": ("cone", "strip"), "profile": ("curve", "profile"),
-                                      "coupled": ("curve", "coupled")}
-
 Progress = Callable[[float, str], None]
 
 
@@ -56,24 +51,6 @@ def neo_hookean(E_Pa: float, nu: float, formulation: str | None = None) -> NeoHo
                          f"{LOCKING_NU} (above, its elements lock and stiffen F0); use "
                          f"--formulation mixed for nu up to 0.4999, got {nu:g}")
     return NeoHookean(E_Pa=E_Pa, nu=nu, formulation=formulation)
-
-
-def route_model(route: str, cup_laws: str | None = None) -> tuple[str, str]:
-    """(geometry, seal) of a route: paper -> the cone laws (or the curve's with cup_laws "curve")
-    and eq (6)'s strip; profile -> the curve's laws and its profiles; coupled -> the suction
-    table's (cup_laws refused). ValueError names --cup-laws."""
-    geometry, seal = ROUTES[route]
-    if seal == "coupled":
-        if cup_laws is not None:
-            raise ValueError("--cup-laws: the coupled route takes r and V from the FEM suction table; "
-                             "drop --cup-laws")
-        return geometry, seal
-    if cup_laws is None:
-        return geometry, seal
-    if seal == "profile" and cup_laws != "curve":
-        raise ValueError("--cup-laws: the profile route takes r and V from the FEM curve whose "
-                         "profiles it crosses; drop --cup-laws cone")
-    return cup_laws, seal
 
 
 @lru_cache(maxsize=8)
@@ -112,16 +89,15 @@ def fem_path(geometry: CupGeometry | str | None, material: NeoHookean, contact: 
         mesh = cup_mesh(geometry, fidelity, element=element)
     if u_max_m is None and geometry is not None and not isinstance(geometry, str):
         u_max_m = 0.9 * geometry.h1_m
-    return compress_cup(mesh, material, contact=law.law, friction=law.friction, u_max_m=u_max_m,
-                        progress=progress, **solver_opts)
+    return compress_cup(mesh, material, contact=law, u_max_m=u_max_m, progress=progress, **solver_opts)
 
 
 def fem_curve(response: CupResponse, geometry: Mapping[str, Any], fidelity: str | None,
               contact_source: str | None = None, mesh: Mapping[str, Any] | None = None) -> StiffnessCurve:
-    """The hand-off `StiffnessCurve` of an FEM path, with its provenance (`validation.handoff`):
+    """The hand-off `StiffnessCurve` of an FEM path, with its provenance (`validation.bridge.handoff`):
     the design's description, the mesh (`mesh_record` of the path's mesh unless given) and who
     chose the contact law."""
-    from validation import handoff
+    from validation.bridge import handoff
 
     record = dict(mesh) if mesh is not None else mesh_record(response.mesh, fidelity)
     prov = handoff.provenance(response, geometry=geometry, mesh=record, fidelity=fidelity,

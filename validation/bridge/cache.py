@@ -28,13 +28,13 @@ __all__ = ["Cache", "source_hash", "file_digest", "user_cache_dir", "CACHE_ENV"]
 CACHE_ENV = "CUPCHECK_CACHE_DIR"
 
 F = TypeVar("F", bound=Callable[..., Any])
-_ROOT = Path(__file__).resolve().parents[1]
+_ROOT = Path(__file__).resolve().parents[2]
 
 
 @lru_cache(maxsize=None)
 def source_hash(*parts: str) -> str:
     """A hash of the sources of packages or single files, paths relative to the repository
-    ("fem", "validation/coupled", "reduced/suction_table.py")."""
+    ("fem", "validation/bridge/coupled", "reduced/suction_table.py")."""
     h = hashlib.sha256()
     for part in parts:
         root = _ROOT / part

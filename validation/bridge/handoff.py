@@ -30,6 +30,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from fem.cup import CupResponse
+from fem.interface import ContactLaw
 from reduced.stiffness_curve import StiffnessCurve, profiles_from_lists
 from validation.output import software_versions
 
@@ -49,7 +50,7 @@ def provenance(response: CupResponse, *, geometry: Mapping[str, Any], mesh: Mapp
         "geometry": dict(geometry),
         "material": {"law": "compressible neo-Hookean", "E_Pa": m.E_Pa, "nu": m.nu,
                      "formulation": m.formulation},
-        **contact_provenance(response.contact, response.friction, contact_source),
+        **contact_provenance(response.contact_law, contact_source),
         "fidelity": fidelity,
         "mesh": dict(mesh),
         "l_definition": "force-quartile width 2 (r_75 - r_25) of the radial line force int p dr "
@@ -58,10 +59,11 @@ def provenance(response: CupResponse, *, geometry: Mapping[str, Any], mesh: Mapp
     }
 
 
-def contact_provenance(law: str, friction: float, source: str | None = None) -> dict[str, Any]:
-    """The provenance's contact keys (stiffness sidecar, suction table): ``contact`` (the law),
-    ``friction`` (Coulomb's mu, with coulomb only) and ``contact_source`` (if known)."""
-    return {"contact": law, **({"friction": float(friction)} if law == "coulomb" else {}),
+def contact_provenance(law: ContactLaw, source: str | None = None) -> dict[str, Any]:
+    """The provenance's contact keys (stiffness sidecar, suction table) of a
+    `fem.interface.ContactLaw`: ``contact`` (the law), ``friction`` (Coulomb's mu, with coulomb
+    only) and ``contact_source`` (if known)."""
+    return {"contact": law.law, **({"friction": float(law.friction)} if law.law == "coulomb" else {}),
             **({"contact_source": source} if source is not None else {})}
 
 

@@ -1,0 +1,287 @@
+"""The products of a `validation.bridge.study.Study`, each computed on first use and cached by content.
+
+`Products` computes a product the first time something asks for it and keeps it: a study whose
+outputs need only the u_c table never builds a curve, and a lifetime fed by Appendix A never
+imports `fem`. The expensive products (u_c table, FEM path, curve, frames, lifetimes) go through
+`validation.bridge.cache`: the key is the function's code, its arguments with every input file (design
+file, u_c table) by the sha256 of its bytes instead of its path, and a hash of the sources that
+compute the product. `COMPUTED` counts the products actually computed in this process (a second
+run of the same study computes none).
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import asdict, replace
+from pathlib import Path
+from typing import Any
+
+from validation.bridge.cache import Cache, file_digest, source_hash
+from validation.bridge.study import Contact, Study
+
+__all__ = ["Products", "COMPUTED"]
+
+#: products computed (not taken from the cache) in this process, by name
+COMPUTED: Counter = Counter()
+
+
+def _design_key(study: Study) -> dict:
+    d = study.design
+    return {"preset": d.preset, "file": file_digest(d.file),
+            "geometry": None if d.geometry is None else d.geometry.describe()}
+
+
+def _study_key(study: Study) -> dict:
+    """Everything a study's lifetimes depend on, input files by content."""
+    data = asdict(replace(study, outputs=(), sweep=None, design=replace(study.design, geometry=None)))
+    data["design"] = {**data["design"], **_design_key(study)}
+    data["surface"] = {**data["surface"], "uc_table": file_digest(study.surface.uc_table)}
+    data["suction_table"] = file_digest(study.suction_table)
+    return data
+
+
+# ------------------------------------------------------------------ the cached computations
+def _uc_table(surface_key: dict, code: str, surface=None):
+    """u_c(p/E) of the study's surface (`surface`, not part of the key: `surface_key` has the
+    table file's content hash)."""
+    COMPUTED["uc_table"] += 1
+    from reduced.critical_gap import UcTable
+    if surface.uc_table is not None:
+        return UcTable.from_csv(surface.uc_table)
+    from validation.bridge.pipeline import surface_uc_table
+    return surface_uc_table(surface.preset)
+
+
+def _fem_path(design_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
+              design=None, progress=None):
+    """The FEM path: the design pressed onto the plane to u_max_m (a `fem.cup.CupResponse`, every
+    converged step). Keyed only by what it depends on, so a curve, a render, a footprint and a
+    squeeze ending at the same u share one run."""
+    COMPUTED["fem_path"] += 1
+    from validation.bridge.pipeline import fem_path, neo_hookean
+    return fem_path(design.cup_geometry(), neo_hookean(material["E_MPa"] * 1e6, material["nu"]),
+                    Contact(**contact).contact_law(), fidelity, u_max_m, progress)
+
+
+def _fem_curve(design_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
+               contact_source: str, design=None, path=None):
+    """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`, not part of the key);
+    its provenance says who chose the contact law."""
+    COMPUTED["fem_curve"] += 1
+    from validation.bridge.pipeline import fem_curve
+    return fem_curve(path(), design.cup_geometry().describe(), fidelity, contact_source)
+
+
+def _fem_frames(design_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, n_frames: int,
+                code: str, path=None) -> list:
+    """The deformed states (`validation.render.frames.CupFrame`) at n_frames plate displacements
+    evenly spaced up to u_max_m (1 frame: u_max_m itself; more: from 0, each the converged step
+    nearest its target), drawn from the FEM path to u_max_m (`path()`, not part of the key)."""
+    COMPUTED["fem_frames"] += 1
+    import numpy as np
+
+    from validation.render.frames import frame_from_response
+
+    response = path()
+    targets = [u_max_m] if n_frames == 1 else np.linspace(0.0, u_max_m, n_frames)
+    steps = [int(np.argmin(np.abs(response.u_m - t))) for t in targets]
+    return [frame_from_response(response, k) for k in steps]
+
+
+def _lifetimes(study_key: dict, stiffness, uc, cup, code: str, study=None, progress=None):
+    """The study's lifetimes (`validation.bridge.lifetimes.Lifetimes`) on its route."""
+    COMPUTED["lifetimes"] += 1
+    from validation.bridge.lifetimes import lifetimes, route_options
+    forces = study.loads.forces_N
+
+    def each(fraction: float, message: str) -> None:
+        if progress is not None:
+            progress(f"lifetime {round(fraction * len(forces))} of {len(forces)} done ({message})")
+    return lifetimes(_model(study, stiffness, uc, cup), forces, study.route, progress=each,
+                     refine=1 if study.route == "coupled" else study.refine,
+                     **route_options(study.route, study.cup_laws))
+
+
+def _model(study: Study, stiffness, uc, cup):
+    """The `reduced.LeakageModel` of the study: its cup, its stiffness curve (or, on the coupled
+    route, its suction table), u_c, air at 293.15 K and 1e5 Pa, kappa, relaxation and fluid."""
+    from reduced.gas import Gas
+    from reduced.lifetime import LeakageModel
+    from reduced.viscoelastic import default_relaxation
+
+    loads = study.loads
+    feed = {"suction": stiffness} if study.route == "coupled" else {"stiffness": stiffness}
+    return LeakageModel(cup=cup, u_c=uc, gas=Gas(T_K=293.15), p_a_Pa=1e5, E_Pa=study.material.E_MPa * 1e6,
+                        kappa=loads.kappa, relaxation=default_relaxation() if loads.relaxation == "default" else None,
+                        fluid=loads.fluid, **feed)
+
+
+# ------------------------------------------------------------------ the lazy products
+class Products:
+    """The products of one study, each computed on first use (through the disk cache, if any).
+
+    progress(message): a line per product, FEM step and force; fem_progress(fraction, message):
+    the FEM's and suction table's own progress instead (a terminal's status line); suction_cache_dir:
+    where the coupled route's suction tables are kept (`validation.bridge.coupled.build`; None: not kept)."""
+
+    def __init__(self, study: Study, cache_dir: str | Path | None = None,
+                 progress: Callable[[str], None] | None = None, suction_cache_dir: str | Path | None = None,
+                 fem_progress: Callable[[float, str], None] | None = None):
+        self.study, self.timings, self._done, self._memos = study, {}, {}, {}
+        self._progress = progress or (lambda message: None)
+        self._fem_report = fem_progress
+        self._cache = Cache(cache_dir)
+        self._suction_cache_dir = suction_cache_dir
+        self._parent: Products | None = None
+        self._inherit: tuple[str, ...] = ()
+
+    def _cached(self, func, ignore: list[str] | None = None):
+        return self._cache.cached(func, ignore=ignore)
+
+    def _fem_progress(self, fraction: float, message: str) -> None:
+        if self._fem_report is not None:
+            return self._fem_report(fraction, message)
+        self._progress(f"FEM {message.split(': ', 1)[-1].split(',')[0]}")     # FEM u = .. mm of .. mm
+
+    def _get(self, name: str, compute):
+        if name in self._inherit:
+            return getattr(self._parent, name)()
+        if name not in self._done:
+            self._progress(f"{name} ...")
+            t0 = time.perf_counter()
+            self._done[name] = compute()
+            self.timings[name] = time.perf_counter() - t0
+        return self._done[name]
+
+    def _memo(self, name: str, compute):
+        """A cheap derived value (the cup), kept but neither timed nor reported as a product."""
+        if name in self._inherit:
+            return getattr(self._parent, name)()
+        if name not in self._memos:
+            self._memos[name] = compute()
+        return self._memos[name]
+
+    def _fem_args(self, u_max_m: float) -> tuple:
+        s = self.study
+        contact = {"law": s.contact.law, "friction": s.contact.friction}      # who chose it changes no state
+        return (_design_key(s), asdict(s.material), contact, s.fidelity, u_max_m)
+
+    def uc_table(self):
+        surface = self.study.surface
+        return self._get("uc_table", lambda: self._cached(_uc_table, ignore=["surface"])(
+            {**asdict(surface), "uc_table": file_digest(surface.uc_table)}, source_hash("reduced"), surface=surface))
+
+    def curve(self):
+        """The stiffness curve: the FEM's to 0.9 h1, or Appendix A's (d0 = 2 mm) of the study's cup."""
+        if self.study.stiffness == "appendix-a":
+            return self._get("curve", self._appendix_a_curve)
+        return self._get("curve", lambda: self._cached(_fem_curve, ignore=["design", "path"])(
+            *self._fem_args(self._u_max_m(None)), source_hash("fem", "validation"), self.study.contact.source,
+            design=self.study.design,
+            path=lambda: self.fem_path(None)))
+
+    def _appendix_a_curve(self):
+        from reduced.appendix_a import appendix_a_curve
+        return appendix_a_curve(self.cup(), E_Pa=self.study.material.E_MPa * 1e6, d0_m=2e-3)
+
+    def cup_choice(self):
+        """The cup the FEM curve was computed for (`validation.bridge.design.CupChoice`: the curve's design
+        with the study's r_start, l0, l1); None for Appendix A."""
+        if self.study.stiffness == "appendix-a":
+            return None
+
+        def compute():
+            from validation.bridge.design import resolve_cup
+            from validation.bridge.lifetimes import route_laws
+            s = self.study
+            return resolve_cup(self.curve(), r_start_mm=s.loads.r_start_mm, l0_mm=s.design.l0_mm,
+                               l1_mm=s.design.l1_mm, curve_label="the FEM curve",
+                               laws=route_laws(s.route, s.cup_laws))
+        return self._memo("cup_choice", compute)
+
+    def cup(self):
+        """The reduced model's `CupParameters`: the FEM design's (`cup_choice`), or Table 1's preset."""
+        def compute():
+            choice = self.cup_choice()
+            if choice is not None:
+                return choice.cup
+            from reduced.cup import CUPS
+            cup, r_start = CUPS[self.study.design.preset], self.study.loads.r_start_mm
+            return cup if r_start is None else replace(cup, r_start_m=1e-3 * r_start)
+        return self._memo("cup", compute)
+
+    def _u_max_m(self, u_mm: float | None) -> float:
+        """The path's end [m]: u_mm, or 0.9 h1 for the stiffness curve; checked against h1."""
+        h1_m = self.study.design.cup_geometry().h1_m
+        if u_mm is None:
+            return 0.9 * h1_m
+        if not 0 < u_mm * 1e-3 <= h1_m:
+            raise ValueError(f"outputs: u_mm must be in (0, h1] = (0, {1e3 * h1_m:.4g}] mm, got {u_mm:g}")
+        return u_mm * 1e-3
+
+    def fem_path(self, u_mm: float | None):
+        """The FEM path to u_mm (None: 0.9 h1), computed once per end point and study (`_fem_path`)."""
+        u_max_m = self._u_max_m(u_mm)
+        return self._get(f"fem_path_{1e3 * u_max_m:.6g}mm", lambda: self._cached(_fem_path, ignore=["design", "progress"])(
+            *self._fem_args(u_max_m), source_hash("fem", "validation/bridge/pipeline.py"), design=self.study.design,
+            progress=self._fem_progress))
+
+    def fem_frames(self, u_mm: float, n_frames: int = 1) -> list:
+        """The deformed states at n_frames plate displacements up to u_mm (`_fem_frames`), drawn from
+        the FEM path to u_mm: a render, a footprint and a squeeze ending at one u share one FEM run."""
+        u_max_m = self._u_max_m(u_mm)
+        name = f"fem_state_{u_mm:g}mm" + (f"_{n_frames}frames" if n_frames > 1 else "")
+        return self._get(name, lambda: self._cached(_fem_frames, ignore=["path"])(
+            *self._fem_args(u_max_m), n_frames, source_hash("fem", "validation"), path=lambda: self.fem_path(u_mm)))
+
+    def suction_table(self):
+        """The coupled route's FEM suction table: the study's file, or built for the design at its
+        mesh level and contact law (kept in suction_cache_dir)."""
+        def compute():
+            from reduced.suction_table import SuctionTable
+            s = self.study
+            if s.suction_table is not None:
+                return SuctionTable.from_json(s.suction_table)
+            from validation.bridge.coupled.build import suction_table_for
+            return suction_table_for(s.design.cup_geometry(), fidelity=s.fidelity, contact=s.contact.contact_law(),
+                                     E_Pa=s.material.E_MPa * 1e6, nu=s.material.nu,
+                                     cache_dir=self._suction_cache_dir,
+                                     progress=self._fem_report or (lambda f, m: self._progress(f"suction {m}")))
+        return self._get("suction_table", compute)
+
+    def lifetimes(self):
+        """The lifetimes (`validation.bridge.lifetimes.Lifetimes`) of the study's forces on its route."""
+        s = self.study
+        def compute():
+            feed = self.suction_table() if s.route == "coupled" else self.curve()
+            return self._cached(_lifetimes, ignore=["study", "progress"])(
+                _study_key(s), feed, self.uc_table(), self.cup(), source_hash("reduced", "validation"),
+                study=s, progress=self._progress)
+        return self._get("lifetimes", compute)
+
+    def derived(self, study: Study, inherit: tuple[str, ...] = ()) -> Products:
+        """The products of another study sharing this one's cache, and taking the products named
+        in `inherit` (e.g. "uc_table", "cup", "curve") from this one."""
+        child = Products(study, progress=self._progress, suction_cache_dir=self._suction_cache_dir,
+                         fem_progress=self._fem_report)
+        child._cache, child._parent, child._inherit = self._cache, self, inherit
+        return child
+
+    def appendix_a(self, refine: int | None = None) -> Products | None:
+        """For a FEM study: the same cup fed by Appendix A's F0 (d0 = 2 mm) through the paper's
+        route and frictionless contact (the comparison `cupcheck example` draws); else None."""
+        s = self.study
+        if s.stiffness != "fem":
+            return None
+        study = replace(s, stiffness="appendix-a", route="paper", cup_laws="cone", contact=Contact(), sweep=None,
+                        refine=s.refine if refine is None else refine)
+        return self._get("appendix_a", lambda: self.derived(study, inherit=("uc_table", "cup")))
+
+    def variants(self) -> list[tuple[Any, Products]]:
+        """For a swept study: (value, the products of the study with that value), sharing the cache."""
+        return self._get("variants", lambda: [(v, self.derived(study)) for v, study in self.study.variants()])
+
+    def computed(self) -> dict[str, Any]:
+        return dict(self._done)
