@@ -74,6 +74,9 @@ def lifetimes(model: LeakageModel, forces_N: Iterable[float], route: str, *, t_m
     ValueError naming the field."""
     from reduced.lifetime import largest_holdable_force, solve_lifetime
 
+    if route == "fem":                     # the FEM-in-the-loop route registers itself on first use
+        from validation.bridge.fem_route import register
+        register()
     largest = largest_holdable_force(model, route, **options)
     forces = [float(f) for f in forces_N]
     results = []

@@ -1,0 +1,315 @@
+"""The route "fem": the cup's whole life in the FEM, registered into `reduced.ROUTES`.
+
+    from validation.bridge.fem_route import FemCup
+    life = reduced.solve_lifetime(model, 10.0, route="fem", cup=FemCup("A", contact=ContactLaw("coulomb", 0.5)))
+
+The cup (`FemCup`: design, wall, contact law, mesh level) is pressed with the gas escaping
+(`fem.gas_path.CupWithGas.press_to`: to the model's r_start by default, or a plate displacement or
+a pressing force, `Press`) and sealed there (N0 = p_a V / k_B T). Under the pull F1 the cup follows
+its equilibrium branch (`fem.gas_branch.equilibrium_branch`: the plate raised at N0 until the pull
+is F1, then the states holding F1 with N rising), which ends at the detachment: the fold (the
+largest N held at F1: reason "fold") or the seal opening at the rim (reason "reached_r1"). A
+branch that ends without a detachment is a failure (`FemRouteError`), never a lifetime.
+
+At each branch state the leak Q [1/s] flows through that state's own contact-pressure profile at
+its p_b, as the coupled route reads its table (`reduced.coupled`): the solid pressure is the
+FEM's less the interface gas's rise over p_b across the zone [r_k, r_cut] (the model's
+`interface`), averaged over the u_c table's patch length, its rings' gaps u_c(p / E) in series
+(`reduced.profile_leak`). The lifetime is t = int_{N0}^{N_max} dN / Q by the trapezoid in N over
+the branch states: N rises monotonically along the branch whereas u turns where the branch does
+(the walk switches to N as its parameter there), and 1/Q is smooth in N; the change when the
+plate step is halved measures the quadrature and branch error (benchmarks/bench_fem_route.py).
+
+The largest holdable force is the largest pull along the plate raised at fixed N0 from the sealed
+state (the branch at a larger F1 does not start: the cup lets go at once).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from fem.gas_path import CupWithGas, GasState
+    from fem.interface import ContactLaw
+    from reduced.lifetime import LeakageModel, Lifetime, Run
+
+__all__ = ["FemCup", "Press", "FemRoute", "FemRouteError", "state_leak_rate", "register"]
+
+#: the default plate step along the branch [m] (`equilibrium_branch`'s du_m)
+DEFAULT_DU_M = 0.25e-3
+
+
+class FemRouteError(RuntimeError):
+    """The FEM path ended without a detachment (the branch stopped or ran out of plate)."""
+
+
+def _law() -> ContactLaw:
+    from fem.interface import ContactLaw
+    return ContactLaw()
+
+
+@dataclass(frozen=True)
+class FemCup:
+    """The FEM cup of the route: the design (a `fem.geometry.CupGeometry` or a preset name), the
+    wall's neo-Hookean material (E [Pa], nu), the contact law with the plane and the mesh level."""
+
+    geometry: Any = "A"
+    fidelity: str = "coarse"
+    E_Pa: float = 4e6
+    nu: float = 0.49
+    contact: Any = field(default_factory=_law)
+
+    def describe(self) -> dict[str, Any]:
+        geometry = self.geometry if isinstance(self.geometry, str) else self.geometry.describe()
+        return {"geometry": geometry, "fidelity": self.fidelity, "E_Pa": self.E_Pa, "nu": self.nu,
+                **self.contact.describe()}
+
+    def build(self, T_K: float, p_a_Pa: float) -> CupWithGas:
+        from fem.gas_path import CupWithGas
+        from fem.geometry import cup_geometry
+        from fem.mesh import cup_mesh
+        from validation.bridge.pipeline import neo_hookean
+
+        geometry = cup_geometry(self.geometry) if isinstance(self.geometry, str) else self.geometry
+        mesh = cup_mesh(geometry, self.fidelity)
+        return CupWithGas.of(mesh, neo_hookean(self.E_Pa, self.nu), self.contact.law,
+                             self.contact.friction, T_K=T_K, p_a_Pa=p_a_Pa)
+
+
+@dataclass(frozen=True)
+class Press:
+    """How the cup is pressed before it is sealed: to an inner contact radius ("r_start_m"), a
+    plate displacement ("u_m") or a pressing force ("force_N"), `fem.gas_path.CupWithGas.press_to`."""
+
+    kind: str
+    value: float
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("r_start_m", "u_m", "force_N"):
+            raise ValueError(f"press: expected 'r_start_m', 'u_m' or 'force_N', got {self.kind!r}")
+        if not (isinstance(self.value, (int, float)) and math.isfinite(self.value) and self.value > 0):
+            raise ValueError(f"press: {self.kind} must be a number > 0, got {self.value!r}")
+
+
+def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: str = "annulus") -> float:
+    """Molecules per second leaking into the cavity at one sealed FEM state (module docstring):
+    the solid pressure of `reduced.table_surface.solid_profile` on the state's own profile, at
+    the state's p_b, u_c read at p / E_Pa (the wall's modulus). inf where no solid contact is left
+    (the gas holds the seal open)."""
+    from reduced.profile_leak import ContactProfile, patch_average, profile_leak_rate, ring_gaps
+    from reduced.stiffness_curve import profiles_from_lists
+
+    prof, = profiles_from_lists([1e3 * state.profile.r_m], [1e-3 * state.profile.p_Pa])
+    if prof is None:
+        return math.inf
+    dp = max(state.dp_Pa, 0.0)
+    r, p = prof.r_m, prof.p_Pa
+    rk, rcut = state.seal_r_m, state.cut_r_m
+    tol = 1e-9 * rcut
+    zone = (r >= rk - tol) & (r <= rcut + tol)
+    rise = {"p_b": 0.0, "p_a": 1.0}.get(model.interface)
+    if rise is None:
+        rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
+    solid = ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
+    patch = getattr(model.u_c, "patch_length_m", None)
+    if patch:
+        solid = patch_average(solid, patch)
+    gaps = ring_gaps(solid, model.u_c, E_Pa)
+    if np.all(np.isinf(gaps)):
+        return math.inf
+    p_b = min(max(state.p_b_Pa, 0.0), model.p_a_Pa)
+    return profile_leak_rate(model.gas, model.p_a_Pa, p_b, solid.r_m, gaps, radial)
+
+
+
+@dataclass(frozen=True, eq=False)
+class Sealed:
+    """The pressed and sealed cup: the FEM cup with its gas and the sealed state."""
+
+    cup: CupWithGas
+    state: GasState
+    E_Pa: float
+
+
+class FemRoute:
+    """The route "fem" (module docstring). Options: cup (a `FemCup`, required), press (a `Press`;
+    None: the model's r_start), du_m (the plate step along the branch [m]), radial (the rings'
+    geometry, `reduced.profile_leak`)."""
+
+    name = "fem"
+    options = {"cup": None, "press": None, "du_m": DEFAULT_DU_M, "radial": "annulus"}
+
+    def __init__(self) -> None:
+        self._sealed: dict[tuple, Sealed] = {}
+
+    def check(self, model: LeakageModel, options: Mapping[str, Any]) -> None:
+        from fem.interface import ContactLaw
+
+        if not isinstance(options["cup"], FemCup):
+            raise ValueError("cup: the fem route needs the FEM cup, a "
+                             "validation.bridge.fem_route.FemCup")
+        if not isinstance(options["cup"].contact, ContactLaw):
+            raise ValueError("cup: its contact must be a fem.interface.ContactLaw")
+        if options["press"] is not None and not isinstance(options["press"], Press):
+            raise ValueError(f"press: expected a Press or None, got {type(options['press']).__name__}")
+        du = options["du_m"]
+        if not (isinstance(du, (int, float)) and math.isfinite(du) and du > 0):
+            raise ValueError(f"du_m: the plate step must be a number > 0 m, got {du!r}")
+        if options["radial"] not in ("annulus", "strip"):
+            raise ValueError(f"radial: expected 'annulus' or 'strip', got {options['radial']!r}")
+        if model.u_c is None:
+            raise ValueError("u_c: the fem route needs a critical gap u_c(p/E) (e.g. a UcTable)")
+        if model.fluid != "air":
+            raise ValueError(f"fluid: the fem route models a gas-filled cavity only, got '{model.fluid}'")
+        if model.relaxation is not None or model.kappa != 1.0:
+            raise ValueError("relaxation, kappa: the fem route's wall is the FEM's elastic one; "
+                             "drop relaxation and kappa")
+
+    def seal(self, model: LeakageModel, options: Mapping[str, Any],
+             progress: Callable[[float, str], None] | None = None) -> Sealed:
+        """The cup pressed with the gas escaping and sealed, once per (cup, press, gas)."""
+        press = options["press"] or Press("r_start_m", model.cup.r_start_m)
+        key = (options["cup"], press, model.gas.T_K, model.p_a_Pa)
+        if key not in self._sealed:
+            if progress:
+                progress(0.0, f"pressing the cup to {press.kind} = {press.value:g}")
+            cup = options["cup"].build(model.gas.T_K, model.p_a_Pa)
+            state = cup.press_to(**{press.kind: float(press.value)})[-1]
+            self._sealed[key] = Sealed(cup, state, options["cup"].E_Pa)
+        return self._sealed[key]
+
+    def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
+        sealed = self.seal(model, options)
+        return largest_pull(sealed.cup, sealed.state)
+
+    def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
+        from fem.gas_branch import equilibrium_branch
+        from reduced.lifetime import Lifetime
+        from reduced.lifetime.paper import check_run
+
+        check_run(force_N, run.t_max_s, run.rtol, run.refine)
+        if run.refine != 1:
+            raise ValueError(f"refine: the fem route has no dense output, got {run.refine}")
+        sealed = self.seal(model, options, run.progress)
+        if run.progress:
+            run.progress(0.1, f"F1 = {force_N:g} N: following the branch")
+        branch = equilibrium_branch(sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]))
+        largest = self.largest_force(model, options)
+        s0 = sealed.state
+        provenance = {"route": self.name, "options": {**options, "cup": options["cup"].describe(),
+                                                       "press": options["press"] and vars(options["press"])},
+                      "model": model.label, "t_max_s": run.t_max_s}
+        common = dict(route=self.name, force_N=float(force_N), largest_force_N=largest,
+                      provenance=provenance)
+        base = {"N0": s0.N, "u_sealed_mm": 1e3 * s0.u_m, "r_start_mm": 1e3 * s0.r_c_m,
+                "seal_r_sealed_mm": 1e3 * s0.seal_r_m, "branch_reason": branch.reason}
+        if branch.reason == "not held":
+            return Lifetime(reason="over_force", lifetime_s=0.0, message=f"F1 = {force_N:g} N exceeds "
+                            f"what the sealed cup holds: it detaches at once", trajectory={},
+                            details=base, **common)
+        if branch.detachment is None:
+            raise FemRouteError(f"F1 = {force_N:g} N: the branch ended without a detachment "
+                                f"({branch.reason}) after {len(branch.states)} states")
+        states = list(branch.states)
+        q = np.array([state_leak_rate(s, model, sealed.E_Pa, options["radial"]) for s in states])
+        N = np.array([s.N for s in states])
+        columns = _columns(states, q)
+        stats = branch.stats
+        details = {**base, "N_max": branch.N_max, "states": len(states), "snaps": branch.snaps,
+                   "newton_iterations": stats.newton_iterations, "wall_time_s": stats.wall_time_s,
+                   "seal_r_final_mm": 1e3 * states[-1].seal_r_m, "p_b_final_Pa": states[-1].p_b_Pa,
+                   "u_final_mm": 1e3 * states[-1].u_m}
+        if np.any(q <= 0):
+            k = int(np.argmax(q <= 0))
+            cut = {k2: v[:k + 1] for k2, v in columns.items()}
+            cut["t_s"] = np.concatenate([lifetime_integral(N[:k + 1], q[:k + 1])[:-1], [math.inf]]) \
+                if k else np.array([math.inf])
+            return Lifetime(reason="sealed", lifetime_s=math.inf, message=f"the interface seals at "
+                            f"u = {1e3 * states[k].u_m:.4g} mm, p_b = {states[k].p_b_Pa / 1e3:.4g} kPa",
+                            trajectory=cut, details=details, **common)
+        t = lifetime_integral(N, q)
+        if t[-1] > run.t_max_s:
+            end = int(np.searchsorted(t, run.t_max_s, side="right"))
+            cut = {k2: v[:end] for k2, v in columns.items()}
+            cut["t_s"] = t[:end]
+            return Lifetime(reason="horizon", lifetime_s=math.inf, message=f"still holding at "
+                            f"t_max = {run.t_max_s:g} s", trajectory=cut, details=details, **common)
+        columns["t_s"] = t
+        reason = "fold" if branch.reason == "fold" else "reached_r1"
+        where = ("the branch folds: no state holds more gas" if reason == "fold" else
+                 f"the seal opened at the rim (r_k = {1e3 * states[-1].seal_r_m:.4g} mm)")
+        if run.progress:
+            run.progress(1.0, f"F1 = {force_N:g} N: {reason}")
+        return Lifetime(reason=reason, lifetime_s=float(t[-1]), trajectory=columns, details=details,
+                        message=f"detached at t = {t[-1]:.4g} s: {where}", **common)
+
+
+def lifetime_integral(N: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """t(N) = int_{N_0}^{N} dN' / Q(N') [s] at every sample, by the trapezoid (1/Q = 0 where the
+    seal is held open, Q = inf)."""
+    inv = np.where(np.isinf(q), 0.0, 1.0 / q)
+    return np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(N))])
+
+
+def _columns(states: list, q: np.ndarray) -> dict[str, np.ndarray]:
+    def col(name: str, scale: float = 1.0) -> np.ndarray:
+        return scale * np.array([getattr(s, name) for s in states])
+    return {"N": col("N"), "p_b_Pa": col("p_b_Pa"), "u_mm": col("u_m", 1e3), "F_plate_N": col("F1_N"),
+            "V_mm3": col("V_m3", 1e9), "r_c_mm": col("r_c_m", 1e3), "seal_r_mm": col("seal_r_m", 1e3),
+            "r_out_mm": col("cut_r_m", 1e3), "N_dot_per_s": q}
+
+
+class _Past(Exception):
+    """Stops the fixed-N0 pull once its pull has passed its maximum."""
+
+
+def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float:
+    """The largest pull F1 [N] along the plate raised at fixed N (the sealed state's) from
+    `sealed` (module docstring): the path is followed up to -h1 until F1 has fallen by `drop` of
+    its maximum or the solver stops (the seal opening), and the maximum refined by the parabola
+    through the three states around it."""
+    from fem.solver import ConvergenceError
+    from fem.trapped_gas import GasMechanics, TrappedGas, follow_gas_path
+
+    mech = GasMechanics(cup.cup.mech, cup.cavity, TrappedGas(sealed.N, cup.T_K, cup.p_a_Pa))
+    top = cup.cup.top
+    dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
+    u0, span = sealed.u_m, sealed.u_m + cup.h1_m
+    plate = lambda t: (dofs, np.concatenate([zeros, np.full(top.size, -(u0 - t))]))  # noqa: E731
+    seen: list[tuple[float, float]] = [(u0, sealed.F1_N)]
+
+    def on_step(step) -> None:
+        F1 = float(np.sum(step.r_int[2 * top + 1]))
+        seen.append((u0 - step.t, F1))
+        best = max(f for _, f in seen)
+        if best > 0 and F1 < (1.0 - drop) * best:
+            raise _Past
+    options = replace(cup.options, max_step=min(cup.options.max_step, 0.01))
+    try:
+        follow_gas_path(mech, plate, span, plane=cup.cup.plane, start=sealed.state, options=options,
+                        on_step=on_step)
+    except (_Past, ConvergenceError):
+        pass
+    u, F = np.array(seen).T
+    k = int(np.argmax(F))
+    if 0 < k < F.size - 1:
+        a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
+        if a < 0:
+            return float(max(F[k], c - b * b / (4 * a)))
+    return float(F[k])
+
+
+def register() -> FemRoute:
+    """Register the route "fem" into `reduced.ROUTES` (once; the registered route afterwards)."""
+    from reduced.lifetime import ROUTES, register_route
+
+    route = ROUTES.get("fem")
+    return route if isinstance(route, FemRoute) else register_route(FemRoute())
+
+
+register()
