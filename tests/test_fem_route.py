@@ -1,0 +1,115 @@
+"""The route "fem" (`validation.bridge.fem_route`): coarse cup A pressed to r_start, sealed, held
+at F1 along its FEM branch, the leak through each state's own profile.
+
+Independent checks: at mu = 0 the lifetime equals the table-coupled route's (the same cup through
+its (u, dp) suction table, started from the same sealed content N0) to 1 % (slow: the default
+table); the lifetime converges as the branch's plate step is halved; the quadrature against
+Simpson's rule on the same states; the detachment from the branch, not from the solver."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import simpson
+from scipy.optimize import brentq
+
+import reduced
+from fem.interface import ContactLaw
+from validation.bridge.fem_route import FemCup, Press, lifetime_integral
+from validation.bridge.lifetimes import lifetimes
+from validation.bridge.pipeline import surface_uc_table
+
+
+@pytest.fixture(scope="module")
+def model():
+    return reduced.reference_model(reduced.CUP_A, surface_uc_table())
+
+
+@pytest.fixture(scope="module")
+def frictionless(model):
+    return lifetimes(model, [10.0], "fem", cup=FemCup("A", "coarse"))
+
+
+def test_frictionless_branch_holds_F1_to_its_detachment(frictionless):
+    life = frictionless[0]
+    assert life.route == "fem" and life.reason in ("fold", "reached_r1")
+    assert 0.0 < life.lifetime_s < math.inf
+    tr = life.trajectory
+    assert np.allclose(tr["F_plate_N"], 10.0, atol=0.05)         # every state holds the pull
+    assert np.all(np.diff(tr["N"]) > 0) and np.all(np.diff(tr["t_s"]) > 0)   # gas in, time on
+    assert tr["N"][0] == pytest.approx(life.details["N0"], rel=0.02)          # pulled at N0
+    # the gas law at every state, p_b V = N k_B T
+    assert np.allclose(tr["p_b_Pa"] * tr["V_mm3"] * 1e-9, tr["N"] * reduced.AIR.kT_J, rtol=1e-9)
+    assert frictionless.largest_force_N > 10.0
+
+
+def test_quadrature_in_N_agrees_with_simpson(frictionless):
+    """The trapezoid of 1/Q in N against Simpson's rule on the same branch states."""
+    tr = frictionless[0].trajectory
+    q, N = tr["N_dot_per_s"], tr["N"]
+    inv = np.where(np.isinf(q), 0.0, 1.0 / q)
+    assert lifetime_integral(N, q)[-1] == pytest.approx(simpson(inv, x=N), rel=5e-3)
+
+
+def test_over_force_detaches_at_once(model, frictionless):
+    F = 1.2 * frictionless.largest_force_N
+    life = reduced.solve_lifetime(model, F, route="fem", cup=FemCup("A", "coarse"))
+    assert life.reason == "over_force" and life.lifetime_s == 0.0
+
+
+def test_bad_options_name_the_field(model):
+    with pytest.raises(ValueError, match="^cup: "):
+        lifetimes(model, [10.0], "fem")
+    with pytest.raises(ValueError, match="^press: "):
+        Press("depth", 1.0)
+    with pytest.raises(ValueError, match="^du_m: "):
+        lifetimes(model, [10.0], "fem", cup=FemCup(), du_m=-1.0)
+
+
+def test_coulomb_run_completes(model):
+    life = reduced.solve_lifetime(model, 10.0, route="fem",
+                                  cup=FemCup("A", "coarse", contact=ContactLaw("coulomb", 0.5)))
+    assert life.reason in ("fold", "reached_r1") and 0.0 < life.lifetime_s < math.inf
+
+
+@pytest.mark.slow
+def test_lifetime_converges_as_the_plate_step_is_halved(model, frictionless):
+    fine = reduced.solve_lifetime(model, 10.0, route="fem", cup=FemCup("A", "coarse"),
+                                  du_m=0.5 * frictionless[0].provenance["options"]["du_m"])
+    assert fine.lifetime_s == pytest.approx(frictionless[0].lifetime_s, rel=0.01)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("force_N", [5.0, 10.0, 20.0])
+def test_mu0_equals_the_table_coupled_route(model, table, force_N):
+    """Two paths to one answer: the FEM branch against the suction table's, started from the same
+    sealed content (the table's start u is where the sealed cup, raised at N0, pulls nothing).
+    The table ends at its smallest u (table_edge) where the FEM goes on: compared there."""
+    from validation.bridge.fem_route import register
+
+    route = register()
+    cup = FemCup("A", "coarse")
+    life = reduced.solve_lifetime(model, force_N, route="fem", cup=cup)
+    sealed = route.seal(model, {**route.options, "cup": cup})
+    u_release = brentq(lambda u: sealed.cup.move_plate(sealed.state, u)[-1].F1_N,
+                       0.3 * sealed.state.u_m, (1 - 1e-6) * sealed.state.u_m, xtol=1e-10)
+    coupled = reduced.solve_lifetime(dataclasses.replace(model, suction=table), force_N,
+                                     route="coupled", u_start_m=u_release)
+    tr = life.trajectory
+    assert coupled.trajectory["N"][0] == pytest.approx(tr["N"][0], rel=2e-3)
+    if coupled.reason == "table_edge":
+        N_end = coupled.trajectory["N"][-1]
+        assert N_end < tr["N"][-1]
+        t = float(np.interp(N_end, tr["N"], tr["t_s"]))
+    else:
+        t = life.lifetime_s
+    assert t == pytest.approx(coupled.lifetime_s, rel=0.01)
+
+
+@pytest.fixture(scope="module")
+def table():
+    from validation.bridge.coupled.build import suction_table_for
+    return suction_table_for("A", fidelity="coarse")
