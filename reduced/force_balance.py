@@ -292,6 +292,9 @@ def force_balance(model: LeakageModel, geometry: str | None = None, seal: str | 
     shares). exact: the profile seal solves every flow directly instead of from its tables."""
     seal = seal or model.seal
     key = (geometry or model.geometry, seal, bool(exact) and seal == "profile")
+    if seal == "profile" and key[0] != "curve":
+        raise ValueError("seal: the profile's radii are the FEM's: 'profile' needs geometry 'curve' "
+                         "(r and V from the same curve)")
     per_model = _BALANCES.setdefault(model, {})
     if key not in per_model:
         per_model[key] = ForceBalance(model, *key)
