@@ -26,8 +26,7 @@ from fem.geometry import cup_geometry
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
 from fem.suction import suction_grid
-from reduced.coupled import CoupledCavity
-from reduced.lifetime import lifetime
+from reduced.lifetime import LeakageModel, largest_holdable_force, solve_lifetime
 from reduced.suction_table import SuctionTable
 from validation.cli import build_parser
 from validation.commands.lifetime import build_model, build_uc
@@ -72,19 +71,20 @@ def main() -> None:
     cli = build_parser().parse_args(["lifetime", "--surface", "pmma-1.89", "--force", "5"])
     uc, paper = build_uc(cli), build_model(cli)
     u_start = paper.cup.h1_m - paper.cup.h_start_m
-    print(f"paper route: " + ", ".join(f"{lifetime(paper, F).lifetime_s:.4g}" for F in FORCES_N)
+    print(f"paper route: " + ", ".join(f"{solve_lifetime(paper, F, route='paper').lifetime_s:.4g}" for F in FORCES_N)
           + f" s at F1 = {', '.join(f'{F:g}' for F in FORCES_N)} N")
     rows = {}
     for name, (level, u, dp) in grids().items():
         t, build_s = table(name, level, u, dp, args.tables)
-        model = CoupledCavity(t, uc, paper.gas, paper.p_a_Pa)
+        model = LeakageModel(cup=paper.cup, suction=t, u_c=uc, gas=paper.gas, p_a_Pa=paper.p_a_Pa)
         start = time.perf_counter()
-        life = np.array([model.lifetime(F, u_start).lifetime_s for F in FORCES_N])
+        life = np.array([solve_lifetime(model, F, route="coupled", u_start_m=u_start).lifetime_s
+                         for F in FORCES_N])
         cost = (time.perf_counter() - start) / len(FORCES_N)
         rows[name] = life
         print(f"{name:>16}: {t.u_m.size:2d} x {t.dp_Pa.size:2d} states, table {build_s:6.1f} s; lifetimes "
               + ", ".join(f"{x:.4g}" for x in life) + f" s ({1e3 * cost:.0f} ms each); largest "
-              f"holdable force {model.largest_holdable_force(u_start):.4g} N")
+              f"holdable force {largest_holdable_force(model, route='coupled', u_start_m=u_start):.4g} N")
     base = rows["coarse"]
     for name in ("coarse u*2", "coarse dp*2", "coarse u/2", "coarse dp/2", "coarse +u_min/2", "medium"):
         diff = 100 * (base / rows[name] - 1)

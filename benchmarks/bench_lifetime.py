@@ -15,7 +15,7 @@ import time
 
 from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
 from reduced.cup import CUP_A
-from reduced.lifetime import largest_holdable_force, lifetime, lifetime_sweep, reference_model
+from reduced.lifetime import largest_holdable_force, reference_model, solve_lifetime
 
 FORCES_N = [float(f) for f in range(5, 85, 5)]
 
@@ -29,6 +29,11 @@ def _time(fn, repeat: int) -> tuple[float, float]:
     return min(samples), statistics.median(samples)
 
 
+def _sweep(model) -> list:
+    """The lifetimes at every force of FORCES_N (sharing the model's precomputation)."""
+    return [solve_lifetime(model, F1, route="paper") for F1 in FORCES_N]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=30, help="repetitions per figure (default: 30)")
@@ -39,21 +44,21 @@ def main() -> None:
 
     def cold(F1: float):
         m = reference_model(CUP_A, uc)
-        return lifetime(m, F1)
+        return solve_lifetime(m, F1, route="paper")
 
     print("cupcheck reduced model, cup A, reference mode, illustrative u_c table")
     for F1 in (5.0, 20.0, 80.0):
-        r = lifetime(model, F1)
-        lo, med = _time(lambda: lifetime(model, F1), args.repeat)
+        r = solve_lifetime(model, F1, route="paper")
+        lo, med = _time(lambda: solve_lifetime(model, F1, route="paper"), args.repeat)
         print(f"  one lifetime F1 = {F1:4g} N ({r.lifetime_s:8.4g} s, {r.steps:2d} steps): "
               f"min {1e3 * lo:6.2f} ms, median {1e3 * med:6.2f} ms")
     lo, med = _time(lambda: cold(20.0), max(3, args.repeat // 3))
     print(f"  one lifetime F1 =   20 N, cold (model built too):        "
           f"min {1e3 * lo:6.2f} ms, median {1e3 * med:6.2f} ms")
-    lo, med = _time(lambda: lifetime_sweep(model, FORCES_N), max(3, args.repeat // 3))
+    lo, med = _time(lambda: _sweep(model), max(3, args.repeat // 3))
     print(f"  sweep of {len(FORCES_N)} forces 5...80 N:                          "
           f"min {1e3 * lo:6.1f} ms, median {1e3 * med:6.1f} ms")
-    lo, med = _time(lambda: lifetime_sweep(reference_model(CUP_A, uc), FORCES_N), max(3, args.repeat // 3))
+    lo, med = _time(lambda: _sweep(reference_model(CUP_A, uc)), max(3, args.repeat // 3))
     print(f"  sweep of {len(FORCES_N)} forces, cold:                             "
           f"min {1e3 * lo:6.1f} ms, median {1e3 * med:6.1f} ms")
     print("targets: <= 5 ms per lifetime, <= 100 ms per sweep")

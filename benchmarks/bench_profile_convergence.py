@@ -30,7 +30,7 @@ from fem.geometry import cup_geometry
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
 from reduced.cup import CUP_A
-from reduced.lifetime import lifetime, reference_model
+from reduced.lifetime import reference_model, solve_lifetime
 from reduced.roughness import preset
 from reduced.roughness.persson import patch_length
 from validation.bridge import handoff
@@ -68,10 +68,9 @@ def main() -> None:
               f"neighbours {1e6 * gaps[j - 1]:.1f} and {1e6 * gaps[j]:.1f} um away, profile force "
               f"{prof.force_N / curve.F0_N[k]:.3f} F0")
         for name, table_uc in variants.items():
-            model = dataclasses.replace(reference_model(CUP_A, table_uc), stiffness=curve, geometry="curve",
-                                        seal="profile")
+            model = dataclasses.replace(reference_model(CUP_A, table_uc), stiffness=curve)
             t0 = time.perf_counter()
-            lives = [lifetime(model, F).lifetime_s for F in FORCES_N]
+            lives = [solve_lifetime(model, F, route="profile").lifetime_s for F in FORCES_N]
             table[name][level] = lives
             print(f"  {name:8s} lifetimes {' '.join(f'{x:8.4g}' for x in lives)} s "
                   f"({time.perf_counter() - t0:.1f} s)")

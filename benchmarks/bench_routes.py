@@ -28,10 +28,9 @@ from fem.cup import compress_cup
 from fem.geometry import cup_geometry
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
-from reduced.coupled import CoupledCavity
 from reduced.cup import CUP_A
 from reduced.gas import AIR
-from reduced.lifetime import largest_holdable_force, lifetime, reference_model
+from reduced.lifetime import LeakageModel, largest_holdable_force, reference_model, solve_lifetime
 from reduced.profile_leak import profile_leak_rate, ring_gaps
 from validation.bridge import handoff
 from validation.bridge.coupled.build import suction_table_for
@@ -39,7 +38,7 @@ from validation.crosscheck.context import pmma_uc_table
 
 FORCES_N = (5.0, 10.0, 20.0, 40.0, 80.0)
 SURFACES = ("pmma-1.89", "table")
-ROUTES = {"paper": {"geometry": "cone"}, "profile": {"geometry": "curve", "seal": "profile"}}
+ROUTES = {"paper": {"route": "paper", "cup_laws": "cone"}, "profile": {"route": "profile"}}
 
 
 def _row(route: str, lives: list[float], table_10N: float, held: float, cost: str) -> None:
@@ -65,12 +64,12 @@ def main() -> None:
         print(f"  {'route':8s} " + " ".join(f"{f'{F:g} N':>9}" for F in FORCES_N)
               + f" {'table 10N':>9} {'held_N':>8}  cost")
         for route, kw in ROUTES.items():
-            models = {s: dataclasses.replace(reference_model(CUP_A, uc[s]), stiffness=curve, **kw) for s in SURFACES}
+            models = {s: dataclasses.replace(reference_model(CUP_A, uc[s]), stiffness=curve) for s in SURFACES}
             t0 = time.perf_counter()
-            lives = [lifetime(models["pmma-1.89"], F).lifetime_s for F in FORCES_N]
+            lives = [solve_lifetime(models["pmma-1.89"], F, **kw).lifetime_s for F in FORCES_N]
             spent = time.perf_counter() - t0
-            _row(route, lives, lifetime(models["table"], 10.0).lifetime_s,
-                 largest_holdable_force(models["pmma-1.89"]),
+            _row(route, lives, solve_lifetime(models["table"], 10.0, **kw).lifetime_s,
+                 largest_holdable_force(models["pmma-1.89"], **kw),
                  f"FEM path + {spent / len(FORCES_N):.2g} s per lifetime")
         if level in args.coupled_levels:
             _coupled(g, level, uc, args.cache_dir)
@@ -82,15 +81,16 @@ def _coupled(g, level: str, uc: dict, cache_dir: str) -> None:
     table = suction_table_for(g, fidelity=level, cache_dir=cache_dir)
     read = time.perf_counter() - t0
     u_start = table.h1_m - CUP_A.h_start_m
-    models = {s: CoupledCavity(table, uc[s]) for s in SURFACES}
+    models = {s: LeakageModel(cup=CUP_A, suction=table, u_c=uc[s]) for s in SURFACES}
+    kw = {"route": "coupled", "u_start_m": u_start}
     t0 = time.perf_counter()
-    models["pmma-1.89"].lifetime(FORCES_N[0], u_start)               # the nodes' conductances, once
+    solve_lifetime(models["pmma-1.89"], FORCES_N[0], **kw)           # the nodes' conductances, once
     setup = time.perf_counter() - t0
     t0 = time.perf_counter()
-    lives = [models["pmma-1.89"].lifetime(F, u_start).lifetime_s for F in FORCES_N]
+    lives = [solve_lifetime(models["pmma-1.89"], F, **kw).lifetime_s for F in FORCES_N]
     spent = time.perf_counter() - t0
-    _row("coupled", lives, models["table"].lifetime(10.0, u_start).lifetime_s,
-         models["pmma-1.89"].largest_holdable_force(u_start),
+    _row("coupled", lives, solve_lifetime(models["table"], 10.0, **kw).lifetime_s,
+         largest_holdable_force(models["pmma-1.89"], **kw),
          f"table {table.provenance['solver']['wall_time_s']:.0f} s once ({table.provenance['grid']}; "
          f"read {read:.1f} s) + {setup:.1f} s conductances + {spent / len(FORCES_N):.2g} s per lifetime")
 

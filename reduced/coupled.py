@@ -50,14 +50,14 @@ import numpy as np
 from scipy.optimize import brentq
 
 from reduced.coupled_relax import RelaxedParts, relaxed_lifetime, relaxed_parts
-from reduced.coupled_result import CoupledLifetime
+from reduced.coupled_result import _CoupledRecord
 from reduced.gas import AIR, Gas
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
 from reduced.suction_table import SuctionTable
 from reduced.table_surface import INTERFACES, TableSurface, solid_profile
 from reduced.viscoelastic import RelaxationModulus
 
-__all__ = ["CoupledCavity", "CoupledLifetime", "INTERFACES"]
+__all__ = ["CoupledCavity", "INTERFACES"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -242,13 +242,13 @@ class CoupledCavity:
                              f"{1e3 * self._u[-1]:.4g} mm; extend the table")
         return N0, brentq(lambda d: self.content(F1, d)[1] - N0, lo, hi, xtol=1e-10 * max(hi, 1.0)), lo
 
-    def largest_holdable_force(self, u_start_m: float) -> float:
+    def _largest_force(self, u_start_m: float) -> float:
         """The largest F1 [N] the cup released at u_start holds at t = 0: the branch at that F1
         just reaches the start content at its low-dp end (bisection on F1). With relaxation: the
         cup at t = 0, kappa(phi = 0)."""
         if self.relaxation is not None:
             k0 = self._relaxed.kappa(0.0)[0]
-            return replace(self, kappa=k0, relaxation=None, phi0_s=None).largest_holdable_force(u_start_m)
+            return replace(self, kappa=k0, relaxation=None, phi0_s=None)._largest_force(u_start_m)
         _, N0 = self.start(u_start_m)
 
         def holds(F1: float) -> bool:
@@ -262,8 +262,8 @@ class CoupledCavity:
             lo, hi = (mid, hi) if holds(mid) else (lo, mid)
         return lo
 
-    def lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
-                 rtol: float = 1e-6) -> CoupledLifetime:
+    def _lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
+                  rtol: float = 1e-6) -> _CoupledRecord:
         """Lifetime of the cup released at u_start and pulled by F1 = force_N (module docstring).
         With relaxation it is integrated in time (`reduced.coupled_relax`) up to t_max_s with the
         relative tolerance rtol; without, t_max_s and rtol are not used (a quadrature)."""
@@ -276,7 +276,7 @@ class CoupledCavity:
             return relaxed_lifetime(self, F1, u_start_m, t_max_s, rtol)
         N0, dp0, lo = self.loaded(F1, u_start_m)
         if dp0 is None:
-            return CoupledLifetime(F1, 0.0, "over_force", f"F1 = {F1:g} N exceeds what the cup holds "
+            return _CoupledRecord(F1, 0.0, "over_force", f"F1 = {F1:g} N exceeds what the cup holds "
                                    f"with its start content: it detaches at once", N0,
                                    *(np.zeros(0),) * 6, p_a_Pa=self.p_a_Pa)
         dps = np.linspace(dp0, lo, self.samples)
@@ -290,12 +290,12 @@ class CoupledCavity:
         q = np.array([self.Ndot(a, b) for a, b in zip(u, dps)])
         if np.any(q <= 0):
             k = int(np.argmax(q <= 0))
-            return CoupledLifetime(F1, math.inf, "sealed", f"the interface seals at u = "
+            return _CoupledRecord(F1, math.inf, "sealed", f"the interface seals at u = "
                                    f"{1e3 * u[k]:.4g} mm, dp = {dps[k] / 1e3:.4g} kPa", N0,
                                    np.zeros(1), u[:1], dps[:1], N[:1], q[:1], V[:1], p_a_Pa=self.p_a_Pa)
         t = np.concatenate([[0.0], np.cumsum(0.5 * (1 / q[1:] + 1 / q[:-1]) * np.diff(N))])
         where = ("u reached the table's smallest u = " f"{1e3 * self._u[0]:.4g} mm" if reason == "table_edge"
                  else "the branch folds: no state holds more gas")
-        return CoupledLifetime(F1, float(t[-1]), reason, f"detached at t = {t[-1]:.4g} s: {where}", N0,
+        return _CoupledRecord(F1, float(t[-1]), reason, f"detached at t = {t[-1]:.4g} s: {where}", N0,
                                t, u, dps, N, q, V, p_a_Pa=self.p_a_Pa)
 

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.polynomial import chebyshev
 
 from reduced.coupled_branch import Branch, BranchPoint
-from reduced.coupled_result import CoupledLifetime
+from reduced.coupled_result import _CoupledRecord
 from reduced.gas import Gas
 from reduced.ode import dopri5
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
@@ -255,7 +255,7 @@ class _Dynamics:
 
 
 def relaxed_lifetime(cc: CoupledCavity, F1: float, u_start: float, t_max: float,
-                     rtol: float) -> CoupledLifetime:
+                     rtol: float) -> _CoupledRecord:
     """Lifetime of the relaxing cup released at u_start and pulled by F1 (module docstring)."""
     run = _Run(cc, F1)
     k0, dk0 = run.parts.kappa(0.0)
@@ -332,7 +332,7 @@ class _Run:
         P = R.point
         return (t, P.u, R.kappa * P.s, N, R.N_dot, P.V[0], phi, R.kappa)
 
-    def result(self, life: float, reason: str, msg: str, rows: list, steps: int = 0) -> CoupledLifetime:
+    def result(self, life: float, reason: str, msg: str, rows: list, steps: int = 0) -> _CoupledRecord:
         a = np.array(rows, dtype=float).reshape(-1, 8).T
-        return CoupledLifetime(self.F1, life, reason, msg, self.N0, *a[:6], p_a_Pa=self.cc.p_a_Pa,
+        return _CoupledRecord(self.F1, life, reason, msg, self.N0, *a[:6], p_a_Pa=self.cc.p_a_Pa,
                                phi_s=a[6], kappa=a[7], steps=steps)

@@ -11,11 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CoupledLifetime"]
+__all__: list[str] = []
 
 
 @dataclass(frozen=True, eq=False)
-class CoupledLifetime:
+class _CoupledRecord:
     """Lifetime [s] (inf if the interface seals) and the trajectory along the branch (SI)."""
 
     force_N: float

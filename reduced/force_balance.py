@@ -33,7 +33,7 @@ from scipy.optimize import brentq, minimize_scalar
 from reduced.fast_curve import CurveRangeError, ScalarPchip
 from reduced.geometry import geometry_source
 from reduced.model import LeakageModel
-from reduced.seal import ProfileSeal, StripSeal
+from reduced.seal import SEALS, ProfileSeal, StripSeal
 from reduced.viscoelastic import measurement_contact_time
 
 __all__ = ["ForceBalance", "force_balance"]
@@ -284,14 +284,18 @@ class ForceBalance:
 _BALANCES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def force_balance(model: LeakageModel, geometry: str | None = None, seal: str | None = None,
+def force_balance(model: LeakageModel, geometry: str = "cone", seal: str = "strip",
                   exact: bool = False) -> ForceBalance:
     """The `ForceBalance` of `model` with the cup laws `geometry` ('cone' | 'curve') and the
-    `seal` ('strip' | 'profile'), by default the model's; built once per model and choice (its
+    `seal` ('strip' | 'profile'), as the route chose them; built once per model and choice (its
     start state, fold grid and the profile seal's flow tables are what every lifetime of the model
     shares). exact: the profile seal solves every flow directly instead of from its tables."""
-    seal = seal or model.seal
-    key = (geometry or model.geometry, seal, bool(exact) and seal == "profile")
+    if seal not in SEALS:
+        raise ValueError(f"seal: unknown seal '{seal}', allowed: {', '.join(SEALS)}")
+    key = (geometry, seal, bool(exact) and seal == "profile")
+    if seal == "profile" and geometry != "curve":
+        raise ValueError("seal: the profile's radii are the FEM's: 'profile' needs geometry 'curve' "
+                         "(r and V from the same curve)")
     per_model = _BALANCES.setdefault(model, {})
     if key not in per_model:
         per_model[key] = ForceBalance(model, *key)

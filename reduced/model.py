@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 from reduced.appendix_a import appendix_a_curve
 from reduced.cup import CupParameters
 from reduced.gas import AIR, WATER_VISCOSITY_PA_S, Gas
-from reduced.seal import SEALS
 from reduced.stiffness_curve import StiffnessCurve
 from reduced.suction_table import SuctionTable
 from reduced.table_surface import INTERFACES
@@ -41,9 +40,8 @@ class LeakageModel:
     incompressible liquid that flows in by eq 24; p_b may become negative, Sec. 6);
     cavitation_pressure_Pa: water only, None: metastable liquid, else a vapour bubble opens below it.
     interface: the gas law in the coupled route's contact zone (`reduced.table_surface.INTERFACES`).
-
-    geometry ('cone' | 'curve') and seal ('strip' | 'profile') are the legacy spelling of the route
-    read by `reduced.lifetime.lifetime`; `solve_lifetime` takes the route by name instead.
+    The route (and with it the cup laws and the seal) is not part of the model: `solve_lifetime`
+    takes it by name.
     """
 
     cup: CupParameters
@@ -54,8 +52,6 @@ class LeakageModel:
     E_Pa: float = 4e6
     relaxation: RelaxationModulus | None = None
     phi0_s: float | None = None
-    geometry: str = "cone"
-    seal: str = "strip"
     fluid: str = "air"
     liquid_viscosity_Pa_s: float = WATER_VISCOSITY_PA_S
     cavitation_pressure_Pa: float | None = None
@@ -73,13 +69,6 @@ class LeakageModel:
             raise ValueError(f"kappa: stiffness factor must be > 0, got {self.kappa}")
         if self.phi0_s is not None and not self.phi0_s > 0:
             raise ValueError(f"phi0_s: measurement contact time must be > 0 s, got {self.phi0_s}")
-        if self.geometry not in ("cone", "curve"):
-            raise ValueError(f"geometry: unknown source '{self.geometry}', allowed: cone, curve")
-        if self.seal not in SEALS:
-            raise ValueError(f"seal: unknown seal '{self.seal}', allowed: {', '.join(SEALS)}")
-        if self.seal == "profile" and self.geometry != "curve":
-            raise ValueError("seal: the profile's radii are the FEM's: 'profile' needs geometry 'curve' "
-                             "(r and V from the same curve)")
         if self.interface not in INTERFACES:
             raise ValueError(f"interface: expected one of {', '.join(INTERFACES)}, got {self.interface!r}")
         if self.fluid not in FLUIDS:
@@ -104,7 +93,8 @@ class LeakageModel:
 
 def reference_model(cup: CupParameters, u_c: Callable[[float], float]) -> LeakageModel:
     """The paper's reference conventions (`reduced.lifetime.paper`) for `cup` and `u_c`: Appendix A
-    stiffness (d0 = 2 mm, E = 4 MPa), no relaxation, air at 293.15 K, p_a = 1e5 Pa, the rigid cone."""
+    stiffness (d0 = 2 mm, E = 4 MPa), no relaxation, air at 293.15 K, p_a = 1e5 Pa (the paper's rigid
+    cone is the paper route's default cup_laws)."""
     return LeakageModel(cup=cup, stiffness=appendix_a_curve(cup, E_Pa=4e6, d0_m=2e-3), u_c=u_c,
                         gas=Gas(T_K=293.15, molecular_mass_u=28.97, viscosity_Pa_s=1.81e-5),
-                        p_a_Pa=1e5, E_Pa=4e6, relaxation=None, geometry="cone", label="reference")
+                        p_a_Pa=1e5, E_Pa=4e6, relaxation=None, label="reference")

@@ -128,14 +128,15 @@ def test_kappa_scales_the_stiffness_as_a_scaled_curve(capsys):
     """--kappa k is the same model as a stiffness curve with F0 scaled by k (the paper's Fig.
     1stiffnessFactor); a stiffer cup presses the strip harder and holds longer at 10 N."""
     from reduced.appendix_a import appendix_a_curve
-    from reduced.lifetime import lifetime, reference_model
+    from reduced.lifetime import reference_model, solve_lifetime
 
     code, out, _ = _run(capsys, "lifetime", "--kappa", "2", "--force", "10", "--surface", "illustrative", "--json")
     assert code == 0
     base = reference_model(CUP_A, UcTable.from_csv(ILLUSTRATIVE_UC_CSV))
     import dataclasses
     scaled = dataclasses.replace(base, stiffness=appendix_a_curve(CUP_A).scaled(2.0))
-    assert json.loads(out)[0]["lifetime_s"] == pytest.approx(lifetime(scaled, 10.0).lifetime_s, rel=1e-9)
-    assert json.loads(out)[0]["lifetime_s"] > lifetime(base, 10.0).lifetime_s
+    assert json.loads(out)[0]["lifetime_s"] == pytest.approx(solve_lifetime(scaled, 10.0, route="paper").lifetime_s,
+                                                                     rel=1e-9)
+    assert json.loads(out)[0]["lifetime_s"] > solve_lifetime(base, 10.0, route="paper").lifetime_s
     code, _, err = _run(capsys, "lifetime", "--kappa", "0")
     assert code == 2 and "--kappa: stiffness factor must be > 0" in err

@@ -28,7 +28,7 @@ def test_lifetime_defaults_to_the_calibrated_surface(capsys):
     calibrated preset's Persson u_c table), not the illustrative power law."""
     from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
     from reduced.cup import CUP_A
-    from reduced.lifetime import lifetime, reference_model
+    from reduced.lifetime import reference_model, solve_lifetime
     from reduced.roughness import uc_table
     from reduced.roughness.surfaces import preset
 
@@ -36,11 +36,12 @@ def test_lifetime_defaults_to_the_calibrated_surface(capsys):
     assert code == 0 and err == ""
     got = json.loads(out)[0]["lifetime_s"]
     pmma = reference_model(CUP_A, uc_table(preset("pmma-1.89").spectrum(), 0.5))
-    assert got == pytest.approx(lifetime(pmma, 10.0).lifetime_s, rel=1e-9)
+    assert got == pytest.approx(solve_lifetime(pmma, 10.0, route="paper").lifetime_s, rel=1e-9)
     code, out, _ = _run(capsys, "lifetime", "--cup", "A", "--force", "10", "--surface", "pmma-1.89", "--json")
     assert json.loads(out)[0]["lifetime_s"] == got
     code, out, err = _run(capsys, "lifetime", "--cup", "A", "--force", "10", "--surface", "illustrative")
-    illustrative = lifetime(reference_model(CUP_A, UcTable.from_csv(ILLUSTRATIVE_UC_CSV)), 10.0).lifetime_s
+    illustrative = solve_lifetime(reference_model(CUP_A, UcTable.from_csv(ILLUSTRATIVE_UC_CSV)), 10.0,
+                                  route="paper").lifetime_s
     assert code == 0 and "ILLUSTRATIVE" in err
     assert f"{illustrative:.6g}" in out and abs(illustrative - got) > 1.0
 

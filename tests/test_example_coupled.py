@@ -35,7 +35,7 @@ def coupled_example(tmp_path_factory, table_file):
 def test_coupled_example_lifetimes_are_the_librarys(coupled_example, table_file):
     import pandas as pd
 
-    from reduced.coupled import CoupledCavity
+    import reduced
     from reduced.cup import CUP_A
     from reduced.roughness import uc_table
     from reduced.roughness.surfaces import preset
@@ -47,10 +47,10 @@ def test_coupled_example_lifetimes_are_the_librarys(coupled_example, table_file)
     assert {tuple(r) for r in rows[["route", "contact", "mesh", "surface"]].to_numpy()} == \
         {("coupled", "frictionless", "coarse", "pmma-1.89")}
     table = SuctionTable.from_json(table_file)
-    model = CoupledCavity(table, uc_table(preset("pmma-1.89").spectrum(), 0.5))
+    model = reduced.LeakageModel(cup=CUP_A, suction=table, u_c=uc_table(preset("pmma-1.89").spectrum(), 0.5))
     u_start = table.h1_m - CUP_A.h_start_m
     for F, life, reason in zip(rows.force_N, rows.lifetime_s, rows.reason):
-        expected = model.lifetime(F, u_start)
+        expected = reduced.solve_lifetime(model, F, route="coupled", u_start_m=u_start)
         assert reason == expected.reason
         assert float(life) == pytest.approx(expected.lifetime_s, rel=1e-9)
     held = rows[rows.reason != "over_force"]

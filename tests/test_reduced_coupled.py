@@ -14,7 +14,7 @@ from reduced.coupled_relax import load_strip
 from reduced.critical_gap import illustrative_uc_table
 from reduced.cup import cup_by_name
 from reduced.force_balance import force_balance
-from reduced.lifetime import largest_holdable_force, lifetime, reference_model, solve_lifetime
+from reduced.lifetime import largest_holdable_force, reference_model, solve_lifetime
 from reduced.profile_leak import ContactProfile
 from reduced.suction_table import SuctionTable
 from reduced.viscoelastic import RelaxationModulus, default_relaxation, measurement_contact_time
@@ -102,7 +102,7 @@ def test_kappa_is_the_papers_stiffness_factor(model):
     scaled = replace(model, stiffness=model.stiffness.scaled(2.0))
     for F1 in (10.0, 40.0):
         paper_s = solve_lifetime(stiff, F1, route="paper").lifetime_s
-        assert paper_s == lifetime(scaled, F1).lifetime_s
+        assert paper_s == solve_lifetime(scaled, F1, route="paper").lifetime_s
         assert solve_lifetime(stiff, F1, **COUPLED).lifetime_s == pytest.approx(paper_s, rel=1e-3)
     assert largest_holdable_force(stiff, **COUPLED) == pytest.approx(largest_holdable_force(stiff), rel=1e-2)
 
@@ -119,9 +119,8 @@ def test_interface_gas_bounds_the_lifetime(model):
 
 
 # ----------------------------------------------------------------------------- relaxation
-def _relaxed_on_paper_table(model, n: int, law, phi0_s: float, **kw) -> CoupledCavity:
-    return CoupledCavity(paper_table(model, n, n), model.u_c, model.gas, model.p_a_Pa, interface="p_b",
-                         radial="strip", relaxation=law, phi0_s=phi0_s, **kw)
+#: the coupled route on eq (6)'s strip geometry
+STRIP = {"route": "coupled", "radial": "strip"}
 
 
 def test_flat_relaxation_is_the_quadrature(model):
@@ -130,13 +129,13 @@ def test_flat_relaxation_is_the_quadrature(model):
     < 1e-6 from 1601) to the ODE tolerance (rtol 1e-6; measured 5e-6 / 3.5e-5 / 6e-6 on 41 x 41,
     the kinks of the dp-linear surfaces cost the error control a factor ~30)."""
     flat = RelaxationModulus(np.array([1.0, 10.0]), np.array([4e6, 4e6]))
-    relaxed = _relaxed_on_paper_table(model, 41, flat, 1.0)
-    quadrature = replace(relaxed, relaxation=None, phi0_s=None, samples=6401)
-    u_start = model.cup.h1_m - model.cup.h_start_m
+    quadrature = on_table(model, 41, 41)
+    relaxed = replace(quadrature, relaxation=flat, phi0_s=1.0)
     for F1 in (5.0, 20.0, 60.0):
-        r = relaxed.lifetime(F1, u_start)
-        assert r.reason == "table_edge" and np.allclose(r.kappa, 1.0, rtol=1e-12, atol=0)
-        assert r.lifetime_s == pytest.approx(quadrature.lifetime(F1, u_start).lifetime_s, rel=1e-4)
+        r = solve_lifetime(relaxed, F1, **STRIP)
+        assert r.reason == "table_edge" and np.allclose(r.trajectory["kappa"], 1.0, rtol=1e-12, atol=0)
+        assert r.lifetime_s == pytest.approx(solve_lifetime(quadrature, F1, **STRIP, samples=6401).lifetime_s,
+                                             rel=1e-4)
 
 
 @pytest.fixture(scope="module")
@@ -171,18 +170,16 @@ def test_softening_lengthens_the_lifetime(model):
     drive dp is smaller; the interface does not open, kappa p / E_eff(phi) staying what it was (the
     suction's share beta dp / E_eff even grows). The paper route shows the same sign (117 -> 152 s
     at 5 N with this law)."""
-    u_start = model.cup.h1_m - model.cup.h_start_m
     soft = RelaxationModulus(np.array([1.0, 3e4]), np.array([4e6, 1.8e6]))
     stiff = RelaxationModulus(np.array([1.0, 3e4]), np.array([4e6, 4e6 * 4e6 / 1.8e6]))
-    unrelaxed = CoupledCavity(paper_table(model, 21, 21), model.u_c, model.gas, model.p_a_Pa,
-                              interface="p_b", radial="strip")
+    unrelaxed = on_table(model, 21, 21)
     for F1 in (5.0, 60.0):
-        base = unrelaxed.lifetime(F1, u_start)
-        softer = replace(unrelaxed, relaxation=soft, phi0_s=1.0).lifetime(F1, u_start)
-        stiffer = replace(unrelaxed, relaxation=stiff, phi0_s=1.0).lifetime(F1, u_start)
-        assert softer.kappa[0] == stiffer.kappa[0] == 1.0
+        base = solve_lifetime(unrelaxed, F1, **STRIP)
+        softer = solve_lifetime(replace(unrelaxed, relaxation=soft, phi0_s=1.0), F1, **STRIP)
+        stiffer = solve_lifetime(replace(unrelaxed, relaxation=stiff, phi0_s=1.0), F1, **STRIP)
+        assert softer.trajectory["kappa"][0] == stiffer.trajectory["kappa"][0] == 1.0
         assert stiffer.lifetime_s < base.lifetime_s < softer.lifetime_s
-        assert softer.kappa[-1] < 1.0 < stiffer.kappa[-1]
+        assert softer.trajectory["kappa"][-1] < 1.0 < stiffer.trajectory["kappa"][-1]
 
 
 def test_contact_time_starts_as_the_time(model):
@@ -190,10 +187,10 @@ def test_contact_time_starts_as_the_time(model):
     E_eff(phi) / E_eff(phi0) along the trajectory (phi falls again near the end, where the strip
     moves fast: rdot phi / l > 1), and the CSV columns name both."""
     law = default_relaxation()
-    cc = _relaxed_on_paper_table(model, 21, law, 13.0)
-    r = cc.lifetime(20.0, model.cup.h1_m - model.cup.h_start_m)
-    assert r.phi_s[0] == 0.0 and r.phi_s[1] == pytest.approx(r.t_s[1], rel=1e-2)
-    assert np.allclose(r.kappa, law(r.phi_s) / law(13.0), rtol=1e-12, atol=0)
+    r = solve_lifetime(on_table(model, 21, 21, relaxation=law, phi0_s=13.0), 20.0, **STRIP)
+    phi, t = r.trajectory["phi_s"], r.trajectory["t_s"]
+    assert phi[0] == 0.0 and phi[1] == pytest.approx(t[1], rel=1e-2)
+    assert np.allclose(r.trajectory["kappa"], law(phi) / law(13.0), rtol=1e-12, atol=0)
     assert {"phi_s", "kappa"} <= set(r.trajectory_columns()) and r.summary()["phi_final_s"] > 0
 
 

@@ -11,10 +11,9 @@ from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
 from reduced.cup import CUP_A, CUP_B
 from reduced.fast_curve import CurveRangeError
 from reduced.force_balance import force_balance
-from reduced.lifetime import (largest_holdable_force, lifetime, lifetime_by_quadrature, solve_lifetime,
-                              reference_model)
+from reduced.lifetime import largest_holdable_force, lifetime_by_quadrature, solve_lifetime, reference_model
 from reduced.stiffness_curve import StiffnessCurve
-from reduced.viscoelastic import RelaxationModulus, default_relaxation
+from reduced.viscoelastic import RelaxationModulus, default_relaxation, measurement_contact_time
 
 UC = UcTable.from_csv(ILLUSTRATIVE_UC_CSV)
 REF_A = reference_model(CUP_A, UC)
@@ -67,7 +66,7 @@ def test_tighter_tolerance_converges_to_the_quadrature():
 # ----------------------------------------------------------------- conservation
 def _simpson_leak(r, refine):
     """int Ndot dt over the trajectory by Simpson's rule on each step's `refine`+1 points."""
-    t, q = r.t_s, r.N_dot_per_s
+    t, q = r.trajectory["t_s"], r.trajectory["N_dot_per_s"]
     total = [0.0]
     for i in range(0, t.size - 1, refine):
         h = (t[i + refine] - t[i]) / refine
@@ -77,20 +76,42 @@ def _simpson_leak(r, refine):
     return np.array(total)
 
 
+def _force_residual(model, r) -> np.ndarray:
+    """|G| of eq (7), G = kappa F0(h) + F1 - pi r^2 (p_a - p_b), at every output of the cone route,
+    relative to the largest force term; kappa = E_eff(phi) / E_eff(phi0) with relaxation."""
+    tr = r.trajectory
+    h, rr, pb = 1e-3 * tr["h_mm"], 1e-3 * tr["r_mm"], tr["p_b_Pa"]
+    F0 = np.array([float(model.stiffness.force(x)) for x in h])
+    kappa = np.ones_like(h)
+    if model.relaxation is not None:
+        law = model.relaxation
+        E_ref = law.modulus_and_log_slope(measurement_contact_time(model.cup))[0]
+        kappa = np.array([law.modulus_and_log_slope(max(phi, 0.0))[0] / E_ref for phi in tr["phi_s"]])
+    G = kappa * F0 + r.force_N - np.pi * rr ** 2 * (model.p_a_Pa - pb)
+    return np.abs(G) / (np.abs(kappa * F0) + r.force_N + np.pi * rr ** 2 * model.p_a_Pa)
+
+
+def _ideal_gas(model, r) -> np.ndarray:
+    """N of eq (8), p_b V(r) / kT with V of eq (4), at every output of the cone route."""
+    kT = 1.380649e-23 * model.gas.T_K
+    return r.trajectory["p_b_Pa"] * np.array([model.cup.volume(x) for x in 1e-3 * r.trajectory["r_mm"]]) / kT
+
+
 @pytest.mark.parametrize("relaxed", [False, True])
 def test_mass_balance_and_force_balance_at_every_output(relaxed):
     model = dataclasses.replace(REF_A, relaxation=default_relaxation()) if relaxed else REF_A
     refine = 8
-    r = lifetime(model, 20.0, rtol=1e-8, refine=refine)
+    r = solve_lifetime(model, 20.0, route="paper", rtol=1e-8, refine=refine)
     # force balance eq (7) with eq (8) at every output, relative to the largest force term
-    assert r.force_residual.max() < 1e-9
+    assert _force_residual(model, r).max() < 1e-9
     # N(t) - N(0) = int Ndot dt: N comes from the integrator, Ndot is recomputed from the projected
     # state. Simpson's error on (t_step/8) is far below the solver's 1e-8.
     leaked = _simpson_leak(r, refine)
-    N_steps = r.N[::refine]
-    np.testing.assert_allclose(N_steps - r.N0, leaked, rtol=0, atol=1e-6 * (r.N[-1] - r.N0))
+    N = r.trajectory["N"]
+    N_steps = N[::refine]
+    np.testing.assert_allclose(N_steps - N[0], leaked, rtol=0, atol=1e-6 * (N[-1] - N[0]))
     # and the gas content is the ideal gas of eq (8) in the cavity
-    assert np.all(np.diff(r.N) >= 0) and r.N[0] == pytest.approx(r.N0, rel=1e-15)
+    assert np.all(np.diff(N) >= 0) and N == pytest.approx(_ideal_gas(model, r), rel=1e-10)
 
 
 # ----------------------------------------------------------------- limits in u_c
@@ -158,11 +179,12 @@ def test_relaxation_with_a_constant_modulus_is_the_reference_model():
 
 
 def test_relaxation_changes_the_lifetime_and_keeps_the_invariants():
-    r = lifetime(dataclasses.replace(REF_A, relaxation=default_relaxation()), 20.0)
-    ref = lifetime(REF_A, 20.0)
+    relaxed = dataclasses.replace(REF_A, relaxation=default_relaxation())
+    r = solve_lifetime(relaxed, 20.0, route="paper")
+    ref = solve_lifetime(REF_A, 20.0, route="paper")
     assert r.reason in ("reached_r1", "fold") and r.lifetime_s != pytest.approx(ref.lifetime_s, rel=1e-2)
-    assert r.force_residual.max() < 1e-9
-    assert np.all(r.phi_s >= 0) and np.all(np.diff(r.t_s) > 0)
+    assert _force_residual(relaxed, r).max() < 1e-9
+    assert np.all(r.trajectory["phi_s"] >= 0) and np.all(np.diff(r.trajectory["t_s"]) > 0)
 
 
 def test_curve_geometry_sampled_from_the_cone_reproduces_the_cone():
@@ -182,41 +204,40 @@ def test_leaving_the_stiffness_curve_is_an_error_not_a_clamp():
     u = np.linspace(0, 3e-3, 31)                      # r_start needs u = 4.5 mm
     short = StiffnessCurve(u, 2.5e3 * u, CUP_A.h1_m, provenance={"source": "short"})
     with pytest.raises(CurveRangeError, match="outside the curve's range"):
-        lifetime(dataclasses.replace(REF_A, stiffness=short), 10.0)
+        solve_lifetime(dataclasses.replace(REF_A, stiffness=short), 10.0, route="paper")
     u = np.linspace(1e-3, CUP_A.h1_m, 81)            # starts at u = 1 mm: cannot reach r1
     late = StiffnessCurve(u, 2.5e3 * u, CUP_A.h1_m, provenance={"source": "late"})
     with pytest.raises(CurveRangeError, match="extend it to u = 0"):
-        lifetime(dataclasses.replace(REF_A, stiffness=late), 10.0)
+        solve_lifetime(dataclasses.replace(REF_A, stiffness=late), 10.0, route="paper")
     with pytest.raises(ValueError, match="geometry: 'curve' needs"):
-        lifetime(dataclasses.replace(REF_A, geometry="curve"), 10.0)
+        solve_lifetime(REF_A, 10.0, route="paper", cup_laws="curve")
 
 
 @pytest.mark.parametrize("force", [0.0, -3.0, float("nan"), float("inf")])
 def test_bad_force_is_rejected(force):
     with pytest.raises(ValueError, match="force_N: pull force must be > 0 N"):
-        lifetime(REF_A, force)
-    with pytest.raises(ValueError, match="force_N: pull force must be > 0 N"):
-        solve_lifetime(REF_A, force)
+        solve_lifetime(REF_A, force, route="paper")
 
 
 def test_initial_state_and_leak_rate_by_hand():
     """t = 0+ from eqs (3)-(9), (20), (23) written out here, independently of the model's code."""
     F1, c = 20.0, CUP_A
-    r = lifetime(REF_A, F1)
+    r = solve_lifetime(REF_A, F1, route="paper")
+    tr = r.trajectory
     k_B, T, pa = 1.380649e-23, 293.15, 1e5
     kT = k_B * T
-    h, rr = r.h_m[0], r.r_m[0]
+    h, rr = 1e-3 * tr["h_mm"][0], 1e-3 * tr["r_mm"][0]
     F0 = appendix_a_force(c.h1_m - h, 33.0, 4e6, 2e-3, c.r0_m, c.r1_m)
     V = math.pi * c.r0_m ** 2 * c.h0_m / 3 * ((rr / c.r0_m) ** 3 - 1)          # eq (4)
     pb = pa - (F0 + F1) / (math.pi * rr ** 2)                                   # eq (7)
-    assert r.p_b_Pa[0] == pytest.approx(pb, rel=1e-10)
-    assert r.N0 == pytest.approx(pb * V / kT, rel=1e-10)                        # eq (8), N fixed at t=0
+    assert tr["p_b_Pa"][0] == pytest.approx(pb, rel=1e-10)
+    assert tr["N"][0] == pytest.approx(pb * V / kT, rel=1e-10)                  # eq (8), N fixed at t=0
     l = 4e-3 + (0.8e-3 - 4e-3) / (1 - 19 / 5) * (1 - rr / c.r0_m)             # eq (5)
     p = F0 / (2 * math.pi * rr * l) + 0.8 * (pa - pb)                            # eq (6)
     # the model's F0 is the PCHIP of 401 samples of the closed form: ~1e-7 relative (see inputs tests)
-    assert r.p_Pa[0] == pytest.approx(p, rel=1e-7)
+    assert tr["p_Pa"][0] == pytest.approx(p, rel=1e-7)
     uc = 0.68e-6 * (p / 4e6 / 0.025) ** -1                                       # the illustrative law
-    assert r.u_c_m[0] == pytest.approx(uc, rel=1e-7)
+    assert 1e-9 * tr["u_c_nm"][0] == pytest.approx(uc, rel=1e-7)
     m = 28.97 * 1.66053906660e-27
     vbar = math.sqrt(8 * kT / (math.pi * m))                                     # eq (11)
     lam_a = 3 * 1.81e-5 / (m * (pa / kT) * vbar)                                 # eq (12)
@@ -224,7 +245,7 @@ def test_initial_state_and_leak_rate_by_hand():
     lam = 0.5 * (pa * lam_a + pb * lam_b) / (pa + pb)                            # eq (20)
     Ndot = (2 * math.pi * rr / l) * (pa ** 2 - pb ** 2) / (24 * kT) * uc ** 3 / 1.81e-5 * (
         1 + 32 / math.pi * lam / uc)                                             # eqs (9), (23)
-    assert r.N_dot_per_s[0] == pytest.approx(Ndot, rel=1e-6)
+    assert tr["N_dot_per_s"][0] == pytest.approx(Ndot, rel=1e-6)
 
 
 def test_water_filled_cavity_eq24_against_an_independent_ode():
@@ -232,8 +253,8 @@ def test_water_filled_cavity_eq24_against_an_independent_ode():
     from scipy.integrate import solve_ivp
     water = dataclasses.replace(REF_A, fluid="water")
     F1, c = 40.0, CUP_A
-    r = lifetime(water, F1)
-    assert r.reason == "reached_r1" and r.h_m[0] == pytest.approx(c.h_start_m, rel=1e-14)
+    r = solve_lifetime(water, F1, route="paper")
+    assert r.reason == "reached_r1" and 1e-3 * r.trajectory["h_mm"][0] == pytest.approx(c.h_start_m, rel=1e-14)
     assert r.lifetime_s == pytest.approx(lifetime_by_quadrature(water, F1), rel=1e-4)
     assert "V_liquid_mm3" in r.trajectory_columns() and r.summary()["largest_force_N"] is None
 
@@ -267,7 +288,8 @@ def test_curve_geometry_with_a_vanishing_strip_width_is_a_sealing_line_contact()
     strip = CUP_A.l0_m + CUP_A.l_a_m * (1.0 - x)
     l = np.where(u < 0.1 * CUP_A.h1_m, 0.0, strip)
     kw = dict(u_m=u, F0_N=2.5e3 * u, h1_m=CUP_A.h1_m, r_c_m=CUP_A.r0_m * x, V_m3=CUP_A.V0_m3 * (x ** 3 - 1.0))
-    line = lifetime(dataclasses.replace(REF_A, stiffness=StiffnessCurve(l_m=l, **kw), geometry="curve"), 20.0)
+    line = solve_lifetime(dataclasses.replace(REF_A, stiffness=StiffnessCurve(l_m=l, **kw)), 20.0, route="paper",
+                          cup_laws="curve")
     assert line.reason == "sealed" and math.isinf(line.lifetime_s) and "line contact" in line.message
     sealed_h = float(line.message.split("h = ")[1].split(" mm")[0]) * 1e-3
     # PCHIP keeps l = 0 from the last zero sample u_z on: the first point of the fold-search grid
@@ -275,7 +297,8 @@ def test_curve_geometry_with_a_vanishing_strip_width_is_a_sealing_line_contact()
     u_z = u[u < 0.1 * CUP_A.h1_m][-1]
     assert CUP_A.h1_m - u_z - 1e-6 <= sealed_h <= CUP_A.h1_m - u_z + CUP_A.h1_m / 1200 + 1e-6
     # the same curve with the strip everywhere leaks to r1 in finite time
-    open_ = lifetime(dataclasses.replace(REF_A, stiffness=StiffnessCurve(l_m=strip, **kw), geometry="curve"), 20.0)
+    open_ = solve_lifetime(dataclasses.replace(REF_A, stiffness=StiffnessCurve(l_m=strip, **kw)), 20.0,
+                           route="paper", cup_laws="curve")
     assert open_.reason in ("reached_r1", "fold") and 0 < open_.lifetime_s < math.inf
 
 
@@ -308,19 +331,20 @@ def test_water_cavitation_against_a_hand_written_bubble_ode():
     top.terminal = True
     sol = solve_ivp(Vdot, (0, 1e9), [volume(c.h_start_m)], method="LSODA", rtol=1e-10, atol=1e-15,
                     events=top)
-    r = lifetime(water, F1)
+    r = solve_lifetime(water, F1, route="paper")
     assert r.reason == "reached_r1" and "cavitation at t = 0" in r.message
-    assert r.h_m[0] == pytest.approx(hc, rel=1e-9) and r.p_b_Pa[0] == pytest.approx(p_cav, rel=1e-6)
+    assert 1e-3 * r.trajectory["h_mm"][0] == pytest.approx(hc, rel=1e-9)
+    assert r.trajectory["p_b_Pa"][0] == pytest.approx(p_cav, rel=1e-6)
     # PCHIP of the Appendix A force (1e-7) and the integration at rtol 1e-6
     assert r.lifetime_s == pytest.approx(sol.t_events[0][0], rel=1e-5)
     assert lifetime_by_quadrature(water, F1) == pytest.approx(r.lifetime_s, rel=1e-4)
     # it shortens the metastable (tension) lifetime; below the cavitation load nothing changes
-    assert r.lifetime_s < lifetime(dataclasses.replace(water, cavitation_pressure_Pa=None), F1).lifetime_s
-    low = lifetime(water, 20.0)
-    assert low.p_b_Pa[0] > p_cav and "cavitation" not in low.message
+    assert r.lifetime_s < solve_lifetime(dataclasses.replace(water, cavitation_pressure_Pa=None), F1).lifetime_s
+    low = solve_lifetime(water, 20.0, route="paper")
+    assert low.trajectory["p_b_Pa"][0] > p_cav and "cavitation" not in low.message
     # the largest holdable force: the capacity at r1, where F0 = 0
     assert largest_holdable_force(water) == pytest.approx(math.pi * c.r1_m ** 2 * (1e5 - p_cav), rel=1e-9)
-    assert lifetime(water, 111.0).reason == "over_force"
+    assert solve_lifetime(water, 111.0, route="paper").reason == "over_force"
 
 
 @pytest.mark.parametrize("kw,match", [({"cavitation_pressure_Pa": 2339.0}, "only for fluid 'water'"),
@@ -331,10 +355,9 @@ def test_bad_cavitation_pressure_is_rejected(kw, match):
         dataclasses.replace(REF_A, **kw)
 
 
-def test_profile_seal_of_a_uniform_strip_is_the_papers_strip_on_an_annulus():
-    """A curve whose profiles are eq (6)'s uniform strip (p = F0 / (2 pi r l) on [r, r + l]): the
-    profile seal's flow is the strip seal's times the annulus factor l / (r ln(1 + l/r)) at every
-    state (the paper's flat strip vs the exact ring), so the lifetime is a little shorter."""
+def _uniform_strip_curve():
+    """Cup A's Appendix A spring with the cone's r, l, V, and eq (6)'s uniform strip as its contact
+    pressure profiles (p = F0 / (2 pi r l) on [r, r + l]); also (h, r, l) at the samples."""
     from reduced.profile_leak import ContactProfile
 
     u = np.linspace(0.0, 0.8 * CUP_A.h1_m, 60)
@@ -346,15 +369,24 @@ def test_profile_seal_of_a_uniform_strip_is_the_papers_strip_on_an_annulus():
                          for ri, li, F in zip(r[1:], l[1:], F0[1:])]
     curve = StiffnessCurve(u_m=u, F0_N=F0, h1_m=CUP_A.h1_m, r_c_m=r, l_m=l, V_m3=CUP_A.V0_m3 * (x ** 3 - 1),
                            profiles=profiles)
-    strip = dataclasses.replace(REF_A, stiffness=curve, geometry="curve")
-    prof = dataclasses.replace(strip, seal="profile")
+    return curve, h, r, l
+
+
+def test_profile_seal_of_a_uniform_strip_is_the_papers_strip_on_an_annulus():
+    """A curve whose profiles are eq (6)'s uniform strip: the profile seal's flow is the strip
+    seal's times the annulus factor l / (r ln(1 + l/r)) at every state (the paper's flat strip vs
+    the exact ring), so the lifetime is a little shorter."""
+    curve, h, r, l = _uniform_strip_curve()
+    model = dataclasses.replace(REF_A, stiffness=curve)
+    strip, prof = force_balance(model, "curve", "strip"), force_balance(model, "curve", "profile")
     for hh in (0.3 * CUP_A.h1_m, 0.6 * CUP_A.h1_m):
         i = int(np.argmin(np.abs(h - hh)))                   # at a sample: no interpolation between profiles
-        N = 0.5 * force_balance(strip).n_eq(h[i], 1.0, 0.0)[0]
-        q_strip = force_balance(strip).state(h[i], N, 1.0, 4e6, 10.0)[0]
-        q_prof = force_balance(prof).state(h[i], N, 1.0, 4e6, 10.0)[0]
+        N = 0.5 * strip.n_eq(h[i], 1.0, 0.0)[0]
+        q_strip = strip.state(h[i], N, 1.0, 4e6, 10.0)[0]
+        q_prof = prof.state(h[i], N, 1.0, 4e6, 10.0)[0]
         assert q_prof / q_strip == pytest.approx(l[i] / (r[i] * math.log(1 + l[i] / r[i])), rel=1e-9)
-    t_strip, t_prof = lifetime(strip, 20.0).lifetime_s, lifetime(prof, 20.0).lifetime_s
+    t_strip = solve_lifetime(model, 20.0, route="paper", cup_laws="curve").lifetime_s
+    t_prof = solve_lifetime(model, 20.0, route="profile").lifetime_s
     assert 0.85 * t_strip < t_prof < t_strip
     with pytest.raises(ValueError, match="seal: the profile's radii are the FEM's"):
-        dataclasses.replace(prof, geometry="cone")
+        force_balance(model, "cone", "profile")

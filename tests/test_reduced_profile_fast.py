@@ -51,8 +51,12 @@ def _curve(samples: int = 40) -> StiffnessCurve:
 
 
 def _model(uc, **kw):
-    return dataclasses.replace(reference_model(CUP_A, uc), stiffness=_curve(), geometry="curve",
-                               seal="profile", **kw)
+    return dataclasses.replace(reference_model(CUP_A, uc), stiffness=_curve(), **kw)
+
+
+def _profile(model, exact: bool = False):
+    """The profile route's force balance (the curve's laws, the profile seal)."""
+    return force_balance(model, "curve", "profile", exact=exact)
 
 
 def _sealing_table(at: float = 0.01) -> UcTable:
@@ -95,7 +99,7 @@ def test_the_flow_table_follows_the_direct_flow(pmma, fluid):
     p_a): within 2e-6 (measured 1e-6 near the grid's high-p_b end, ~1e-7 elsewhere); outside the
     grid the direct flow is used."""
     model = _model(pmma, fluid=fluid)
-    seal = force_balance(model).seal
+    seal = _profile(model).seal
     assert seal.tabulate_at == (1.0, E) and seal.patch_length_m == pmma.patch_length_m
     pb = np.concatenate([np.geomspace(150.0, 0.99 * P_A, 25), P_A - np.geomspace(1.0, 1e3, 6)])
     worst = 0.0
@@ -112,7 +116,7 @@ def test_the_tabulated_flows_outputs_are_the_direct_ones(pmma):
     """Where the table gives Ndot, the peak pressure is the same and u_c (the narrowest gap, at the
     highest ring pressure since u_c falls with p) the same to round-off; the share follows u_c."""
     model = _model(pmma)
-    fast, direct = force_balance(model).seal, force_balance(model, exact=True).seal
+    fast, direct = _profile(model).seal, _profile(model, exact=True).seal
     for u in (0.7e-3, 2.5e-3, 4.1e-3, 6e-3):
         for pb in (3e3, 5e4, 9.5e4):
             a, b = fast.flow(0.0, 0.0, 0.0, pb, 1.0, E, u), direct.flow(0.0, 0.0, 0.0, pb, 1.0, E, u)
@@ -122,7 +126,7 @@ def test_the_tabulated_flows_outputs_are_the_direct_ones(pmma):
 
 
 def test_the_rate_is_the_flows_first_entry_on_the_direct_path(pmma):
-    seal = force_balance(_model(pmma), exact=True).seal
+    seal = _profile(_model(pmma), exact=True).seal
     assert seal.tabulate_at is None
     for u in (1e-3, 2.5e-3, 4e-3):
         for pb in (0.0, 3e4, 9e4):
@@ -174,8 +178,8 @@ def test_tabulated_lifetimes_agree_with_the_direct_path(pmma, fluid):
         fast, direct = solve_lifetime(model, F, route="profile"), solve_lifetime(model, F, route="profile", exact=True)
         assert fast.reason == direct.reason == "reached_r1"
         assert fast.lifetime_s == pytest.approx(direct.lifetime_s, rel=1e-3)
-        q_fast = lifetime_by_quadrature(model, F, epsrel=1e-10)
-        q_direct = lifetime_by_quadrature(model, F, epsrel=1e-10, exact=True)
+        q_fast = lifetime_by_quadrature(model, F, route="profile", epsrel=1e-10)
+        q_direct = lifetime_by_quadrature(model, F, route="profile", epsrel=1e-10, exact=True)
         assert q_fast == pytest.approx(q_direct, rel=1e-8)
         assert direct.lifetime_s == pytest.approx(q_direct, rel=1e-3)
 
@@ -183,7 +187,7 @@ def test_tabulated_lifetimes_agree_with_the_direct_path(pmma, fluid):
 def test_relaxation_keeps_the_direct_path(pmma):
     """With relaxation kappa and E change along the way: no table, the same lifetime to the bit."""
     model = _model(pmma, relaxation=default_relaxation())
-    assert force_balance(model).seal.tabulate_at is None
+    assert _profile(model).seal.tabulate_at is None
     a = solve_lifetime(model, 20.0, route="profile")
     assert a.lifetime_s == solve_lifetime(model, 20.0, route="profile", exact=True).lifetime_s
 
@@ -213,5 +217,5 @@ def test_the_main_jobs_lifetimes_tabulated_against_direct():
             fast = solve_lifetime(m, F, route="profile", refine=2)
             direct = solve_lifetime(m, F, route="profile", refine=2, exact=True)
             assert fast.lifetime_s == pytest.approx(direct.lifetime_s, rel=1e-3), F
-            assert lifetime_by_quadrature(m, F, epsrel=1e-10) == pytest.approx(
-                lifetime_by_quadrature(m, F, epsrel=1e-10, exact=True), rel=1e-8), F
+            assert lifetime_by_quadrature(m, F, route="profile", epsrel=1e-10) == pytest.approx(
+                lifetime_by_quadrature(m, F, route="profile", epsrel=1e-10, exact=True), rel=1e-8), F

@@ -90,7 +90,7 @@ def test_a_registered_route_is_dispatched(paper):
     ({}, {"route": "profile"}, "stiffness: the profile route needs a curve with contact-pressure"),
     ({"stiffness": None}, {"route": "paper"}, "stiffness: the paper route needs"),
     ({"u_c": None}, {"route": "paper"}, "u_c: the paper route needs"),
-    ({"geometry": "curve", "seal": "profile"}, {"route": "paper"}, "seal: the model asks for the 'profile'"),
+    ({}, {"route": "profile", "cup_laws": "curve"}, "cup_laws: not an option of route 'profile'"),
 ])
 def test_refusals_name_the_field(paper, change, kw, field):
     model = replace(paper, **change)
@@ -135,14 +135,12 @@ def test_the_paper_route_is_its_quadrature(paper):
         assert life.lifetime_s == pytest.approx(lifetime_by_quadrature(paper, F1), rel=1e-6)
 
 
-def test_the_legacy_spelling_of_the_route_is_the_route(profiled):
-    """seal='profile' (with geometry='curve') on the model is route='profile'; geometry='curve'
-    alone is the paper route's cup_laws='curve'."""
-    legacy = replace(profiled, geometry="curve", seal="profile")
-    assert solve_lifetime(legacy, 10.0).summary() == solve_lifetime(profiled, 10.0, route="profile").summary()
-    curve = replace(profiled, geometry="curve")
-    assert solve_lifetime(curve, 10.0).summary() == solve_lifetime(profiled, 10.0, cup_laws="curve").summary()
-    assert solve_lifetime(curve, 10.0).summary() != solve_lifetime(profiled, 10.0).summary()
+def test_the_paper_routes_cup_laws_default_to_the_cone(profiled):
+    """The route, not the model, chooses the cup laws: no route is the paper route on the cone."""
+    assert solve_lifetime(profiled, 10.0).summary() == solve_lifetime(profiled, 10.0, route="paper",
+                                                                      cup_laws="cone").summary()
+    assert solve_lifetime(profiled, 10.0, cup_laws="curve").summary() != solve_lifetime(profiled, 10.0).summary()
+    assert not hasattr(profiled, "seal") and not hasattr(profiled, "geometry")
 
 
 def test_import_reduced_is_cheap_and_exposes_its_nouns():

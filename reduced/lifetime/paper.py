@@ -1,4 +1,5 @@
-"""The paper and profile routes' lifetime: the leakage dynamics of Sec. 3 (eqs 3-10), flow of Sec. 4.
+"""The paper and profile routes' integrator (private to them, `reduced.lifetime.routes`): the
+leakage dynamics of Sec. 3 (eqs 3-10), flow of Sec. 4.
 
 State and equations. The gas content N of the cavity and (with relaxation) the contact-time state
 phi evolve in time; the cup height h is algebraic, fixed by the force balance
@@ -50,13 +51,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 from reduced.fast_curve import CurveRangeError
-from reduced.force_balance import ForceBalance, force_balance
-from reduced.model import LeakageModel
-from reduced.lifetime.result import LifetimeResult
+from reduced.force_balance import ForceBalance
+from reduced.lifetime.result import _PaperRecord
 from reduced.ode import dopri5
 
-__all__ = ["lifetime", "lifetime_sweep", "integrate", "start_height",
-           "sealed_on_branch", "check_run"]
+__all__ = ["integrate", "start_height", "sealed_on_branch", "check_run"]
 _DYNAMIC_FOLD = 1e-4  # |D| / |D(0)| at which the relaxed dynamics is declared singular
 
 
@@ -73,15 +72,6 @@ def check_run(force_N: float, t_max_s: float, rtol: float, refine: int) -> float
     return F1
 
 
-def lifetime(model: LeakageModel, force_N: float, *, t_max_s: float = 1e12, rtol: float = 1e-6,
-             refine: int = 1, progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
-    """Lifetime [s] of the cup under the pull force F1 = force_N, with trajectories, on the route
-    the model's `geometry` and `seal` name (`integrate`; `reduced.solve_lifetime` takes the route
-    by name and returns the common `Lifetime`)."""
-    return integrate(force_balance(model), force_N, t_max_s=t_max_s, rtol=rtol, refine=refine,
-                     progress=progress)
-
-
 def start_height(core: ForceBalance, F1: float) -> float:
     """h at t = 0 under F1 < the largest holdable force: F1 applied at the start content N0."""
     hs, N0, kappa0, Fmax, hm = core.initial
@@ -90,7 +80,7 @@ def start_height(core: ForceBalance, F1: float) -> float:
 
 
 def integrate(core: ForceBalance, force_N: float, *, t_max_s: float = 1e12, rtol: float = 1e-6,
-              refine: int = 1, progress: Callable[[float, str], None] | None = None) -> LifetimeResult:
+              refine: int = 1, progress: Callable[[float, str], None] | None = None) -> _PaperRecord:
     """Lifetime [s] of the cup of `core` under the pull force F1 = force_N, with trajectories.
 
     Integrates N (and phi with relaxation) by an adaptive Dormand-Prince pair with terminal events;
@@ -129,7 +119,7 @@ def _outputs(sol, refine: int) -> tuple[list, list]:
     return ts, ys
 
 
-def _run_reference(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) -> LifetimeResult:
+def _run_reference(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) -> _PaperRecord:
     h_end, reason = core.branch_end(h0, 1.0, F1)
     N_end = core.n_eq(h_end, 1.0, F1)[0]
     E = core.m.E_Pa
@@ -221,7 +211,7 @@ def _cavitation_note(core: ForceBalance, F1: float, N0: float, h0: float, N_h0: 
             f"{p_cav:g} Pa let the cup rise to h_c = {1e3 * h0:.4g} mm")
 
 
-def _run_relaxed(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) -> LifetimeResult:
+def _run_relaxed(core: ForceBalance, F1, N0, h0, Fmax, t_max, rtol, refine) -> _PaperRecord:
     last = {"h": h0}
 
     def solve(N: float, phi: float):
@@ -319,7 +309,7 @@ def _end_message(reason: str, t: float) -> str:
     return f"detached at t = {t:.6g} s: {what}"
 
 
-def _result(core: ForceBalance, F1, t_life, reason, msg, Fmax, N0, ts, ys, hs, steps) -> LifetimeResult:
+def _result(core: ForceBalance, F1, t_life, reason, msg, Fmax, N0, ts, ys, hs, steps) -> _PaperRecord:
     rows = []
     for t, y, h in zip(ts, ys, hs):
         N, phi = y[0], max(y[1], 0.0)
@@ -331,19 +321,8 @@ def _result(core: ForceBalance, F1, t_life, reason, msg, Fmax, N0, ts, ys, hs, s
     a = np.array(rows, dtype=float).T
     for arr in a:
         arr.flags.writeable = False
-    return LifetimeResult(force_N=F1, lifetime_s=float(t_life), reason=reason, message=msg,
+    return _PaperRecord(force_N=F1, lifetime_s=float(t_life), reason=reason, message=msg,
                           fluid=core.m.fluid,
                           largest_force_N=float(Fmax), N0=float(N0), t_s=a[0], r_m=a[1], h_m=a[2],
                           p_b_Pa=a[3], p_Pa=a[4], u_c_m=a[5], N=a[6], N_dot_per_s=a[7], phi_s=a[8],
                           ballistic_share_t=a[9], force_residual=a[10], steps=steps)
-
-
-def lifetime_sweep(model: LeakageModel, forces_N, progress=None, **kw) -> list[LifetimeResult]:
-    """`lifetime` for each force (sharing the model's precomputation)."""
-    forces = [float(f) for f in forces_N]
-    out = []
-    for i, F1 in enumerate(forces):
-        out.append(lifetime(model, F1, **kw))
-        if progress:
-            progress((i + 1) / len(forces), f"F1 = {F1:g} N")
-    return out

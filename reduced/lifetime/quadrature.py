@@ -10,25 +10,29 @@ import math
 
 from scipy.integrate import quad
 
-from reduced.force_balance import force_balance
 from reduced.lifetime.paper import sealed_on_branch, start_height
+from reduced.lifetime.routes import _resolve
 from reduced.model import LeakageModel
 
 __all__ = ["lifetime_by_quadrature"]
 
 
-def lifetime_by_quadrature(model: LeakageModel, force_N: float, epsrel: float = 1e-10,
-                           exact: bool = False) -> float:
+def lifetime_by_quadrature(model: LeakageModel, force_N: float, *, route: str = "paper",
+                           epsrel: float = 1e-10, **route_options) -> float:
     """Reference-mode lifetime as t = int_{h(0+)}^{h_end} (dN_eq/dh) / Ndot(h) dh (no time stepping).
 
-    An independent evaluation for checking `lifetime`: without relaxation the state is
+    An independent evaluation for checking `solve_lifetime` on `route` ('paper' or 'profile', with
+    their options, e.g. cup_laws='curve' or exact=True): without relaxation the state is
     one-dimensional and the time to move along the equilibrium branch is a quadrature.
-    Returns inf if u_c vanishes on the branch and 0 for an over-force. exact: the profile seal
-    solves every flow directly (`force_balance`).
+    Returns inf if u_c vanishes on the branch and 0 for an over-force.
     """
     if not model.reference:
         raise ValueError("lifetime_by_quadrature: only without relaxation (reference mode)")
-    core = force_balance(model, exact=exact)
+    impl, options = _resolve(model, route, route_options)
+    if not hasattr(impl, "core"):
+        raise ValueError(f"route: the quadrature follows the paper and profile routes' force balance, "
+                         f"not route {route!r}")
+    core = impl.core(model, options)
     F1 = float(force_N)
     if not (math.isfinite(F1) and F1 > 0):
         raise ValueError(f"force_N: pull force must be > 0 N, got {force_N}")

@@ -1,6 +1,6 @@
 """The one result type of every lifetime route (`Lifetime`), the one vocabulary of how a lifetime
-ends (`REASONS`), and the paper integrator's own record (`LifetimeResult`, SI arrays) that the
-paper and profile routes turn into a `Lifetime`."""
+ends (`REASONS`), and the paper integrator's own record (`_PaperRecord`, SI arrays), private to
+the paper and profile routes, which turn it into a `Lifetime`."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Lifetime", "LifetimeResult", "REASONS"]
+__all__ = ["Lifetime", "REASONS"]
 
 #: How a lifetime ends, on every route:
 #: "reached_r1"  the contact radius reached r1: the cup let go (paper and profile routes)
@@ -90,7 +90,7 @@ class Lifetime:
 
 
 @dataclass(frozen=True, eq=False)
-class LifetimeResult:
+class _PaperRecord:
     """Lifetime and trajectories (SI). lifetime_s is inf when sealed or beyond the horizon."""
 
     force_N: float

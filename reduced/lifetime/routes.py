@@ -25,7 +25,7 @@ from typing import Any, Protocol
 from reduced.coupled import CoupledCavity
 from reduced.force_balance import force_balance
 from reduced.lifetime.paper import check_run, integrate
-from reduced.lifetime.result import Lifetime, LifetimeResult
+from reduced.lifetime.result import Lifetime, _PaperRecord
 from reduced.model import LeakageModel
 from reduced.viscoelastic import measurement_contact_time
 
@@ -93,7 +93,7 @@ class _StripOrProfile:
     def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
         return float(self.core(model, options).initial[3])
 
-    def result(self, record: LifetimeResult, model: LeakageModel, run: Run, options: dict) -> Lifetime:
+    def result(self, record: _PaperRecord, model: LeakageModel, run: Run, options: dict) -> Lifetime:
         return Lifetime(route=self.name, force_N=record.force_N, lifetime_s=record.lifetime_s,
                         reason=record.reason, message=record.message,
                         largest_force_N=record.largest_force_N, trajectory=record.trajectory_columns(),
@@ -103,21 +103,19 @@ class _StripOrProfile:
 
 
 class PaperRoute(_StripOrProfile):
-    """Eqs (3)-(10) with the uniform strip of eq (6); cup_laws 'cone' or 'curve' (None: the model's
-    legacy `geometry`)."""
+    """Eqs (3)-(10) with the uniform strip of eq (6); cup_laws 'cone' (the default; None is the
+    same) or 'curve'."""
 
     name = "paper"
-    options = {"cup_laws": None}
+    options = {"cup_laws": "cone"}
 
     def laws(self, model: LeakageModel, options: Mapping[str, Any]) -> str:
-        return options["cup_laws"] or model.geometry
+        return options["cup_laws"] or "cone"
 
     def check(self, model: LeakageModel, options: Mapping[str, Any]) -> None:
         super().check(model, options)
         if options["cup_laws"] not in (None, "cone", "curve"):
             raise ValueError(f"cup_laws: expected 'cone' or 'curve', got {options['cup_laws']!r}")
-        if model.seal != "strip":
-            raise ValueError(f"seal: the model asks for the '{model.seal}' seal: that is route='profile'")
 
 
 class ProfileRoute(_StripOrProfile):
@@ -182,7 +180,7 @@ class CoupledRoute:
     def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
         cc, u_start, cache = self.cavity(model, options)
         if "largest" not in cache:
-            cache["largest"] = float(cc.largest_holdable_force(u_start))
+            cache["largest"] = float(cc._largest_force(u_start))
         return cache["largest"]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
@@ -190,7 +188,7 @@ class CoupledRoute:
             raise ValueError(f"refine: the coupled route has no dense output, got {run.refine}")
         check_run(force_N, run.t_max_s, run.rtol, run.refine)
         cc, u_start, _ = self.cavity(model, options)
-        record = cc.lifetime(force_N, u_start, t_max_s=run.t_max_s, rtol=run.rtol)
+        record = cc._lifetime(force_N, u_start, t_max_s=run.t_max_s, rtol=run.rtol)
         if run.progress:
             run.progress(1.0, f"F1 = {record.force_N:g} N: {record.reason}")
         return Lifetime(route=self.name, force_N=record.force_N, lifetime_s=record.lifetime_s,
@@ -227,7 +225,7 @@ def _resolve(model: LeakageModel, route: str | None, given: Mapping[str, Any]) -
     """The route object and its full options (defaults filled in); ValueError naming the field."""
     if not isinstance(model, LeakageModel):
         raise ValueError(f"model: expected a LeakageModel, got {type(model).__name__}")
-    name = route if route is not None else ("profile" if model.seal == "profile" else "paper")
+    name = route if route is not None else "paper"
     impl = ROUTES.get(name) if isinstance(name, str) else None
     if impl is None:
         raise ValueError(f"route: unknown route {name!r}; registered: {', '.join(ROUTES)}")
@@ -244,7 +242,7 @@ def solve_lifetime(model: LeakageModel, force_N: float, *, route: str | None = N
                    t_max_s: float = 1e12, rtol: float = 1e-6, refine: int = 1,
                    progress: Callable[[float, str], None] | None = None, **route_options) -> Lifetime:
     """The lifetime of `model`'s cup under the pull force F1 = force_N [N] on `route` (a name in
-    `ROUTES`; None: 'paper', or 'profile' for a model with the legacy seal='profile').
+    `ROUTES`; None: 'paper').
 
     t_max_s: the horizon; rtol: the integrator's relative tolerance; refine: output points per
     accepted step (dense output); route_options: the route's own (`ROUTES[name].options`). Bad

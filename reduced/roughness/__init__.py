@@ -11,7 +11,7 @@ contact area, mean separation), `persson` (critical junction, the u_c table), `e
 """
 
 from .line_scan import read_line_scan, spectrum_from_line_scan
-from .persson import GapTable, critical_gap_table, uc_table  # noqa: F401  (GapTable: the former name of UcTable)
+from .persson import critical_gap_table, uc_table
 from .spectrum import PowerSpectrum, read_psd_csv, self_affine
 from .surfaces import load_presets, preset
 

@@ -61,9 +61,6 @@ def critical_junction_gap(mom: Moments, pstar: np.ndarray, gamma: float = 0.45,
 METHODS = ("emt", "critical-junction")
 
 
-#: the former name of the theory's result, now the one u_c table type (`reduced.critical_gap.UcTable`)
-GapTable = UcTable
-
 
 def check_gap_parameters(p_over_E: np.ndarray, method: str, gamma: float, a_c: float) -> None:
     """Raise ValueError naming the field if a table request is out of range (cheap; call first)."""

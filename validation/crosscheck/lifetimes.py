@@ -6,7 +6,7 @@ EMT, nu = 0.5), fed by four stiffness sources:
 
 (a) Appendix A, paper reading (d0 = 2 mm, d1 = 0), cone laws (3)-(5): the reference model;
 (b) FEM frictionless F0(h), cone laws; (c) FEM sticking F0(h), cone laws;
-(d) FEM sticking F0(h) with its own r_c(h), V(h), l(h) (``geometry="curve"``); where the FEM
+(d) FEM sticking F0(h) with its own r_c(h), V(h), l(h) (the paper route's ``cup_laws="curve"``); where the FEM
     resolves no strip (only the rim corner touches the plane, one node: l = 0, before the wall
     lands and, for sticking, after it buckles away), l falls back to eq (5) at the FEM's r_c;
 (e) the same with the frictionless FEM;
