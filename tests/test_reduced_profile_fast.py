@@ -206,13 +206,13 @@ def test_the_main_jobs_lifetimes_tabulated_against_direct():
     <= 1.0e-4, the integrator's own error at rtol 1e-6) and < 1e-8 by quadrature (measured 2e-10)."""
     from pathlib import Path
 
-    from validation.scenes.pipeline import Products, _model as scene_model
+    from validation.bridge.products import Products, _model as study_model
     from validation.scenes.schema import load_scene
 
-    scene = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "main.toml")
-    products = Products(scene)
-    model = scene_model(scene.tables, products.curve(), products.uc_table())
-    for m, forces in ((model, scene.tables["loads"]["F1_N"]), (dataclasses.replace(model, fluid="water"), FORCES_N)):
+    study = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "main.toml").study()
+    products = Products(study)
+    model = study_model(study, products.curve(), products.uc_table(), products.cup())
+    for m, forces in ((model, study.loads.forces_N), (dataclasses.replace(model, fluid="water"), FORCES_N)):
         for F in forces:
             fast = solve_lifetime(m, F, route="profile", refine=2)
             direct = solve_lifetime(m, F, route="profile", refine=2, exact=True)
