@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 from reduced.lifetime import ROUTES, lifetime_by_quadrature, solve_lifetime
-from validation.scenes.pipeline import Products, _model
+from validation.bridge.products import Products, _model
 from validation.scenes.schema import load_scene
 
 SCENE = Path(__file__).resolve().parents[1] / "scenes" / "main.toml"
@@ -50,11 +50,11 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--baseline", help="the main job's lifetime_vs_force.csv before the change")
     args = ap.parse_args()
-    scene = load_scene(SCENE)
-    products = Products(scene)
+    study = load_scene(SCENE).study()
+    products = Products(study)
     t0 = time.perf_counter()
-    model = _model(scene.tables, products.curve(), products.uc_table())
-    forces = [float(F) for F in scene.tables["loads"]["F1_N"]]
+    model = _model(study, products.curve(), products.uc_table(), products.cup())
+    forces = [float(F) for F in study.loads.forces_N]
     print(f"main job: FEM curve and u_c table {time.perf_counter() - t0:.2f} s; {len(forces)} forces, "
           f"{sum(p is not None for p in model.stiffness.profiles)} profiles")
     modes = {"direct": True, "tabulated": False} if "exact" in ROUTES["profile"].options else {"direct": None}
