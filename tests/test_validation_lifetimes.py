@@ -19,8 +19,10 @@ def model():
 
 
 def test_route_names_are_reduced_registry():
+    from validation.bridge.fem_route import register
+    register()                             # the fem route registers itself on first use
     assert set(ROUTES) <= set(reduced.ROUTES)
-    assert set(ROUTES) == {"paper", "profile", "coupled"}
+    assert set(ROUTES) == {"paper", "profile", "coupled", "fem"}
 
 
 def test_paper_route_agrees_with_the_quadrature(model):

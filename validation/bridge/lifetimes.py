@@ -20,7 +20,7 @@ __all__ = ["ROUTES", "Lifetimes", "lifetimes", "route_options", "route_laws"]
 
 #: the names of `reduced.ROUTES`, spelled out so that building the command line imports no reduced
 #: model (a test pins them equal)
-ROUTES = ("paper", "profile", "coupled")
+ROUTES = ("paper", "profile", "coupled", "fem")
 
 
 @dataclass(frozen=True)
@@ -45,7 +45,12 @@ class Lifetimes:
 def route_laws(route: str, cup_laws: str | None = None) -> str:
     """Where r(h), V(h), l(h) come from on `route`: paper -> the cone laws unless cup_laws says
     'curve'; profile -> the curve's (cone refused); coupled -> the FEM's own, from its suction
-    table ('curve'; cup_laws refused). ValueError names --cup-laws."""
+    table ('curve'; cup_laws refused); fem -> its FEM states' ('curve'; cup_laws refused). ValueError names --cup-laws."""
+    if route == "fem":
+        if cup_laws is not None:
+            raise ValueError("--cup-laws: the fem route takes r, V and the contact profile from its own "
+                             "FEM states; drop --cup-laws")
+        return "curve"
     if route == "coupled":
         if cup_laws is not None:
             raise ValueError("--cup-laws: the coupled route takes r and V from the FEM suction table; "

@@ -67,7 +67,9 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = 
                         "p(r) + beta (p_a - p_b), ring by ring, with its r_c and V; needs an FEM curve; "
                         "not mesh-converged where only the sharp rim corner touches, see docs/lifetime.md), "
                         "or coupled (lifetime only: the cup's state from the FEM's (u, dp) suction table of "
-                        "`cupcheck suction`, --suction-table; replaces eqs 3-7 and beta) "
+                        "`cupcheck suction`, --suction-table; replaces eqs 3-7 and beta), or fem (lifetime only: "
+                        "the cup pressed, sealed and held at F1 along its FEM equilibrium branch while "
+                        "the gas leaks in through each state's own profile; --contact, --fidelity) "
                         f"(default: {default_route})")
     g.add_argument("--cup-laws", default=None, choices=("cone", "curve"),
                    help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 with the cup's r0, r1, "
@@ -92,6 +94,8 @@ def cup_laws(args: argparse.Namespace, coupled: bool = False) -> str:
 
     if args.route == "coupled" and not coupled:
         raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
+    if args.route == "fem":
+        raise ValueError("--route: fem is a route of `cupcheck lifetime`")
     return route_laws(args.route, args.cup_laws)
 
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from validation.commands._cup import add_cup_arguments, add_cup_law_arguments, cup_laws
+from validation.commands._cup import add_contact_arguments, add_cup_arguments, add_cup_law_arguments, cup_laws
 from validation.commands._reduced_options import ILLUSTRATIVE, build_uc, check_run_options, relaxation_law
 from validation.commands._surface import add_surface_arguments
 
@@ -37,6 +37,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_cup_arguments(p, "with --stiffness FILE, the curve's own design is used and an explicit "
                          "cup must agree with it")
     add_cup_law_arguments(p)
+    fem = p.add_argument_group("fem route (--route fem)")
+    add_contact_arguments(fem, "the paper's soap-cleaned PMMA is not frictionless, so give the law you mean")
+    fem.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default=None,
+                     help="for --route fem: mesh level of the cup (default coarse with --route fem: one "
+                          "lifetime in ~15 s on one core; medium is ~4x slower, see "
+                          "benchmarks/bench_fem_route.py)")
+    fem.add_argument("--du-mm", dest="du_mm", type=float, default=0.25,
+                     help="for --route fem: the plate step along the equilibrium branch in mm, > 0 "
+                          "(default: 0.25)")
     p.add_argument("--force", dest="force_N", type=float, nargs="+", default=[10.0], metavar="F1_N",
                    help="pull force(s) F1 in N, > 0 (default: 10)")
     p.add_argument("--stiffness", default="appendix-a", metavar="appendix-a|FILE.csv",
@@ -225,6 +234,12 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import check_file_names, check_outputs, command_inputs
     check_outputs(directories={"--out": args.out}, inputs=command_inputs(args))
     check_file_names({f"--force {f!r}": [f"trajectory_F1_{f:g}N.csv"] for f in args.force_N if args.out})
+    from validation.commands._fem_route import FEM_ONLY, run_fem_route
+    if args.route == "fem":
+        return run_fem_route(args)
+    given = [option for option, name, default in FEM_ONLY if getattr(args, name) != default]
+    if given:
+        raise ValueError(f"{given[0]}: applies to --route fem only")
     if args.route == "coupled":
         from validation.commands._coupled import run_coupled
         return run_coupled(args)
