@@ -32,6 +32,10 @@ MM = 1e-3
 #: integrator's global error, up to 4e-5 on the profile route (cup A coarse, 5-40 N; at rtol 1e-9
 #: the two agree to 4e-7)
 REREAD = 1e-4
+#: the ballistic share is a trapezoid average over the integrator's accepted steps: when the step
+#: sequence changes (the curve from memory or from its CSV: 27 against 23 steps at 10 N on the profile
+#: route) it moves by up to 2e-3 (0.2512 against 0.2517), the quantity's own discretisation error
+BALLISTIC = 5e-3
 
 
 def run_example(name: str, cwd: Path) -> list[str]:
@@ -160,7 +164,7 @@ def test_03_profile_route(tmp_path, capsys):
     cli = cli_lifetimes(capsys, "--route", "profile", "--stiffness", tmp_path / "cupA_coarse.csv", "--force", *forces)
     for (_, t, end, ballistic), c in zip(table, cli):
         assert shows(t, c["lifetime_s"], REREAD) and end == c["reason"]
-        assert shows(ballistic, c["ballistic_share"], REREAD)
+        assert shows(ballistic, c["ballistic_share"], BALLISTIC)
     assert shows(number_after(lines[-2], "largest holdable force:"), cli[0]["largest_force_N"], REREAD)
 
 

@@ -13,6 +13,7 @@ The table is written to ``suction_table.json`` (``cupcheck lifetime --route coup
 --suction-table`` reads it).
 """
 
+import fem
 import reduced
 import validation
 
@@ -20,7 +21,7 @@ FORCES_N = (5.0, 10.0, 20.0)
 
 grid = validation.SuctionGridSpec(u_fractions=(0.005, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8),   # of h1
                                   dp_kPa=(0.0, 2.0, 5.0, 10.0, 20.0, 40.0, 70.0, 100.0))
-table = validation.suction_table_for("A", fidelity="coarse", contact="frictionless", grid=grid)
+table = validation.suction_table_for("A", fidelity="coarse", contact=fem.ContactLaw("frictionless"), grid=grid)
 table.to_json("suction_table.json")
 
 model = reduced.LeakageModel(cup=reduced.CUP_A, suction=table, u_c=validation.surface_uc_table("pmma-1.89"),
