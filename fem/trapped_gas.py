@@ -270,8 +270,8 @@ class GasMechanics:
         return self.body.material
 
     def coordinates(self, u: np.ndarray) -> np.ndarray:
-        """Deformed node coordinates x = X + u [2, nnodes]."""
-        return self.kin.node_coordinates() + np.stack([u[0::2], u[1::2]])
+        """Deformed node coordinates x = X + u [2, nnodes] (the cavity load's)."""
+        return self._load.coordinates(u)
 
     def volume_m3(self, u: np.ndarray) -> float:
         """V_cav(u) [m^3]."""
