@@ -136,3 +136,13 @@ def test_ctrl_c_on_a_sweep_is_one_line(tmp_path):
     out, err = proc.communicate(timeout=120)
     lines = [ln for ln in err.splitlines() if not ln.startswith("sweep: ")]
     assert proc.returncode == 130 and lines == ["cupcheck sweep: interrupted"], err
+
+
+def test_messages_carry_no_terminal_escapes(capsys, tmp_path):
+    """A file name with a terminal escape in it is named, escaped, in the one-line error: the
+    message never acts on the user's terminal."""
+    from tests.cli import run_cli
+
+    bad = tmp_path / "curve\x1b[31mred.csv"
+    code, out, err = run_cli(capsys, "lifetime", "--stiffness", bad, "--force", "10")
+    assert code == 2 and "\x1b" not in err and "\\x1b" in err and len(err.strip().splitlines()) == 1

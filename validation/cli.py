@@ -107,20 +107,23 @@ def _main(argv: Sequence[str] | None) -> int:
     except OSError as exc:                   # a full disk, a read-only directory, a size limit
         where = f" ('{exc.filename}')" if exc.filename else ""
         what = "cannot write the output: " if exc.errno in _WRITE_ERRORS else ""
-        print(f"cupcheck {args.command}: failed: {what}{exc.strerror or exc}{where}", file=sys.stderr)
+        print(_one_line(f"cupcheck {args.command}: failed: {what}{exc.strerror or exc}{where}"), file=sys.stderr)
         return 1
     except ValueError as exc:
         print(f"cupcheck {args.command}: error: {_one_line(str(exc))}", file=sys.stderr)
         return 2
     except RuntimeError as exc:
-        print(f"cupcheck {args.command}: failed: {exc}", file=sys.stderr)
+        print(f"cupcheck {args.command}: failed: {_one_line(str(exc))}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         return _interrupted(f"cupcheck {args.command}")
 
 
 def _one_line(message: str) -> str:
-    return " ".join(line.strip() for line in message.splitlines() if line.strip())
+    """The message on one line, its control characters (a terminal escape in a file name the user
+    gave, say) shown escaped instead of acting on the terminal."""
+    text = " ".join(line.strip() for line in str(message).splitlines() if line.strip())
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 if __name__ == "__main__":
