@@ -10,7 +10,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from validation.commands._reduced_options import build_uc, check_run_options, relaxation_law
+from validation.commands._reduced_options import (build_uc, check_run_options, refuse_other_options,
+                                                   relaxation_law)
 
 #: lifetime options that the coupled route replaces or does not model: (option, value, default)
 _NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--fluid", "fluid", "air"),
@@ -22,13 +23,8 @@ def coupled_options(args: argparse.Namespace):
     """The typed options of the command line (every check; ValueError naming the option)."""
     from validation.bridge.coupled.route import CoupledOptions
 
-    if args.reference_mode:
-        raise ValueError("--reference-mode: the reference conventions are the paper route's; "
-                         "drop it with --route coupled")
-    given = [opt for opt, name, default in _NOT_HERE if getattr(args, name) != default]
-    if given:
-        raise ValueError(f"--route: coupled takes F1, V, r and the contact profile from the suction "
-                         f"table and does not model water; drop {', '.join(given)}")
+    refuse_other_options(args, "coupled", _NOT_HERE, "takes F1, V, r and the contact profile from the "
+                         "suction table and does not model water")
     if args.suction_table is None:
         raise ValueError("--suction-table: --route coupled needs the FEM table of `cupcheck suction` (.json)")
     if not Path(args.suction_table).is_file():

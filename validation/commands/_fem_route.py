@@ -10,7 +10,7 @@ import math
 import sys
 from typing import Any
 
-from validation.commands._reduced_options import build_uc, check_run_options
+from validation.commands._reduced_options import build_uc, check_run_options, refuse_other_options
 
 #: mesh level of the fem route when --fidelity is not given (one lifetime ~15 s on one core)
 DEFAULT_FIDELITY = "coarse"
@@ -37,13 +37,8 @@ def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, 
     from validation.commands._cup import contact_choice, load_cup_design
     from validation.guards import check_design, check_modulus
 
-    if args.reference_mode:
-        raise ValueError("--reference-mode: the reference conventions are the paper route's; "
-                         "drop it with --route fem")
-    given = [opt for opt, name, default in _NOT_HERE if getattr(args, name) != default]
-    if given:
-        raise ValueError(f"--route: fem computes the cup's mechanics, volume and contact profile in the FEM "
-                         f"(elastic wall, gas-filled cavity); drop {', '.join(given)}")
+    refuse_other_options(args, "fem", _NOT_HERE, "computes the cup's mechanics, volume and contact profile "
+                         "in the FEM (elastic wall, gas-filled cavity)")
     check_run_options(args)
     E_MPa = check_modulus(args.E_MPa, "--E-MPa")
     if not (math.isfinite(args.du_mm) and args.du_mm > 0):

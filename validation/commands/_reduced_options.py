@@ -58,3 +58,15 @@ def relaxation_law(value: str):
     if value == "none":
         return None
     return default_relaxation() if value == "default" else RelaxationModulus.from_csv(value)
+
+
+def refuse_other_options(args, route: str, not_here, why: str) -> None:
+    """Refuse, naming them, the options a route replaces or does not model (`not_here`: (option,
+    attribute, default) triples) and the paper route's reference conventions; `why` says what the
+    route does instead. ValueError."""
+    if args.reference_mode:
+        raise ValueError(f"--reference-mode: the reference conventions are the paper route's; "
+                         f"drop it with --route {route}")
+    given = [opt for opt, name, default in not_here if getattr(args, name) != default]
+    if given:
+        raise ValueError(f"--route: {route} {why}; drop {', '.join(given)}")
