@@ -27,7 +27,7 @@ from typing import NoReturn
 #: errno values that mean an output could not be written
 _WRITE_ERRORS = {errno.ENOSPC, errno.EROFS, errno.EACCES, errno.EFBIG, errno.EDQUOT, errno.EPERM}
 #: subcommand modules, in the order `cupcheck --help` lists them
-COMMANDS = ("example", "lifetime", "render", "run", "stiffness", "suction", "sweep", "uc", "validate")
+COMMANDS = ("example", "lifetime", "paper", "render", "run", "stiffness", "suction", "sweep", "uc", "validate")
 
 
 class OneLineParser(argparse.ArgumentParser):
