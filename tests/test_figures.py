@@ -235,6 +235,16 @@ def test_nice_length_is_1_2_5_not_above_the_limit():
     assert style.length_label(0.005) == "5 mm" and style.length_label(2e-4) == "200 \u00b5m"
 
 
+def test_a_3d_views_caption_names_design_contact_law_and_mesh():
+    from validation.bridge.products import Products
+    from validation.bridge.study import Contact, CupDesign, Study
+    from validation.scenes.views3d import view_caption
+
+    study = Study(design=CupDesign(preset="B"), contact=Contact("coulomb", 0.5), fidelity="medium")
+    assert view_caption(Products(study)) == "cup B, coulomb mu = 0.5, medium mesh"
+    assert view_caption(Products(Study())) == "cup A, frictionless, coarse mesh"
+
+
 # ------------------------------------------------------------------------------ 3D views (real renders)
 @pytest.fixture(scope="module")
 def frames():
