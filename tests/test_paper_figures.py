@@ -115,7 +115,7 @@ def test_the_whole_set_at_coarse_reads_and_obeys_its_physics(seen, tmp_path):
         marks = t[t.route == PAPER_ROUTE_LABEL]
         assert len(marks) == sum(2 if n.kind in ("band", "slope") else 1 for n in paper_numbers(name)
                                  if n.kind not in ("claim", "input")), name
-        assert (marks.source != "").all()
+        assert len(marks) == 0 or (marks.source != "").all()
         if name != "uc_vs_pressure":
             assert {"profile", "paper"} <= set(t.route), name
 

@@ -35,7 +35,8 @@ def main() -> None:
     lines = ["# Scene gallery", "",
              "Each shipped scene, its animation or first image and the command that made it (regenerate this page with",
              "`python -m validation.scenes.gallery`). Scene keys: `docs/scenes.md`. Cold and warm run times",
-             "of every scene: the README (`python benchmarks/bench_scenes.py`).", ""]
+             "of every scene: the README (`python benchmarks/bench_scenes.py`). The paper's calculated figures,",
+             "FEM-fed beside the paper's inputs, in one command (`cupcheck paper --out DIR`): docs/paper-figures.md.", ""]
     for scene_path in sorted(args.scenes.glob("*.toml")):
         if scene_path.name.startswith("sweep_"):
             continue
@@ -88,7 +89,8 @@ def paper_gallery(docs: Path, fidelity: str = "coarse", cache_dir: Path | None =
              f"    cupcheck paper --out out/paper            # all eight, {fidelity} FEM; --only NAME for one", "",
              f"Solid lines are fed by the FEM (the cup's frictionless FEM at the {fidelity} level through the profile "
              "route: its F0, contact radius, volume and contact-pressure profile); dashed lines by the paper's own "
-             "inputs (Appendix A's F0 with d0 = 2 mm, Table 1's rigid cone and eq (6)'s strip: the paper route). "
+             "inputs (Appendix A's F0 with d0 = 2 mm, Table 1's rigid cone and eq (6)'s strip: the paper route; the "
+             "paper's measured F0 is published only as a plot, so Appendix A's formula stands in for it). "
              "Both use what the paper's lifetimes used: air at 293.15 K and 1e5 Pa, the relaxation modulus "
              "E_eff(t) (in water E = 4 MPa, the paper's dashed lines of Fig. 1rStart) and the calibrated surfaces. "
              "Black marks are the numbers the paper states (text and Table 1 only, none read off its plots), "

@@ -94,8 +94,8 @@ def F0_cups(ctx, drawn):
                        ls=ls, color=CUP_COLOURS[cup], label=f"cup {cup}: {what}")
     drawn.marks([ax], "F0_vs_u_cups", "u_mm", ("F0_N",))
     ax.legend(fontsize=5)
-    fig.suptitle(f"cups A and B, F0 on the plane (Delta p = 0); FEM frictionless ({ctx.fidelity} mesh) "
-                 "against\nAppendix A (E 4 MPa, d0 2 mm): the F0 the two feeds hand to the lifetimes", fontsize=5.5)
+    fig.suptitle(f"cups A and B pressed on the plane: FEM frictionless ({ctx.fidelity} mesh)\n"
+                 "against Appendix A (E 4 MPa, d0 2 mm), the F0 of the two feeds", fontsize=6)
     small = {k: _at(*curves[("A", k)], 1.0) for k in ("fem", "appendix-a")}
     ratio = {k: np.mean([_at(*curves[("A", k)], u) / _at(*curves[("B", k)], u) for u in (1.0, 2.0, 3.0)])
              for k in ("fem", "appendix-a")}
@@ -315,8 +315,8 @@ def uc_vs_pressure(ctx, drawn):
     handles, labels = ax.get_legend_handles_labels()
     ax.legend(handles + [Line2D([], [], ls="", marker="*", color=MARK_COLOUR)], labels + ["paper: 1 atm (Sec. 5.1)"],
               fontsize=5, loc="lower left")
-    fig.suptitle("u_c(p/E) of the calibrated surfaces (Persson theory, EMT); the roughness model alone:\n"
-                 "no cup, no FEM, no route", fontsize=5.5)
+    fig.suptitle("u_c(p/E) of the calibrated surfaces (Persson theory, EMT):\n"
+                 "the roughness model alone, no cup, no FEM, no route", fontsize=6)
     stated = paper_numbers("uc_vs_pressure", "point")
     worst = max(abs(1e9 * at_1atm[n.label](n.x) / n.value - 1) for n in stated)
     sentence = (f"The surface presets are calibrated to the u_c the paper states at 1 atm (p/E = 0.0253), so the five "
