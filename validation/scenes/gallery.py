@@ -100,7 +100,7 @@ def paper_gallery(docs: Path, fidelity: str = "coarse", cache_dir: Path | None =
              "sentences are computed from the drawn numbers.", ""]
     for r in results:
         f = r.figure
-        marks = [f"{n.label} ({n.source})" for n in paper_numbers(f.name) if n.kind != "input"]
+        marks = [_number_text(n) for n in paper_numbers(f.name) if n.kind != "input"]
         lines += [f"## {f.name}", "", f"{f.shows}; the paper's {f.paper}.", "",
                   f"    cupcheck paper --out out/paper --only {f.name}", "",
                   f"![{f.name}](paper-figures/{f.name}.png)", "",
@@ -110,6 +110,12 @@ def paper_gallery(docs: Path, fidelity: str = "coarse", cache_dir: Path | None =
     page = docs / "paper-figures.md"
     page.write_text("\n".join(lines))
     return page
+
+
+def _number_text(n) -> str:
+    """A paper number for the page: its label, its value where the label has none, its source."""
+    text = f"{n.label}: {n.value:g} {n.unit}" if n.kind == "point" else n.label     # the other labels hold it
+    return text if n.source in text else f"{text} ({n.source})"
 
 
 def small_png(src: Path, dst: Path, colours: int = 64) -> Path:
