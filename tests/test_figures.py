@@ -52,12 +52,14 @@ def _log_tick_labels(fig) -> list[list[str]]:
 
 
 def _x_labels_overlap(fig) -> bool:
-    """Whether any axes of a drawn figure has two x tick labels (inside the view) that overlap."""
+    """Whether any axes of a drawn figure has two shown x tick labels (inside the view) that overlap
+    (the hidden labels of an axes sharing x with the one below have no extent to compare)."""
     renderer = fig.canvas.get_renderer()
     for ax in fig.axes:
         lo, hi = sorted(ax.xaxis.get_view_interval())
         boxes = [t.label1.get_window_extent(renderer) for t in ax.xaxis.get_major_ticks()
-                 if lo - 1e-9 * abs(hi) <= t.get_loc() <= hi + 1e-9 * abs(hi) and t.label1.get_text()]
+                 if lo - 1e-9 * abs(hi) <= t.get_loc() <= hi + 1e-9 * abs(hi) and t.label1.get_text()
+                 and t.label1.get_visible()]
         if _boxes_overlap(boxes):
             return True
     return False

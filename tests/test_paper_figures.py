@@ -14,6 +14,7 @@ import pytest
 from matplotlib.image import imread
 
 from tests.cli import run_cli
+from tests.test_figures import _log_tick_labels, _x_labels_overlap
 from validation import style
 from validation.scenes.paper import PAPER_FIGURES, run_paper
 from validation.scenes.paper_marks import PAPER_ROUTE_LABEL, all_paper_numbers, paper_numbers
@@ -82,6 +83,7 @@ def seen(monkeypatch):
         legends = [leg for leg in (*fig.legends, *(ax.get_legend() for ax in fig.axes)) if leg is not None]
         found[Path(path).stem] = {
             "clipped": style.clipped_texts(fig),
+            "log_ticks": _log_tick_labels(fig), "x_overlap": _x_labels_overlap(fig),
             "colorbars": [ax.get_ylabel() for ax in fig.axes if hasattr(ax, "_colorbar")],
             "legend": " | ".join(t.get_text() for leg in legends for t in leg.get_texts()),
             "title": fig._suptitle.get_text() if fig._suptitle else ""}
@@ -102,6 +104,7 @@ def test_the_whole_set_at_coarse_reads_and_obeys_its_physics(seen, tmp_path):
 
     for name, m in seen.items():                           # the images, measured
         assert m["clipped"] == [], (name, m["clipped"])
+        assert not m["x_overlap"] and all(len(t) >= 3 for t in m["log_ticks"]), (name, m["log_ticks"])
         assert imread(out / f"{name}.png").shape[1] == round(style.COLUMN_WIDTH_IN * 300)
         if name not in ("F0_vs_u_cups", "uc_vs_pressure"):
             assert "frictionless (coarse), profile route" in m["legend"] and "paper route" in m["legend"], name

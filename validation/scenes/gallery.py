@@ -87,6 +87,9 @@ def paper_gallery(docs: Path, fidelity: str = "coarse", cache_dir: Path | None =
     lines = ["# The paper's figures, drawn by cupcheck", "",
              "Each calculated figure of Tiwari & Persson's Sec. 5, drawn by one command:", "",
              f"    cupcheck paper --out out/paper            # all eight, {fidelity} FEM; --only NAME for one", "",
+             "A command rather than a folder of scenes: each figure overlays two studies (the FEM-fed case and the "
+             "same case on the paper's inputs) and the paper's numbers, which one scene file does not express, "
+             "and `cupcheck paper --out DIR` is the shortest thing to type.", "",
              f"Solid lines are fed by the FEM (the cup's frictionless FEM at the {fidelity} level through the profile "
              "route: its F0, contact radius, volume and contact-pressure profile); dashed lines by the paper's own "
              "inputs (Appendix A's F0 with d0 = 2 mm, Table 1's rigid cone and eq (6)'s strip: the paper route; the "
