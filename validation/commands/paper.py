@@ -12,7 +12,7 @@ figures: F0_vs_u_cups, lifetime_vs_force_cups, r_pb_vs_time, p_Ndot_vs_time, lif
 lifetime_vs_rms, lifetime_vs_r_start, uc_vs_pressure
 
 examples:
-  cupcheck paper --out out/paper                          # the whole set, coarse FEM (~2 min cold)
+  cupcheck paper --out out/paper        # the whole set, coarse FEM: ~35 s of CPU cold, ~8 s warm
   cupcheck paper --out out/paper --only lifetime_vs_force_cups --fidelity medium
 """
 
