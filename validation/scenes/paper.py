@@ -19,10 +19,14 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from validation.bridge.products import Products
 from validation.bridge.study import Contact, CupDesign, Loads, Study, Surface
 from validation.scenes import paper_plots
+
+if TYPE_CHECKING:
+    from validation.bridge.lifetimes import Lifetimes
 
 __all__ = ["PAPER_FIGURES", "PaperFigure", "PaperResult", "run_paper", "paper_study", "paper_inputs"]
 
@@ -92,6 +96,7 @@ class PaperContext:
         self._products: dict[Study, Products] = {}
 
     def study(self, **kw) -> Study:
+        """The FEM-fed study of `paper_study`'s keywords at the set's mesh level."""
         return paper_study(self.fidelity, **kw)
 
     def pair(self, **kw) -> tuple[Study, Study]:
@@ -100,6 +105,7 @@ class PaperContext:
         return study, paper_inputs(study)
 
     def products(self, study: Study) -> Products:
+        """The study's products (each study once; its FEM curve and u_c table shared, above)."""
         if study not in self._products:
             key = (study.design, study.material, study.contact, study.fidelity, study.stiffness, study.surface)
             if key not in self._roots:
@@ -109,7 +115,8 @@ class PaperContext:
             self._products[study] = self._roots[key].derived(study, inherit=inherit)
         return self._products[study]
 
-    def lifetimes(self, study: Study):
+    def lifetimes(self, study: Study) -> Lifetimes:
+        """The study's lifetimes on its route, one per pull force, and the largest force held."""
         return self.products(study).lifetimes()
 
     def record(self, study: Study) -> dict[str, str]:
