@@ -101,6 +101,9 @@ def test_the_whole_set_at_coarse_reads_and_obeys_its_physics(seen, tmp_path):
     files = sorted(p.name for p in out.iterdir())
     assert files == sorted(["manifest.json", *(f["path"] for f in manifest["files"])])
     assert len(results) == 8 and all(len(r.files) == 3 and r.sentence for r in results)
+    page = (ROOT / "docs" / "paper-figures.md").read_text()      # the committed gallery says what a fresh run says
+    stale = [r.figure.name for r in results if f"**Against the paper.** {r.sentence}" not in page]
+    assert not stale, f"docs/paper-figures.md is stale for {stale}: python -m validation.scenes.gallery --paper"
 
     for name, m in seen.items():                           # the images, measured
         assert m["clipped"] == [], (name, m["clipped"])
