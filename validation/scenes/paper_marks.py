@@ -12,6 +12,7 @@ from __future__ import annotations
 import functools
 import math
 import re
+import textwrap
 import tomllib
 from dataclasses import dataclass
 from importlib.resources import files
@@ -46,6 +47,7 @@ class PaperNumber:
     x_hi: float | None = None
     axis: str = "y"
     panel: int = 0
+    at: float | None = None       # where along the other axis its label sits (axes fraction)
 
 
 @functools.cache
@@ -102,12 +104,14 @@ class Drawn:
             if n.kind == "line":
                 name = x_name if n.axis == "x" else y_name
                 self.rows.append({**base, name: n.value})
-                _line(ax, n.axis, n.value, n.label)
+                _line(ax, n.axis, n.value, n.label, n.at)
             elif n.kind == "band":
                 name = x_name if n.axis == "x" else y_name
                 self.rows += [{**base, name: n.lo}, {**base, name: n.hi}]
                 (ax.axvspan if n.axis == "x" else ax.axhspan)(n.lo, n.hi, color=MARK_COLOUR, alpha=0.07, lw=0)
-                _label(ax, n.axis, math.sqrt(n.lo * n.hi) if _log(ax, n.axis) else 0.5 * (n.lo + n.hi), n.label)
+                middle = math.sqrt(n.lo * n.hi) if _log(ax, n.axis) else 0.5 * (n.lo + n.hi)
+                _label(ax, n.axis, middle, textwrap.fill(n.label, 20) if n.axis == "y" else n.label, n.at,
+                       across=n.axis == "x", centre=n.axis == "y")
             elif n.kind == "point":
                 self.rows.append({**base, x_name: n.x, y_name: n.value})
                 ax.plot([n.x], [n.value], "*", color=MARK_COLOUR, ms=5, zorder=5)
@@ -136,17 +140,25 @@ def _log(ax, axis: str) -> bool:
     return (ax.get_xscale() if axis == "x" else ax.get_yscale()) == "log"
 
 
-def _line(ax, axis: str, value: float, label: str) -> None:
+def _line(ax, axis: str, value: float, label: str, at: float | None) -> None:
     (ax.axvline if axis == "x" else ax.axhline)(value, color=MARK_COLOUR, ls=":", lw=0.8)
-    _label(ax, axis, value, label)
+    _label(ax, axis, value, label, at)
 
 
-def _label(ax, axis: str, value: float, label: str) -> None:
-    """A small label beside a mark, inside the axes (a vertical mark: along it, near the top)."""
+def _label(ax, axis: str, value: float, label: str, at: float | None, across: bool = False,
+           centre: bool = False) -> None:
+    """A small label beside a mark, inside the axes, at `at` (axes fraction) along the other axis: a
+    vertical mark's along it (default: hanging from the top; given `at`: rising from it) or,
+    `across`, level (default near the bottom); a horizontal mark's above it (default at the left;
+    right-aligned past the middle; `centre`: centred on it, a band's label)."""
     label = re.sub(r"\bum\b", "\u00b5m", label)
-    if axis == "x":
-        ax.text(value, 0.97, f" {label}", transform=ax.get_xaxis_transform(), rotation=90, ha="right",
-                va="top", fontsize=5, color=MARK_COLOUR)
+    if axis == "x" and across:
+        ax.text(value, 0.03 if at is None else at, label, transform=ax.get_xaxis_transform(), ha="center",
+                va="bottom", fontsize=5, color=MARK_COLOUR)
+    elif axis == "x":
+        ax.text(value, 0.97 if at is None else at, f" {label} ", transform=ax.get_xaxis_transform(),
+                rotation=90, ha="right", va="top" if at is None else "bottom", fontsize=5, color=MARK_COLOUR)
     else:
-        ax.text(0.02, value, label, transform=ax.get_yaxis_transform(), ha="left", va="bottom",
-                fontsize=5, color=MARK_COLOUR)
+        at = 0.02 if at is None else at
+        ax.text(at, value, label, transform=ax.get_yaxis_transform(), ha="left" if at < 0.5 else "right",
+                va="center" if centre else "bottom", fontsize=5, color=MARK_COLOUR)
