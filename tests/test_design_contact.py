@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fem.geometry import Design, geometry_from_mapping, load_design, load_geometry
+from fem.design_file import Design, geometry_from_mapping, load_design, load_geometry
 from fem.interface import (API, CONTACT_LAWS, FILE, ContactChoice, ContactLaw, choose_contact,
                            contact_law)
 from reduced.design import ContactRecord

@@ -9,7 +9,7 @@ import meshio
 import numpy as np
 import pytest
 
-from fem.mesh import read_mesh
+from fem.mesh_files import read_mesh
 from reduced.design import ContactRecord, CupShape
 from reduced.stiffness_curve import StiffnessCurve
 from reduced.suction_table import SuctionTable
