@@ -57,3 +57,18 @@ def test_a_record_without_a_design_or_law_names_none():
     assert recorded_contact({"contact": None}) is None and recorded_contact({}) is None
     with pytest.raises(ValueError, match="geometry.alpha_deg: expected a number"):
         recorded_design({"geometry": {"r0_mm": 5, "r1_mm": 19, "alpha_deg": "33", "h1_mm": 9}})
+
+
+def test_a_suction_table_of_a_custom_design_gives_its_cup_without_strip_widths():
+    """The coupled route's table records its design but no l(r_c): a custom design's eq (5) widths
+    are then not used (formerly an AttributeError)."""
+    from validation.bridge.coupled.route import _TableDesign
+    from validation.bridge.design import resolve_cup
+
+    wide = replace(preset_design("A"), r1_m=21e-3, name="wide rim")
+    wide = replace(wide, h1_m=wide.cone_height_m)
+    choice = resolve_cup(_TableDesign(wide, wide.h1_m), laws="curve")
+    assert choice.cup.r1_m == pytest.approx(21e-3) and choice.cup.r_start_m == pytest.approx(13e-3)
+    assert choice.l_source.startswith("not used") and choice.label.startswith("wide rim (r0 5 mm, r1 21 mm")
+    with pytest.raises(ValueError, match="l0_mm, l1_mm: wide rim .* is not a Table 1 cup"):
+        resolve_cup(_TableDesign(wide, wide.h1_m), laws="cone")

@@ -44,6 +44,10 @@ class _TableDesign:
     design: CupShape | None
     h1_m: float
 
+    def has(self, name: str) -> bool:
+        """No column of a stiffness curve: the table's r, V, l replace eq (5)'s l0, l1."""
+        return False
+
 
 def coupled_model(options: CoupledOptions, uc: Callable[[float], float]):
     """(the `reduced.LeakageModel` of the coupled route, the `CupChoice`, the cup's description
