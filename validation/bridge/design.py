@@ -3,10 +3,9 @@ Table 1 preset, turned into the reduced model's `CupParameters` (eqs 3-6).
 
 An FEM stiffness curve records the design it was computed for, which it reads back as a typed
 `reduced.design.CupShape` (`StiffnessCurve.design`: r0, r1, alpha, h1, the thickness at both
-ends). A lifetime takes the cup from there; an explicit ``--cup`` or
-``--geometry FILE`` must describe the same cup, or the run is refused with both named. A curve
-that names no design (a measured CSV, a user's mesh) takes the explicit cup, else cup A with a
-note saying so. The curve also records its interface with the plane (`StiffnessCurve.contact`,
+ends). A lifetime takes the cup from there; an explicit ``--cup`` or ``--geometry FILE`` must
+describe the same cup, or the run is refused with both named. A curve that names no design (a
+measured CSV, a user's mesh) takes the explicit cup, else cup A with a note saying so. The curve also records its interface with the plane (`StiffnessCurve.contact`,
 a `reduced.design.ContactRecord`); a ``--geometry FILE`` whose ``[contact]`` table names another
 law or mu is refused the same way. Every decision compares these typed values; an FEM design
 becomes one through its own record (`shape_of`), the form the curve's sidecar keeps.
