@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import fem
-from fem.geometry import design_from_mapping
+from fem.design_file import design_from_mapping
 from fem.solver import ConvergenceError
 from reduced.stiffness_curve import StiffnessCurve
 from tests.cli import run_cli
