@@ -91,8 +91,9 @@ def test_cup_a_is_admissible_for_every_law():
 
 
 def test_command_line_says_where_and_why(tmp_path, capsys):
-    """`cupcheck stiffness` on a thin cone that turns over: exit 1, one line with the u, the place
-    and the cause, no curve written, the record in the failure log."""
+    """`cupcheck stiffness` on a thin cone that turns over: one line with the u, the place and the
+    cause, the record in the failure log; the converged part is written flagged partial (exit 3,
+    tests/test_partial_curve.py)."""
     import json
 
     from validation.cli import main
@@ -102,7 +103,7 @@ def test_command_line_says_where_and_why(tmp_path, capsys):
     out = tmp_path / "c.csv"
     code = main(["stiffness", "--geometry", str(design), "--fidelity", "coarse", "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert code == 1 and not out.exists()
-    assert err.startswith("cupcheck stiffness: failed: stopped at u = ") and "turned over" in err
+    assert code == 3 and json.loads(out.with_suffix(".json").read_text())["provenance"]["partial"]
+    assert err.startswith("cupcheck stiffness: partial: the path stopped at u = ") and "turned over" in err
     record = json.loads((tmp_path / "c.failure.json").read_text())
     assert record["residual_history"] == [] and "dips" in record["cause"]
