@@ -22,7 +22,8 @@ its share of the wall time:
 and, on the tangent of the last factorization of the path (its free block K_ff), the time of one
 factorization by the solver itself and by scipy's sparse LU (`scipy.sparse.linalg.splu`, COLAMD
 ordering): the scale of the linear algebra alone against the time per Newton iteration.
-Timings are wall-clock (perf_counter) around the wrapped functions; the wrappers cost ~1 us a call.
+Times are the process's CPU time (`time.process_time`; one thread with OMP_NUM_THREADS=1, so on a
+quiet machine the wall time, which a busy second core inflates); the wrappers cost ~1 us a call.
 """
 
 from __future__ import annotations
@@ -68,12 +69,12 @@ class Clock:
     def wrap(self, part: str, fn):
         @functools.wraps(fn)
         def timed(*args, **kwargs):
-            frame = [time.perf_counter(), 0.0]
+            frame = [time.process_time(), 0.0]
             self.stack.append(frame)
             try:
                 return fn(*args, **kwargs)
             finally:
-                elapsed = time.perf_counter() - frame[0]
+                elapsed = time.process_time() - frame[0]
                 self.stack.pop()
                 self.time[part] += elapsed - frame[1]
                 self.calls[part] += 1
@@ -109,9 +110,9 @@ def _instrument() -> None:
 def _median_time(fn, repeat: int = 7) -> float:
     times = []
     for _ in range(repeat):
-        t = time.perf_counter()
+        t = time.process_time()
         fn()
-        times.append(time.perf_counter() - t)
+        times.append(time.process_time() - t)
     return statistics.median(times)
 
 
@@ -121,15 +122,15 @@ def profile_curve(level: str, contact: str, repeat: int) -> dict:
     mesh = cup_mesh(geometry, level)
     run = lambda: compress_cup(mesh, NeoHookean(), contact=contact,       # noqa: E731
                                u_max_m=0.9 * geometry.h1_m)
-    t = time.perf_counter()
+    t = time.process_time()
     run()
-    first = time.perf_counter() - t
+    first = time.process_time() - t
     walls, parts = [], []
     for _ in range(repeat):
         CLOCK.reset()
-        t = time.perf_counter()
+        t = time.process_time()
         resp = run()
-        walls.append(time.perf_counter() - t)
+        walls.append(time.process_time() - t)
         parts.append((dict(CLOCK.time), dict(CLOCK.calls)))
     wall = statistics.median(walls)
     i = int(np.argsort(walls)[len(walls) // 2])
@@ -149,7 +150,7 @@ def report(r: dict) -> None:
     n = r["newton"]
     print(f"\ncup A {r['level']}: {r['steps']} steps, {n} Newton iterations, {r['dofs']} dofs "
           f"({r['free']} free at the end), {r['factorizations']} factorizations")
-    print(f"  in-process wall: first call {r['first']:.3f} s, median {r['median']:.3f} s; "
+    print(f"  in-process CPU time: first call {r['first']:.3f} s, median {r['median']:.3f} s; "
           f"per Newton iteration {1e3 * r['wall'] / n:.2f} ms")
     print(f"  one factorization of the last tangent's K_ff: the solver's own {1e3 * r['own_factor']:.2f} ms, "
           f"scipy splu {1e3 * r['splu']:.2f} ms")
