@@ -154,7 +154,9 @@ def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
     if values.ndim == index.ndim:
         return np.bincount(flat, weights=values.ravel(), minlength=size)
     cols = values.reshape(flat.size, -1)
-    return np.stack([np.bincount(flat, weights=c, minlength=size) for c in cols.T], axis=1)
+    m = cols.shape[1]                      # one bincount over (slot, column) pairs
+    return np.bincount((flat[:, None] * m + np.arange(m)).ravel(), weights=cols.ravel(),
+                       minlength=size * m).reshape(size, m)
 
 
 def _positions(csr: sp.csr_matrix):
