@@ -244,5 +244,6 @@ def _constrained_rhs(K: sp.csr_matrix, free: np.ndarray, rhs: np.ndarray,
     mask = fixed if rhs.ndim == 1 else fixed[:, None]
     if du_fixed is None:
         return np.where(mask, 0.0, rhs)
-    b = rhs - K @ np.where(fixed, du_fixed, 0.0)
+    moved = np.where(fixed, du_fixed, 0.0)
+    b = rhs - K @ moved if moved.any() else rhs      # a finite K @ 0 is +0: rhs - 0 is rhs
     return np.where(mask, du_fixed if rhs.ndim == 1 else du_fixed[:, None], b)
