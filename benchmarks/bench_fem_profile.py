@@ -1,7 +1,7 @@
 """Where a stiffness curve's time goes: cup A, frictionless, u = 0 .. 0.9 h1, per fidelity level.
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_fem_profile.py [--levels coarse medium]
-        [--contact frictionless] [--repeat 3]
+        [--contact frictionless] [--repeat 3] [--whole]
 
 Runs `fem.cup.compress_cup` in-process (no start-up, no CSV) and prints per curve: load steps,
 Newton iterations, dofs, factorizations, the in-process wall time (first call and the median of
@@ -22,6 +22,9 @@ its share of the wall time:
 and, on the tangent of the last factorization of the path (its free block K_ff), the time of one
 factorization by the solver itself and by scipy's sparse LU (`scipy.sparse.linalg.splu`, COLAMD
 ordering): the scale of the linear algebra alone against the time per Newton iteration.
+With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
+--repeat runs, CPU time of the child and wall time), whose excess over the in-process curve is
+start-up (imports), the mesh and the output files.
 Times are the process's CPU time (`time.process_time`; one thread with OMP_NUM_THREADS=1, so on a
 quiet machine the wall time, which a busy second core inflates); the wrappers cost ~1 us a call.
 """
@@ -30,8 +33,12 @@ from __future__ import annotations
 
 import argparse
 import functools
+import os
+import resource
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -146,6 +153,25 @@ def profile_curve(level: str, contact: str, repeat: int) -> dict:
             "free": int(free.sum())}
 
 
+def whole_process(level: str, contact: str, repeat: int) -> tuple[float, float]:
+    """(CPU, wall) [s] of `cupcheck stiffness` for cup A at `level`, the medians of `repeat` runs."""
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root), "OMP_NUM_THREADS": "1"}
+    cpu, wall = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(repeat):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "validation.cli", "stiffness", "--cup", "A",
+                            "--fidelity", level, "--contact", contact, "--out",
+                            str(Path(tmp) / "curve.csv")], cwd=root, env=env, check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            wall.append(time.perf_counter() - t)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
+    return statistics.median(cpu), statistics.median(wall)
+
+
 def report(r: dict) -> None:
     n = r["newton"]
     print(f"\ncup A {r['level']}: {r['steps']} steps, {n} Newton iterations, {r['dofs']} dofs "
@@ -161,6 +187,9 @@ def report(r: dict) -> None:
         calls = r["calls"].get(part, 0)
         per_call = f"{1e3 * t / calls:11.3f}" if calls else f"{'':11}"
         print(f"  {part:9} {t:7.3f} {t / total:6.1%} {calls:6d} {per_call} {1e3 * t / n:16.2f}")
+    if "whole_cpu" in r:
+        print(f"  whole process (cupcheck stiffness): CPU {r['whole_cpu']:.3f} s, wall {r['whole_wall']:.3f} s; "
+              f"beyond the curve (start-up, mesh, output): CPU {r['whole_cpu'] - r['median']:.3f} s")
 
 
 def main() -> None:
@@ -168,10 +197,14 @@ def main() -> None:
     ap.add_argument("--levels", nargs="+", default=["coarse", "medium"])
     ap.add_argument("--contact", default="frictionless", choices=["frictionless", "sticking"])
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--whole", action="store_true", help="also time the whole cupcheck process")
     args = ap.parse_args()
     _instrument()
     for level in args.levels:
-        report(profile_curve(level, args.contact, args.repeat))
+        r = profile_curve(level, args.contact, args.repeat)
+        if args.whole:
+            r["whole_cpu"], r["whole_wall"] = whole_process(level, args.contact, args.repeat)
+        report(r)
 
 
 if __name__ == "__main__":
