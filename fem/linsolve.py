@@ -137,7 +137,8 @@ class BandedCholesky:
         self.n, self.kd = n, int(np.max(pj - pi))
         self._indptr, self._indices = pattern.indptr, pattern.indices
         self._sel = np.flatnonzero(upper)
-        self._band = (self.kd + pi[upper] - pj[upper]) * n + pj[upper]     # flat index into ab
+        # flat index into ab [kd + 1, n] in Fortran order, the layout LAPACK takes without a copy
+        self._band = (self.kd + pi[upper] - pj[upper]) + (self.kd + 1) * pj[upper]
         self._perm, self._inv = perm, inv
 
     def factor(self, K: sp.csr_matrix, free: np.ndarray, shift: float = 0.0) -> "Factor":
@@ -147,11 +148,21 @@ class BandedCholesky:
             raise ValueError("BandedCholesky: the matrix does not have the pattern it was built for")
         return Factor(self, K, free, self.band_factor(K.data, free, shift), shift)
 
+    @property
+    def upper_entries(self) -> np.ndarray:
+        """The positions in the pattern's CSR data of the entries the band holds (the upper
+        triangle in the band's ordering), in the order `upper_band_factor` takes them."""
+        return self._sel
+
     def band_factor(self, data: np.ndarray, free: np.ndarray, shift: float = 0.0) -> np.ndarray:
         """The banded Cholesky factor of K_ff from the CSR `data` of K (the pattern's layout)."""
+        return self.upper_band_factor(data[self._sel], free, shift)
+
+    def upper_band_factor(self, upper: np.ndarray, free: np.ndarray, shift: float = 0.0) -> np.ndarray:
+        """`band_factor` from K's entries at `upper_entries` only."""
         ab = np.zeros((self.kd + 1) * self.n)
-        ab[self._band] = data[self._sel]
-        ab = ab.reshape(self.kd + 1, self.n)
+        ab[self._band] = upper
+        ab = ab.reshape((self.kd + 1, self.n), order="F")
         fixed_p = ~free[self._perm]
         at = np.flatnonzero(fixed_p)                           # the constrained rows and columns
         ab[:, at] = 0.0
