@@ -12,7 +12,8 @@ its share of the wall time:
              CSR assembly), per evaluation;
   factor     the shifted factorizations of K_ff (`fem.factorization.ShiftPolicy.factor`, with the
              condensation of the interior nodes) and the Schur complements of freed contact
-             nodes (`fem.linsolve.BorderedFactor`);
+             nodes (`fem.linsolve.BorderedFactor`); its calls count the requests, a reused
+             factor included (the header gives the factorizations done);
   solve      the triangular solves with those factors;
   lcp        the contact step's small LCP (non-negative least squares);
   post       the per-step outputs (`fem.cup._measure`: pressure profile, r_c, l, V, stretch) and
