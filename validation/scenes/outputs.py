@@ -7,7 +7,7 @@ PNG and SVG, axes labelled with units; tables name design, contact law, mesh, ro
 and on disk when given a directory, written atomically with ``manifest.json``).
 
 A rerun into the same directory does no work for what has not changed: the manifest records, for
-every file, the key of what its output was made from (`output_key`) and the sha256 of its bytes;
+every file, the key of what its output was made from (`made_from`) and the sha256 of its bytes;
 an output whose key is unchanged and whose files are present and intact is kept as it is (its
 files linked into the new directory, mtimes unchanged), any other is drawn again; a rerun that
 changes nothing writes nothing.
@@ -30,7 +30,7 @@ from validation.bridge.products import Products
 from validation.bridge.study import Study
 from validation.scenes.schema import STATE_KINDS, Scene, load_scene, scene_from_mapping
 
-__all__ = ["run_scene", "SceneResult", "output_key"]
+__all__ = ["run_scene", "SceneResult", "made_from"]
 
 #: the manifest's name in a scene's output directory
 MANIFEST = "manifest.json"
@@ -52,11 +52,12 @@ class SceneResult:
     up_to_date: bool = False        # the directory was left as it was: nothing written
 
 
-def output_key(output: Mapping[str, Any], study: Study, versions: Mapping[str, str]) -> str:
-    """A content key of what `output` is made from: its own keys, the part of the study it depends
-    on (input files by path and by the sha256 of their bytes), the sources of fem, reduced and
-    validation, and `versions` (`validation.output.software_versions`: the packages the numbers
-    come from)."""
+def made_from(output: Mapping[str, Any], study: Study, versions: Mapping[str, str]) -> dict[str, Any]:
+    """What `output` is made from, for the manifest: ``key``, a content key of its own keys, the part
+    of the study it depends on (input files by path and by the sha256 of their bytes), the sources
+    of fem, reduced and validation and `versions` (`validation.output.software_versions`: the
+    packages the numbers come from); ``made_from``, the study parts by name; ``sources``, the
+    sources' hash."""
     record = study.describe()
     record["design"]["file_sha256"] = file_digest(study.design.file)
     record["surface"]["uc_table_sha256"] = file_digest(study.surface.uc_table)
@@ -67,9 +68,11 @@ def output_key(output: Mapping[str, Any], study: Study, versions: Mapping[str, s
         parts = (*_FEM_PARTS, "stiffness")
     else:
         parts = tuple(record)
-    made_from = {"output": dict(output), "study": {p: record[p] for p in parts},
-                 "sources": source_hash("fem", "reduced", "validation"), "versions": dict(versions)}
-    return hashlib.sha256(json.dumps(made_from, sort_keys=True, default=str).encode()).hexdigest()[:32]
+    sources = source_hash("fem", "reduced", "validation")
+    inputs = {"output": dict(output), "study": {p: record[p] for p in parts}, "sources": sources,
+              "versions": dict(versions)}
+    key = hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()[:32]
+    return {"key": key, "made_from": list(parts), "sources": sources}
 
 
 def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
@@ -97,16 +100,16 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
 
     out = Path(out)
     versions = software_versions()
-    keys = [output_key(o, study, versions) for o in scene.outputs]
+    made = [made_from(o, study, versions) for o in scene.outputs]
     previous = _manifest(out) if reuse else None
-    intact = [_intact_files(o, key, previous, out) for o, key in zip(scene.outputs, keys)]
+    intact = [_intact_files(o, m["key"], previous, out) for o, m in zip(scene.outputs, made)]
     if previous is not None and _up_to_date(previous, scene, intact):
         files = [{**f, "path": str(out / f["path"])} for kept in intact for f in kept]
         return SceneResult(scene, {}, files, {}, kept=list(files), up_to_date=True)
     products = Products(study, cache_dir=cache_dir, progress=progress)
     with atomic_directory(out) as tmp:
         files, kept = [], []
-        for k, (o, key, old) in enumerate(zip(scene.outputs, keys, intact)):
+        for k, (o, origin, old) in enumerate(zip(scene.outputs, made, intact)):
             if progress is not None:
                 progress(f"output {k + 1} of {n}: {o['name']}")
             linked = _link(old, out, Path(tmp)) if old else None
@@ -114,11 +117,10 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
                 kept += linked
                 files += linked
                 continue
-            files += [{**f, "key": key, "sha256": file_digest(f["path"])} for f in _write(o, products, Path(tmp))]
+            files += [{**f, **origin, "sha256": file_digest(f["path"])} for f in _write(o, products, Path(tmp))]
         manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
                     "scene": scene.resolved(), "source": scene.source,
-                    "versions": versions, "timings_s": {**products.timings,
-                                                                   "total": time.perf_counter() - t0}}
+                    "versions": versions, "timings_s": {**products.timings, "total": time.perf_counter() - t0}}
         (Path(tmp) / MANIFEST).write_text(json.dumps(manifest, indent=1, default=str) + "\n")
     rename = lambda f: {**f, "path": str(out / Path(f["path"]).name)}    # noqa: E731
     return SceneResult(scene, products.computed(), [rename(f) for f in files], dict(products.timings),
