@@ -84,8 +84,9 @@ class _VersionAction(argparse.Action):
 
 
 def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
-    """The `cupcheck` parser: every command listed with its help; the full parsers (the command's
-    module imported, its options added) of `commands` only (None: of every command)."""
+    """The `cupcheck` parser with the full parsers (the command's module imported, its options
+    added) of `commands` (None: of every command); none given, every command is listed by its help
+    line alone (bare ``cupcheck``, ``--help``, an unknown command)."""
     parser = OneLineParser(
         prog="cupcheck",
         description="Suction-cup cross-checks: axisymmetric FEM stiffness and the Tiwari-Persson "
@@ -96,7 +97,8 @@ def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentPars
     full = set(COMMANDS if commands is None else commands)
     for name, (module_name, line) in COMMANDS.items():
         if name not in full:
-            sub.add_parser(name, help=line)
+            if not full:
+                sub.add_parser(name, help=line)
             continue
         module = importlib.import_module(module_name)
         p = sub.add_parser(name, help=line, description=module.__doc__,

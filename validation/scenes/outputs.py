@@ -52,12 +52,11 @@ class SceneResult:
     up_to_date: bool = False        # the directory was left as it was: nothing written
 
 
-def made_from(output: Mapping[str, Any], study: Study, versions: Mapping[str, str]) -> dict[str, Any]:
+def made_from(output: Mapping[str, Any], study: Study) -> dict[str, Any]:
     """What `output` is made from, for the manifest: ``key``, a content key of its own keys, the part
-    of the study it depends on (input files by path and by the sha256 of their bytes), the sources
-    of fem, reduced and validation and `versions` (`validation.output.software_versions`: the
-    packages the numbers come from); ``made_from``, the study parts by name; ``sources``, the
-    sources' hash."""
+    of the study it depends on (input files by path and by the sha256 of their bytes) and the
+    sources of fem, reduced and validation (like the products' cache keys: no package versions);
+    ``made_from``, the study parts by name; ``sources``, the sources' hash."""
     record = study.describe()
     record["design"]["file_sha256"] = file_digest(study.design.file)
     record["surface"]["uc_table_sha256"] = file_digest(study.surface.uc_table)
@@ -69,8 +68,7 @@ def made_from(output: Mapping[str, Any], study: Study, versions: Mapping[str, st
     else:
         parts = tuple(record)
     sources = source_hash("fem", "reduced", "validation")
-    inputs = {"output": dict(output), "study": {p: record[p] for p in parts}, "sources": sources,
-              "versions": dict(versions)}
+    inputs = {"output": dict(output), "study": {p: record[p] for p in parts}, "sources": sources}
     key = hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()[:32]
     return {"key": key, "made_from": list(parts), "sources": sources}
 
@@ -99,8 +97,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
         return SceneResult(scene, products.computed(), [], dict(products.timings))
 
     out = Path(out)
-    versions = software_versions()
-    made = [made_from(o, study, versions) for o in scene.outputs]
+    made = [made_from(o, study) for o in scene.outputs]
     previous = _manifest(out) if reuse else None
     intact = [_intact_files(o, m["key"], previous, out) for o, m in zip(scene.outputs, made)]
     if previous is not None and _up_to_date(previous, scene, intact):
@@ -120,7 +117,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
             files += [{**f, **origin, "sha256": file_digest(f["path"])} for f in _write(o, products, Path(tmp))]
         manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
                     "scene": scene.resolved(), "source": scene.source,
-                    "versions": versions, "timings_s": {**products.timings, "total": time.perf_counter() - t0}}
+                    "versions": software_versions(), "timings_s": {**products.timings, "total": time.perf_counter() - t0}}
         (Path(tmp) / MANIFEST).write_text(json.dumps(manifest, indent=1, default=str) + "\n")
     rename = lambda f: {**f, "path": str(out / Path(f["path"]).name)}    # noqa: E731
     return SceneResult(scene, products.computed(), [rename(f) for f in files], dict(products.timings),
