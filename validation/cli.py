@@ -43,7 +43,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                 "FEM response to the cavity suction on a (u, dp) grid, for lifetime --route coupled (JSON)"),
     "sweep": ("validation.commands.sweep",
               "many cup designs on dask.distributed: stiffness, Appendix A ratio, lifetimes (Parquet, CSV, maps)"),
-    "uc": ("validation.commands.uc", "critical gap u_c(p) of a rough surface (Persson theory; presets, PSD or line scan)"),
+    "uc": ("validation.commands.uc",
+           "critical gap u_c(p) of a rough surface (Persson theory; presets, PSD or line scan)"),
     "validate": ("validation.commands.validate",
                  "cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes, the paper's "
                  "numbers, Coulomb friction (CSV, MD, PNG, JSON)"),

@@ -117,7 +117,8 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
             files += [{**f, **origin, "sha256": file_digest(f["path"])} for f in _write(o, products, Path(tmp))]
         manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
                     "scene": scene.resolved(), "source": scene.source,
-                    "versions": software_versions(), "timings_s": {**products.timings, "total": time.perf_counter() - t0}}
+                    "versions": software_versions(),
+                    "timings_s": {**products.timings, "total": time.perf_counter() - t0}}
         (Path(tmp) / MANIFEST).write_text(json.dumps(manifest, indent=1, default=str) + "\n")
     rename = lambda f: {**f, "path": str(out / Path(f["path"]).name)}    # noqa: E731
     return SceneResult(scene, products.computed(), [rename(f) for f in files], dict(products.timings),
@@ -148,7 +149,7 @@ def _intact_files(output: Mapping[str, Any], key: str, manifest: dict | None, ou
 def _same_bytes(directory: Path, entry: Mapping[str, Any]) -> bool:
     """`entry`'s file (a plain name in `directory`) is there and its sha256 is the recorded one."""
     name, digest = entry.get("path"), entry.get("sha256")
-    if not isinstance(name, str) or not isinstance(digest, str) or Path(name).name != name or name in ("", ".", ".."):
+    if not (isinstance(name, str) and isinstance(digest, str)) or Path(name).name != name or name in ("", ".", ".."):
         return False
     path = directory / name
     return path.is_file() and not path.is_symlink() and file_digest(path) == digest
