@@ -293,7 +293,7 @@ def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
     if sc["loads"]["r_start_mm"] is not None:
         base["r_start_mm"] = sc["loads"]["r_start_mm"]
     if sc["cup"]["geometry"]:
-        from fem.geometry import load_geometry
+        from fem.design_file import load_geometry
         d = load_geometry(sc["cup"]["geometry"], cup=sc["cup"]["preset"]).describe()
         base.update(r0_mm=d["r0_mm"], r1_mm=d["r1_mm"], alpha_deg=d["alpha_deg"], d0_mm=d["d_at_r0_mm"],
                     d1_mm=d["d_at_r1_mm"])
