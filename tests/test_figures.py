@@ -52,12 +52,14 @@ def _log_tick_labels(fig) -> list[list[str]]:
 
 
 def _x_labels_overlap(fig) -> bool:
-    """Whether any axes of a drawn figure has two x tick labels (inside the view) that overlap."""
+    """Whether any axes of a drawn figure has two shown x tick labels (inside the view) that overlap
+    (the hidden labels of an axes sharing x with the one below have no extent to compare)."""
     renderer = fig.canvas.get_renderer()
     for ax in fig.axes:
         lo, hi = sorted(ax.xaxis.get_view_interval())
         boxes = [t.label1.get_window_extent(renderer) for t in ax.xaxis.get_major_ticks()
-                 if lo - 1e-9 * abs(hi) <= t.get_loc() <= hi + 1e-9 * abs(hi) and t.label1.get_text()]
+                 if lo - 1e-9 * abs(hi) <= t.get_loc() <= hi + 1e-9 * abs(hi) and t.label1.get_text()
+                 and t.label1.get_visible()]
         if _boxes_overlap(boxes):
             return True
     return False
@@ -233,6 +235,16 @@ def test_nice_length_is_1_2_5_not_above_the_limit():
     for limit, nice in ((0.0123, 0.01), (0.0049, 0.002), (2.6e-4, 2e-4), (0.05, 0.05)):
         assert style.nice_length(limit) == pytest.approx(nice)
     assert style.length_label(0.005) == "5 mm" and style.length_label(2e-4) == "200 \u00b5m"
+
+
+def test_a_3d_views_caption_names_design_contact_law_and_mesh():
+    from validation.bridge.products import Products
+    from validation.bridge.study import Contact, CupDesign, Study
+    from validation.scenes.views3d import view_caption
+
+    study = Study(design=CupDesign(preset="B"), contact=Contact("coulomb", 0.5), fidelity="medium")
+    assert view_caption(Products(study)) == "cup B, coulomb mu = 0.5, medium mesh"
+    assert view_caption(Products(Study())) == "cup A, frictionless, coarse mesh"
 
 
 # ------------------------------------------------------------------------------ 3D views (real renders)

@@ -34,6 +34,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                 "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"),
     "lifetime": ("validation.commands.lifetime",
                  "lifetime of a suction cup under pull forces (reduced leakage model, eqs 3-24)"),
+    "paper": ("validation.commands.paper",
+              "draw the paper's calculated figures: FEM-fed beside the paper's inputs, its stated numbers marked"),
     "render": ("validation.commands.render",
                "3D view (cut-away, footprint from below, squeeze GIF) of a stiffness run's fields file"),
     "run": ("validation.commands.run", "run a scene file: the curves, lifetimes and figures it asks for (cached)"),

@@ -3,7 +3,7 @@
 Each pulls only the deformed states it shows (`Products.fem_frames`: the FEM run only to the
 largest u asked for) and draws them with `validation.render.views`. The footprint's scale (metres
 per pixel, the axis pixel and the contact zones drawn) goes into a JSON file beside the image, so
-the image can be measured.
+the image can be measured. Every view's title names the design, the contact law and the mesh level.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 
 from validation.bridge.products import Products
 
-__all__ = ["write_view"]
+__all__ = ["write_view", "view_caption"]
 
 
 def write_view(output: dict, products: Products, tmp: Path | None) -> list[dict[str, str]]:
@@ -24,17 +24,15 @@ def write_view(output: dict, products: Products, tmp: Path | None) -> list[dict[
         return []
     from validation.render import views
 
-    contact = products.study.contact
-    law = contact.law + (f", mu = {contact.friction:g}" if contact.law == "coulomb"
-                                     else "")
+    law = view_caption(products)
     files = []
     if kind == "render":
         image = views.cutaway(frames[-1], output["field"], tmp / f"{name}.png",
-                              title=f"u = {1e3 * frames[-1].u_m:.3g} mm, {law}")
+                              title=f"{law}, u = {1e3 * frames[-1].u_m:.3g} mm")
         files.append(_file(name, kind, image.path))
     elif kind == "footprint":
         image = views.footprint(frames[-1], tmp / f"{name}.png",
-                                title=f"from below, u = {1e3 * frames[-1].u_m:.3g} mm, {law}")
+                                title=f"{law}, from below, u = {1e3 * frames[-1].u_m:.3g} mm")
         scale = tmp / f"{name}.json"
         scale.write_text(json.dumps({"m_per_px": image.m_per_px, "centre_px": image.centre_px,
                                      "view_box_px": image.view_box_px, "scale_bar_m": image.scale_bar_m,
@@ -44,6 +42,12 @@ def write_view(output: dict, products: Products, tmp: Path | None) -> list[dict[
         seq = views.squeeze(frames, output["field"], tmp / name, title=law)
         files += [_file(name, kind, p) for p in seq.frames] + [_file(name, kind, seq.gif)]
     return files
+
+
+def view_caption(products: Products) -> str:
+    """What a 3D view shows: the design, the FEM's contact law (with mu) and its mesh level."""
+    s = products.study
+    return f"{s.design.label}, {s.contact.label()}, {s.fidelity} mesh"
 
 
 def _file(name: str, kind: str, path: Path) -> dict[str, str]:
