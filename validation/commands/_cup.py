@@ -86,16 +86,16 @@ def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = 
                    help="eq (5)'s strip width at r1 in mm (with --l0-mm)")
 
 
-def cup_laws(args: argparse.Namespace, coupled: bool = False) -> str:
+def cup_laws(args: argparse.Namespace, coupled: bool = False, fem: bool = False) -> str:
     """Where r(h), V(h), l(h) come from for the --route and --cup-laws given
     (`validation.bridge.lifetimes.route_laws`: the route's default, or --cup-laws checked against it).
-    `coupled`: the command runs the coupled route itself (else it is refused here)."""
+    `coupled`, `fem`: the command runs that route itself (else it is refused here)."""
     from validation.bridge.lifetimes import route_laws
 
     if args.route == "coupled" and not coupled:
         raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
-    if args.route == "fem":
-        raise ValueError("--route: fem is a route of `cupcheck lifetime`")
+    if args.route == "fem" and not fem:
+        raise ValueError("--route: fem is a route of `cupcheck lifetime` and `cupcheck example`")
     return route_laws(args.route, args.cup_laws)
 
 

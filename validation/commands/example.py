@@ -18,6 +18,9 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
      built here and cached in --cache-dir, or read from --suction-table): F1, V and the profile of
      every state from the FEM, replacing eqs (3)-(7) and beta (`reduced.coupled`). Building the
      table takes ~3 min (coarse) to ~8 min (medium) once per design and law.
+   - fem: the cup's whole life in the FEM (`validation.bridge.fem_route`): pressed to r_start (or
+     --press-u-mm, --press-force-N) with the gas escaping, sealed, held at F1 along its equilibrium
+     branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse).
    Another design (--geometry FILE) runs the same chain on its own geometry (`validation.bridge.design`).
 
 Writes to DIR, atomically:
@@ -28,6 +31,8 @@ Writes to DIR, atomically:
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
+  trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N, p_b, u, plate force, V, r_c,
+                          seal radius, r_out, leak rate)
   manifest.json           the files and the study (`validation.bridge.study.Study`) they were computed for
 """
 
@@ -73,6 +78,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="where built suction tables are kept (default: %(default)s, the user's cache; "
                         "$CUPCHECK_CACHE_DIR moves it)")
     c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
+    f = p.add_argument_group("fem route")
+    f.add_argument("--press-u-mm", dest="press_u_mm", type=float, default=None, metavar="MM",
+                   help="press the cup to this plate displacement before sealing it (default: to r_start)")
+    f.add_argument("--press-force-N", dest="press_force_N", type=float, default=None, metavar="N",
+                   help="press the cup with this force before sealing it (default: to r_start)")
+    f.add_argument("--du-mm", dest="du_mm", type=float, default=0.25,
+                   help="plate step along the equilibrium branch in mm (default: %(default)s)")
     src = p.add_mutually_exclusive_group()
     src.add_argument("--surface", default=None, metavar="NAME",
                      help="calibrated surface preset for u_c(p/E) (default: pmma-1.89)")
@@ -110,13 +122,27 @@ def write_table(results, path: Path, cup: str, study: Study) -> None:
 
     route = study.route
     s = [r.summary() for r in results]
-    own = ("u_final_mm",) if route == "coupled" else ("ballistic_share", "r_final_mm")
+    own = {"coupled": ("u_final_mm",), "fem": ("u_final_mm", "seal_r_final_mm")}.get(
+        route, ("ballistic_share", "r_final_mm"))
+    largest = {"largest_force_N": results.largest_force_N} if route == "fem" else {}
     record = {k: v for k, v in study.record().items() if k not in ("design", "route")}
     write_csv(path, {"cup": cup, "route": route, **record, "force_N": [r.force_N for r in results],
                      "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in s],
-                     "reason": [r.reason for r in results],
-                     **{key: [_blank(x[key]) for x in s] for key in (*own, "p_b_final_Pa")}},
+                     "reason": [r.reason for r in results], **largest,
+                     **{key: [_blank(x.get(key)) for x in s] for key in (*own, "p_b_final_Pa")}},
               stage="example lifetimes")
+
+
+def _write_trajectories(results, tmp: Path, cup: str) -> None:
+    """The fem route's FEM states of each force, one CSV per force (none where the cup let go at once)."""
+    from validation.output import write_table as write_csv
+
+    for r in results:
+        columns = r.trajectory_columns()
+        if columns:
+            write_csv(tmp / f"trajectory_F1_{r.force_N:g}N.csv",
+                      {"cup": cup, "t_s": columns["t_s"], **{k: v for k, v in columns.items() if k != "t_s"}},
+                      stage=f"example trajectory at F1 = {r.force_N:g} N")
 
 
 def _blank(value):
@@ -139,8 +165,38 @@ def study_of(args: argparse.Namespace, contact: ContactChoice) -> Study:
                  fidelity=args.fidelity, stiffness="fem",
                  surface=Surface(preset=None if args.uc_table else (args.surface or DEFAULT_SURFACE),
                                  uc_table=args.uc_table),
-                 route=args.route, cup_laws=args.cup_laws, loads=Loads(forces_N=FORCES_N, r_start_mm=args.r_start_mm),
+                 route=args.route, cup_laws=args.cup_laws,
+                 loads=Loads(forces_N=FORCES_N, r_start_mm=args.r_start_mm, press_u_mm=args.press_u_mm,
+                             press_force_N=args.press_force_N, du_mm=args.du_mm),
                  refine=4, suction_table=args.suction_table)
+
+
+def _check_fem_route(args: argparse.Namespace) -> None:
+    """The fem route's options (--press-u-mm, --press-force-N, --du-mm) with it only; one press;
+    eq (5)'s strip widths refused there (its seal is the FEM's)."""
+    import math
+
+    from validation.guards import check_forces
+
+    press = [opt for opt, value in (("--r-start-mm", args.r_start_mm), ("--press-u-mm", args.press_u_mm),
+                                    ("--press-force-N", args.press_force_N)) if value is not None]
+    own = press[1:] if args.route == "fem" else [o for o in press if o != "--r-start-mm"]
+    if args.route != "fem" and args.du_mm != 0.25:
+        own.append("--du-mm")
+    if own and args.route != "fem":
+        raise ValueError(f"{own[0]}: applies to --route fem only")
+    if own:
+        raise ValueError(f"{own[0]}: the cup is pressed one way: give one of {', '.join(press)}")
+    if args.route != "fem":
+        return
+    if args.l0_mm is not None or args.l1_mm is not None:
+        raise ValueError("--l0-mm: the fem route's seal is its FEM states' contact; drop --l0-mm, --l1-mm")
+    if args.press_u_mm is not None and not (math.isfinite(args.press_u_mm) and args.press_u_mm > 0):
+        raise ValueError(f"--press-u-mm: the plate displacement must be > 0 mm, got {args.press_u_mm:g}")
+    if args.press_force_N is not None:
+        check_forces(args.press_force_N, "--press-force-N")
+    if not (math.isfinite(args.du_mm) and args.du_mm > 0):
+        raise ValueError(f"--du-mm: the plate step along the branch must be > 0 mm, got {args.du_mm:g}")
 
 
 def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
@@ -204,7 +260,8 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import check_outputs, command_inputs
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
-    laws = cup_laws(args, coupled=True)
+    laws = cup_laws(args, coupled=True, fem=True)
+    _check_fem_route(args)
     geometry, contact, uc_label = _inputs(args)
     _check_suction_table(args, geometry, contact)
     study = study_of(args, contact)
@@ -232,6 +289,8 @@ def run(args: argparse.Namespace) -> int:
                 paper, inherit=("uc_table", "curve", "cup")).lifetimes()
         series["Appendix A-fed, paper route (d0 2 mm)"] = products.appendix_a(refine=1).lifetimes()
         write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, study)
+        if args.route == "fem":
+            _write_trajectories(results, tmp, choice.cup.name)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
              f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
         _write_manifest(tmp, study)
@@ -242,6 +301,8 @@ def run(args: argparse.Namespace) -> int:
                                                                  if patch else " (raw: the u_c table has no patch length)"),
                "coupled": "the contact-pressure profile of each (u, dp) state of the FEM suction table "
                           f"(largest holdable force {holdable:.4g} N)" if args.route == "coupled" else "",
+               "fem": "the contact-pressure profile of each FEM state along the cup's equilibrium branch "
+                      f"(largest holdable force {holdable:.4g} N)",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
                                                             if laws == "cone" else "")}[_seal(args.route)]
     print(f"{choice.label}: FEM {contact.contact.label()} stiffness (from the "
@@ -255,7 +316,7 @@ def run(args: argparse.Namespace) -> int:
                                          for n in names) + "  end")
     for i, r in enumerate(results):
         print(f"  {r.force_N:7g} " + " ".join(f"{series[n][i].lifetime_s:24.4g}" for n in names) + f"  {r.reason}")
-    extra = ", suction_table.json" if args.route == "coupled" else ""
+    extra = {"coupled": ", suction_table.json", "fem": ", trajectory_F1_*.csv"}.get(args.route, "")
     print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
           f"{extra} in {wall:.1f} s")
     return 0
@@ -274,10 +335,12 @@ def _write_manifest(tmp: Path, study: Study) -> None:
 
 def _seal(route: str) -> str:
     """What the leak crosses on `route` (the key of the printed description)."""
-    return {"paper": "strip", "profile": "profile", "coupled": "coupled"}[route]
+    return {"paper": "strip", "profile": "profile", "coupled": "coupled", "fem": "fem"}[route]
 
 
 def _rv_source(route: str, laws: str) -> str:
     if route == "coupled":
         return "FEM suction table"
+    if route == "fem":
+        return "FEM states"
     return "FEM curve" if laws == "curve" else "cone laws (3)-(4)"

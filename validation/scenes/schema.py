@@ -43,12 +43,13 @@ _TABLES: dict[str, dict[str, Any]] = {
     "contact": {"law": "frictionless", "friction": None},
     "surface": {"preset": DEFAULT_SURFACE, "uc_table": None},
     "fluid": {"kind": "air"},
-    "loads": {"F1_N": [5.0, 10.0, 20.0, 40.0, 80.0], "r_start_mm": None, "kappa": 1.0},
-    "stiffness": {"source": "fem", "route": "paper", "fidelity": "coarse"},
+    "loads": {"F1_N": [5.0, 10.0, 20.0, 40.0, 80.0], "r_start_mm": None, "kappa": 1.0, "press_u_mm": None,
+              "press_force_N": None},
+    "stiffness": {"source": "fem", "route": "paper", "fidelity": "coarse", "du_mm": 0.25},
 }
 _CHOICES = {("cup", "preset"): ("A", "B"), ("material", "relaxation"): ("none", "default"),
             ("contact", "law"): ("frictionless", "sticking", "coulomb"), ("fluid", "kind"): ("air", "water"),
-            ("stiffness", "source"): ("fem", "appendix-a"), ("stiffness", "route"): ("paper", "profile"),
+            ("stiffness", "source"): ("fem", "appendix-a"), ("stiffness", "route"): ("paper", "profile", "fem"),
             ("stiffness", "fidelity"): ("coarse", "medium", "fine")}
 
 
@@ -71,10 +72,14 @@ MEANING: dict[str, str] = {
     "loads.F1_N": "pull forces F1 [N]: one lifetime (and trajectory) per force",
     "loads.r_start_mm": "start radius of the contact [mm] (default: Table 1's 12 mm for A and B, mid-wall otherwise)",
     "loads.kappa": "stiffness factor: F0 replaced by kappa F0 (the paper's Fig. 1stiffnessFactor)",
+    "loads.press_u_mm": "route = \"fem\": press the cup to this plate displacement [mm] instead of to r_start",
+    "loads.press_force_N": "route = \"fem\": press the cup with this force [N] instead of to r_start",
     "stiffness.source": "F0(h) from the FEM or from Appendix A's formula",
-    "stiffness.route": "how the FEM reaches the lifetime (README, Routes): eq (6)'s strip on the cone, or the "
-                       "FEM's contact-pressure profile (needs source = \"fem\")",
+    "stiffness.route": "how the FEM reaches the lifetime (README, Routes): eq (6)'s strip on the cone, the "
+                       "FEM's contact-pressure profile, or the cup's whole life in the FEM (fem: pressed, sealed, "
+                       "pulled and leaking; air, no relaxation, kappa 1) (profile and fem need source = \"fem\")",
     "stiffness.fidelity": "FEM mesh level",
+    "stiffness.du_mm": "route = \"fem\": the plate step [mm] along the cup's equilibrium branch",
     "sweep.key": "the one parameter varied (contact.friction with law = \"coulomb\")",
     "sweep.values": "its values, each once: one lifetime table row per value and force",
     "outputs[].kind": "what to write: a stiffness curve, lifetimes, trajectories, a figure, or a 3D view "
@@ -130,7 +135,8 @@ class Scene:
                      route=t["stiffness"]["route"],
                      loads=Loads(forces_N=tuple(t["loads"]["F1_N"]), kappa=t["loads"]["kappa"],
                                  r_start_mm=t["loads"]["r_start_mm"], relaxation=t["material"]["relaxation"],
-                                 fluid=t["fluid"]["kind"]),
+                                 fluid=t["fluid"]["kind"], press_u_mm=t["loads"]["press_u_mm"],
+                                 press_force_N=t["loads"]["press_force_N"], du_mm=t["stiffness"]["du_mm"]),
                      outputs=self.outputs,
                      sweep=None if self.sweep is None else Sweep(self.sweep["key"], tuple(self.sweep["values"])))
 
@@ -171,6 +177,7 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
     _guards(tables, data.get("sweep"))
     contact_source = _design_contact(tables, data.get("contact", {}), source)
     _cross_checks(tables, data.get("sweep"))
+    _fem_route_checks(tables, data, data.get("sweep"))
     outputs = data.get("outputs")
     if not isinstance(outputs, list) or not outputs:
         raise ValueError("outputs: a scene needs a non-empty list of [[outputs]]")
@@ -185,6 +192,11 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
     if sweep is not None and any(o["kind"] in ("curve", "trajectories", *STATE_KINDS)
                                  or o["figure"] in ("r_pb_vs_time", "p_Ndot_vs_time") for o in parsed):
         raise ValueError("sweep: a swept scene writes lifetimes and figures; drop the curve, trajectories and 3D outputs")
+    if tables["stiffness"]["route"] == "fem":
+        for i, o in enumerate(parsed):
+            if o["figure"] in ("r_pb_vs_time", "p_Ndot_vs_time"):
+                raise ValueError(f"outputs[{i}].figure: {o['figure']} draws the cone's r(t) or the strip's p(t), "
+                                 f"which the fem route has not; write kind = \"trajectories\" (its FEM states)")
     return Scene(tables=tables, outputs=parsed, source=source, sweep=sweep, contact_source=contact_source)
 
 
@@ -234,7 +246,7 @@ def _table(name: str, given: Any, defaults: dict[str, Any]) -> dict[str, Any]:
         where = f"{name}.{key}"
         if (name, key) in _CHOICES and value not in _CHOICES[(name, key)]:
             raise ValueError(f"{where}: expected one of {', '.join(_CHOICES[(name, key)])}, got {value!r}")
-        if key in ("E_MPa", "nu", "kappa", "r_start_mm") and value is not None:
+        if key in ("E_MPa", "nu", "kappa", "r_start_mm", "press_u_mm", "press_force_N", "du_mm") and value is not None:
             table[key] = _number(value, where, positive=key != "nu")
         if key == "F1_N":
             values = value if isinstance(value, list) else [value]
@@ -344,6 +356,37 @@ def _cross_checks(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
         raise ValueError("material.relaxation: the water-filled cavity is implemented without relaxation only")
     if not 0.0 <= tables["material"]["nu"] < 0.5:
         raise ValueError(f"material.nu: Poisson's ratio must be in [0, 0.5), got {tables['material']['nu']:g}")
+
+
+def _fem_route_checks(tables: dict[str, dict[str, Any]], data: Mapping[str, Any], sweep: Any = None) -> None:
+    """The fem route's own keys and what it does not model (`validation.bridge.fem_route`)."""
+    from validation import guards
+
+    loads, fem = tables["loads"], tables["stiffness"]["route"] == "fem"
+    given = {f"{t}.{k}" for t in ("loads", "stiffness") for k in data.get(t, {})}
+    for key in ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"):
+        if key in given and not fem:
+            raise ValueError(f"{key}: only for stiffness.route = \"fem\" (the cup pressed and sealed in the FEM)")
+    if not fem:
+        return
+    press = [k for k in ("r_start_mm", "press_u_mm", "press_force_N") if loads[k] is not None]
+    if len(press) > 1:
+        raise ValueError(f"loads.{press[1]}: the cup is pressed one way: give one of loads.r_start_mm, "
+                         f"loads.press_u_mm, loads.press_force_N")
+    if loads["press_force_N"] is not None:
+        guards.check_forces(loads["press_force_N"], "loads.press_force_N")
+    if tables["stiffness"]["source"] != "fem":
+        raise ValueError("stiffness.route: 'fem' needs source = \"fem\" (the cup's whole life in the FEM)")
+    if tables["fluid"]["kind"] != "air":
+        raise ValueError("fluid.kind: the fem route models a gas-filled cavity only; drop fluid.kind = \"water\"")
+    if tables["material"]["relaxation"] != "none":
+        raise ValueError("material.relaxation: the fem route's wall is the FEM's elastic one; drop the relaxation")
+    if loads["kappa"] != 1.0:
+        raise ValueError("loads.kappa: the fem route's stiffness is the FEM's own; drop kappa")
+    if isinstance(sweep, Mapping) and sweep.get("key") == "loads.kappa":
+        raise ValueError("sweep.key: the fem route's stiffness is the FEM's own; kappa cannot be swept")
+    if isinstance(sweep, Mapping) and sweep.get("key") == "loads.r_start_mm" and len(press) > 0 and press[0] != "r_start_mm":
+        raise ValueError(f"sweep.key: loads.r_start_mm is swept, but loads.{press[0]} presses the cup; drop one")
 
 
 def _output(output: Any, i: int) -> dict[str, Any]:

@@ -9,9 +9,9 @@ cause, so one bad design never stops a sweep. Quantities (units in the names):
   Appendix A's secant for the design's own alpha, r0, r1, E and root thickness d0 (d1 = 0);
 * ``r_c_start_mm``, ``l_start_mm``: the FEM's inner contact radius and strip width at the start
   state (eq 3's height at r_start); ``largest_force_N``: the largest F1 the fresh cup holds;
-* ``lifetime_s``, ``reason`` per pull force (the paper's route, eqs 3-7 with the cone laws and eq
-  (5)'s strip widths l0, l1 as given, by default Table 1's for the base cup, the only measured
-  ones; no relaxation, u_c(p/E) of the surface);
+* ``lifetime_s``, ``reason`` per pull force (by default the paper's route, eqs 3-7 with the cone
+  laws and eq (5)'s strip widths l0, l1 as given, by default Table 1's for the base cup, the only
+  measured ones; or base.route's; no relaxation, u_c(p/E) of the surface);
 * ``volume_mm3``: the wall's material volume (a cost for the Pareto front);
 * cost: ``wall_time_s``, ``dofs``, ``newton_iterations``.
 """
@@ -58,8 +58,8 @@ def material_volume_mm3(geometry) -> float:
 
 def study_of(design: dict[str, Any], geometry) -> Study:
     """The `validation.bridge.study.Study` of one design of a sweep: its geometry, material, contact law
-    and mesh level, the paper's route with the cone laws and eq (5)'s l0, l1 (Table 1's unless
-    given) on its surface, at its pull forces."""
+    and mesh level, its route (the paper's with the cone laws and eq (5)'s l0, l1, Table 1's unless
+    given; or profile, fem) on its surface, at its pull forces."""
     from reduced.cup import CUPS
     from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
 
@@ -72,7 +72,7 @@ def study_of(design: dict[str, Any], geometry) -> Study:
                  contact=Contact(law=design["contact"], friction=design.get("friction", 0.0) if coulomb else None,
                                  source="sweep file"),
                  fidelity=design["fidelity"], stiffness="fem", surface=Surface(preset=design["surface"]),
-                 route="paper", cup_laws="cone",
+                 route=design.get("route", "paper"), cup_laws="cone" if design.get("route", "paper") == "paper" else None,
                  loads=Loads(forces_N=tuple(design["F1_N"]), r_start_mm=design.get("r_start_mm")), refine=1)
 
 

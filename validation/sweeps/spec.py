@@ -73,9 +73,9 @@ _BASE_DEFAULTS: dict[str, Any] = {
     "r_start_mm": None, "l0_mm": None, "l1_mm": None, "F1_N": [10.0], "F0_at_u_mm": [1.0], "allow_unusual_design": False,
 }
 #: optional base keys, absent unless given (a design's hash is that of its given keys)
-_OPTIONAL = ("friction",)
+_OPTIONAL = ("friction", "route")
 _CHOICES = {"contact": ("frictionless", "sticking", "coulomb"), "fidelity": ("coarse", "medium", "fine"),
-            "cup": ("A", "B")}
+            "cup": ("A", "B"), "route": ("paper", "profile", "fem")}
 _METHODS = ("grid", "lhs", "sobol")
 
 
@@ -92,6 +92,8 @@ MEANING: dict[str, str] = {
     "base.friction": "Coulomb's mu in [0, 100]: with contact = \"coulomb\" only",
     "base.surface": "calibrated surface preset for u_c(p/E) (`cupcheck uc --list-surfaces`)",
     "base.fidelity": "FEM mesh level",
+    "base.route": "the lifetime route (README, Routes; default paper: the cone laws with l0, l1); fem keeps the "
+                  "cup in the FEM for its whole life, pressed to r_start",
     "base.r_start_mm": "start radius of the contact [mm] (default: Table 1's for A and B, mid-wall otherwise)",
     "base.l0_mm": "eq (5)'s strip width at r0 [mm] (default: Table 1's for the base cup, as measured for it)",
     "base.l1_mm": "eq (5)'s strip width at r1 [mm] (default: Table 1's for the base cup)",
@@ -292,6 +294,8 @@ def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
         base["surface"] = sc["surface"]["preset"]
     if sc["loads"]["r_start_mm"] is not None:
         base["r_start_mm"] = sc["loads"]["r_start_mm"]
+    if sc["stiffness"]["route"] != "paper":
+        base["route"] = sc["stiffness"]["route"]
     if sc["cup"]["geometry"]:
         from fem.geometry import load_geometry
         d = load_geometry(sc["cup"]["geometry"], cup=sc["cup"]["preset"]).describe()
@@ -300,6 +304,9 @@ def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
     if sc["surface"]["uc_table"] or sc["stiffness"]["source"] != "fem" or sc["fluid"]["kind"] != "air":
         raise ValueError(f"scene: a sweep evaluates FEM designs in air on a preset surface; '{scene}' asks for "
                          f"another stiffness source, fluid or a u_c table")
+    if sc["loads"]["press_u_mm"] is not None or sc["loads"]["press_force_N"] is not None:
+        raise ValueError(f"scene: a sweep presses each design to its r_start; '{scene}' gives loads.press_u_mm "
+                         f"or loads.press_force_N")
     return base
 
 
@@ -316,7 +323,7 @@ def _base(table: Mapping[str, Any]) -> dict[str, Any]:
     _keys(table, tuple(_BASE_DEFAULTS) + _OPTIONAL, "base")
     base = {**_BASE_DEFAULTS, **table}
     for key, choices in _CHOICES.items():
-        if base[key] not in choices:
+        if key in base and base[key] not in choices:
             raise ValueError(f"base.{key}: expected one of {', '.join(choices)}, got {base[key]!r}")
     if not isinstance(base["allow_unusual_design"], bool):
         raise ValueError(f"base.allow_unusual_design: expected true or false, got {base['allow_unusual_design']!r}")
