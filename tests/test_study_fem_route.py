@@ -74,10 +74,11 @@ def test_a_sweep_file_takes_the_fem_route():
 
 
 @pytest.mark.parametrize("argv,message", [
-    (["--press-u-mm", "3"], "--press-u-mm: applies to --route fem only"),
+    (["--press-u-mm", "3"], "--press-u-mm: only for --route fem"),
     (["--route", "fem", "--r-start-mm", "12", "--press-force-N", "5"], "--press-force-N: the cup is pressed one way"),
     (["--route", "fem", "--l0-mm", "1", "--l1-mm", "1"], "--l0-mm: the fem route's seal"),
-    (["--route", "fem", "--du-mm", "-1"], "--du-mm: the plate step"),
+    (["--route", "fem", "--du-mm", "-1"], "--du-mm: must be > 0, got -1"),
+    (["--route", "fem", "--press-force-N", "2e6"], "--press-force-N = 2e+06: did you give mN?"),
     (["--route", "fem", "--cup-laws", "cone"], "--cup-laws: the fem route"),
 ])
 def test_example_refuses_bad_fem_route_options_before_any_work(capsys, tmp_path, argv, message):

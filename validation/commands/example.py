@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING
 from validation.bridge.cache import user_cache_dir
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
                                       contact_choice, cup_laws, load_cup_design)
+from validation.study_schema import add_flags, check_route, field_of, parse, values_from_args
 
 if TYPE_CHECKING:
     from fem.interface import ContactChoice
@@ -56,6 +57,10 @@ NAME = "example"
 HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"
 
 FORCES_N = tuple(float(f) for f in range(5, 85, 5))
+#: the study's fields `example` spells as flags (`validation.study_schema`; contact: `contact_choice`)
+KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "cup.l0_mm", "cup.l1_mm", "stiffness.route",
+        "loads.r_start_mm", "stiffness.fidelity", "surface.preset", "surface.uc_table", "loads.press_u_mm",
+        "loads.press_force_N", "stiffness.du_mm")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -67,9 +72,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                           "lifetimes on soap-cleaned surfaces, Sec. 5.3-5.5; sticking is Appendix A's "
                           "no-slip bound, whose contact-pressure profile is singular at the stick "
                           "edges and not mesh-converged")
-    p.add_argument("--fidelity", default=None, choices=("coarse", "medium", "fine"),
-                   help="FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
-                        "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)")
+    add_flags(p, ("stiffness.fidelity",), helps={
+        "stiffness.fidelity": "FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
+                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)"})
     c = p.add_argument_group("coupled route")
     c.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
                    help="the design's table from `cupcheck suction` (default: built at --fidelity "
@@ -78,18 +83,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="where built suction tables are kept (default: %(default)s, the user's cache; "
                         "$CUPCHECK_CACHE_DIR moves it)")
     c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
-    f = p.add_argument_group("fem route")
-    f.add_argument("--press-u-mm", dest="press_u_mm", type=float, default=None, metavar="MM",
-                   help="press the cup to this plate displacement before sealing it (default: to r_start)")
-    f.add_argument("--press-force-N", dest="press_force_N", type=float, default=None, metavar="N",
-                   help="press the cup with this force before sealing it (default: to r_start)")
-    f.add_argument("--du-mm", dest="du_mm", type=float, default=0.25,
-                   help="plate step along the equilibrium branch in mm (default: %(default)s)")
-    src = p.add_mutually_exclusive_group()
-    src.add_argument("--surface", default=None, metavar="NAME",
-                     help="calibrated surface preset for u_c(p/E) (default: pmma-1.89)")
-    src.add_argument("--uc-table", default=None, metavar="FILE.csv",
-                     help="critical gap table instead, columns p_over_E,u_c_m (u_c in m)")
+    add_flags(p.add_argument_group("fem route"), ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"))
+    add_flags(p.add_mutually_exclusive_group(), ("surface.preset", "surface.uc_table"), helps={
+        "surface.preset": "calibrated surface preset for u_c(p/E) (default: pmma-1.89)",
+        "surface.uc_table": "critical gap table instead, columns p_over_E,u_c_m (u_c in m)"},
+        **{"--uc-table": {"metavar": "FILE.csv"}})
 
 
 def _inputs(args: argparse.Namespace):
@@ -151,52 +149,32 @@ def _blank(value):
 
 
 def study_of(args: argparse.Namespace, contact: ContactChoice) -> Study:
-    """The main job as a `validation.bridge.study.Study`: the design of --cup/--geometry (E = 4 MPa,
-    nu = 0.49, `contact`) at --fidelity, through --route on the surface, at F1 = 5, 10, ..., 80 N."""
-    from validation.bridge.pipeline import DEFAULT_SURFACE
-    from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
+    """The main job as a `validation.bridge.study.Study`: the study's fields as the flags give them
+    (`KEYS`; E = 4 MPa, nu = 0.49, `contact`), at F1 = 5, 10, ..., 80 N."""
+    from validation.study_schema import study_from_values
 
     law = contact.contact
-    return Study(design=CupDesign(preset=args.cup or "A", file=None if args.geometry is None else str(args.geometry),
-                                  l0_mm=args.l0_mm, l1_mm=args.l1_mm),
-                 material=Material(E_MPa=4.0, nu=0.49),
-                 contact=Contact(law=law.law, friction=law.friction if law.law == "coulomb" else None,
-                                 source=contact.source),
-                 fidelity=args.fidelity, stiffness="fem",
-                 surface=Surface(preset=None if args.uc_table else (args.surface or DEFAULT_SURFACE),
-                                 uc_table=args.uc_table),
-                 route=args.route, cup_laws=args.cup_laws,
-                 loads=Loads(forces_N=FORCES_N, r_start_mm=args.r_start_mm, press_u_mm=args.press_u_mm,
-                             press_force_N=args.press_force_N, du_mm=args.du_mm),
-                 refine=4, suction_table=args.suction_table)
+    values = {k: v for k, v in values_from_args(args, KEYS).items() if v is not None}
+    if args.geometry is not None:
+        values["cup.geometry"] = str(args.geometry)
+    if args.uc_table is not None:                       # the table instead of the default preset
+        values["surface.preset"] = None
+    values.update({"contact.law": law.law, "contact.friction": law.friction if law.law == "coulomb" else None,
+                   "loads.F1_N": FORCES_N})
+    return study_from_values(values, contact_source=contact.source, stiffness="fem", cup_laws=args.cup_laws,
+                             refine=4, suction_table=args.suction_table)
 
 
-def _check_fem_route(args: argparse.Namespace) -> None:
-    """The fem route's options (--press-u-mm, --press-force-N, --du-mm) with it only; one press;
-    eq (5)'s strip widths refused there (its seal is the FEM's)."""
-    import math
-
-    from validation.guards import check_forces
-
-    press = [opt for opt, value in (("--r-start-mm", args.r_start_mm), ("--press-u-mm", args.press_u_mm),
-                                    ("--press-force-N", args.press_force_N)) if value is not None]
-    own = press[1:] if args.route == "fem" else [o for o in press if o != "--r-start-mm"]
-    if args.route != "fem" and args.du_mm != 0.25:
-        own.append("--du-mm")
-    if own and args.route != "fem":
-        raise ValueError(f"{own[0]}: applies to --route fem only")
-    if own:
-        raise ValueError(f"{own[0]}: the cup is pressed one way: give one of {', '.join(press)}")
-    if args.route != "fem":
-        return
-    if args.l0_mm is not None or args.l1_mm is not None:
-        raise ValueError("--l0-mm: the fem route's seal is its FEM states' contact; drop --l0-mm, --l1-mm")
-    if args.press_u_mm is not None and not (math.isfinite(args.press_u_mm) and args.press_u_mm > 0):
-        raise ValueError(f"--press-u-mm: the plate displacement must be > 0 mm, got {args.press_u_mm:g}")
-    if args.press_force_N is not None:
-        check_forces(args.press_force_N, "--press-force-N")
-    if not (math.isfinite(args.du_mm) and args.du_mm > 0):
-        raise ValueError(f"--du-mm: the plate step along the branch must be > 0 mm, got {args.du_mm:g}")
+def check_fields(args: argparse.Namespace) -> None:
+    """The study's numbers as the flags give them (`validation.study_schema.parse`: sign and shared
+    guard, named by flag) and the rules between the route and the other fields (`check_route`)."""
+    values = values_from_args(args, KEYS)
+    defaults = {k: field_of(k).default_in("cli") for k in KEYS}
+    for key, value in values.items():
+        if field_of(key).type == "number" and value is not None:
+            parse(field_of(key), value, "cli")
+    given = {k for k, v in values.items() if v is not None and v != defaults[k]}
+    check_route(values, given, "cli")
 
 
 def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
@@ -261,7 +239,7 @@ def run(args: argparse.Namespace) -> int:
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     laws = cup_laws(args, coupled=True, fem=True)
-    _check_fem_route(args)
+    check_fields(args)
     geometry, contact, uc_label = _inputs(args)
     _check_suction_table(args, geometry, contact)
     study = study_of(args, contact)

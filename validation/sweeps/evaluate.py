@@ -57,23 +57,23 @@ def material_volume_mm3(geometry) -> float:
 
 
 def study_of(design: dict[str, Any], geometry) -> Study:
-    """The `validation.bridge.study.Study` of one design of a sweep: its geometry, material, contact law
-    and mesh level, its route (the paper's with the cone laws and eq (5)'s l0, l1, Table 1's unless
-    given; or profile, fem) on its surface, at its pull forces."""
+    """The `validation.bridge.study.Study` of one design of a sweep: its base keys as the study's
+    fields (`validation.study_schema`), its geometry, its route (the paper's with the cone laws
+    and eq (5)'s l0, l1, Table 1's unless given; or profile, fem) on its surface, at its pull forces."""
+    from dataclasses import replace
+
     from reduced.cup import CUPS
-    from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
+    from validation.study_schema import FIELDS, study_from_values
 
     table1 = CUPS[design["cup"]]
-    l0 = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
-    l1 = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
-    coulomb = design["contact"] == "coulomb"
-    return Study(design=CupDesign(preset=design["cup"], geometry=geometry, l0_mm=l0, l1_mm=l1),
-                 material=Material(E_MPa=design["E_MPa"], nu=design["nu"]),
-                 contact=Contact(law=design["contact"], friction=design.get("friction", 0.0) if coulomb else None,
-                                 source="sweep file"),
-                 fidelity=design["fidelity"], stiffness="fem", surface=Surface(preset=design["surface"]),
-                 route=design.get("route", "paper"), cup_laws="cone" if design.get("route", "paper") == "paper" else None,
-                 loads=Loads(forces_N=tuple(design["F1_N"]), r_start_mm=design.get("r_start_mm")), refine=1)
+    values = {f.key: design[f.sweep] for f in FIELDS if f.sweep and f.sweep in design}
+    values["cup.l0_mm"] = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
+    values["cup.l1_mm"] = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
+    values["contact.friction"] = design.get("friction", 0.0) if design["contact"] == "coulomb" else None
+    route = design.get("route", "paper")
+    study = study_from_values(values, contact_source="sweep file", stiffness="fem",
+                              cup_laws="cone" if route == "paper" else None, refine=1)
+    return replace(study, design=replace(study.design, geometry=geometry))
 
 
 def evaluate_design(design: dict[str, Any]) -> list[dict[str, Any]]:
