@@ -40,6 +40,7 @@ def _study_key(study: Study) -> dict:
     data["design"] = {**data["design"], **_design_key(study)}
     data["surface"] = {**data["surface"], "uc_table": file_digest(study.surface.uc_table)}
     data["suction_table"] = file_digest(study.suction_table)
+    data["stiffness_file"] = file_digest(study.stiffness_file)
     return data
 
 
@@ -192,9 +193,13 @@ class Products:
             {**asdict(surface), "uc_table": file_digest(surface.uc_table)}, source_hash("reduced"), surface=surface))
 
     def curve(self):
-        """The stiffness curve: the FEM's to 0.9 h1, or Appendix A's (d0 = 2 mm) of the study's cup."""
+        """The stiffness curve: the FEM's to 0.9 h1 (or the study's curve file), or Appendix A's
+        (d0 = 2 mm) of the study's cup."""
         if self.study.stiffness == "appendix-a":
             return self._get("curve", self._appendix_a_curve)
+        if self.study.stiffness_file is not None:
+            from reduced.stiffness_curve import StiffnessCurve
+            return self._get("curve", lambda: StiffnessCurve.from_csv(self.study.stiffness_file))
         return self._get("curve", lambda: self._cached(_fem_curve, ignore=["design", "path"])(
             *self._fem_args(self._u_max_m(None)), source_hash("fem", "validation"), self.study.contact.source,
             design=self.study.design,

@@ -133,7 +133,9 @@ class Study:
     for its whole life, from the design, material, contact law, fidelity and the loads' press); cup_laws: the paper route's r, V, l
     ("cone" or "curve", `validation.bridge.lifetimes.route_laws`; None: the route's own); refine: output points per integration
     step of the lifetimes; suction_table: the coupled route's table file (None: built from the
-    design at `fidelity`); outputs: what to write (the scene's [[outputs]])."""
+    design at `fidelity`); stiffness_file: a stiffness curve file (`cupcheck stiffness`) used as
+    the FEM curve instead of running the FEM (its design, law, mesh level and material are then
+    the study's: `cupcheck example --stiffness`); outputs: what to write (the scene's [[outputs]])."""
 
     design: CupDesign = CupDesign()
     material: Material = Material()
@@ -146,6 +148,7 @@ class Study:
     loads: Loads = Loads()
     refine: int = 2
     suction_table: str | None = None
+    stiffness_file: str | None = None
     outputs: tuple[Mapping[str, Any], ...] = field(default=(), compare=False)
     sweep: Sweep | None = None
 

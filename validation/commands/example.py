@@ -22,6 +22,9 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
      --press-u-mm, --press-force-N) with the gas escaping, sealed, held at F1 along its equilibrium
      branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse).
    Another design (--geometry FILE) runs the same chain on its own geometry (`validation.bridge.design`).
+   A curve of `cupcheck stiffness` (--stiffness CURVE.csv) replaces step 1: its design, contact law,
+   mesh level and material are the example's; a --cup, --geometry, --contact, --friction or
+   --fidelity that contradicts the curve is refused.
 
 Writes to DIR, atomically:
 
@@ -41,8 +44,9 @@ from __future__ import annotations
 import argparse
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from validation.bridge.cache import user_cache_dir
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
@@ -65,7 +69,11 @@ KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "cup.l0_mm", "
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (written atomically)")
-    add_cup_arguments(p, "the FEM runs on it and the lifetimes use it")
+    g = add_cup_arguments(p, "the FEM runs on it and the lifetimes use it")
+    g.add_argument("--stiffness", default=None, metavar="CURVE.csv",
+                   help="a stiffness curve of `cupcheck stiffness` (with its .json sidecar) instead of the "
+                        "FEM run: its design, contact law, mesh level and material are used; an option "
+                        "that contradicts them is refused")
     add_cup_law_arguments(p, default_route="profile")
     add_contact_arguments(p.add_argument_group("FEM contact"),
                           "as in the paper: its F0 was measured on soap-lubricated glass and its "
@@ -90,16 +98,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         **{"--uc-table": {"metavar": "FILE.csv"}})
 
 
-def _inputs(args: argparse.Namespace):
+def _inputs(args: argparse.Namespace, geometry=None):
     """Every check before the solve: (the FEM geometry, its contact law (`contact_choice`), the
-    u_c table's label)."""
+    u_c table's label); `geometry`: the design of a --stiffness curve (its law is checked there)."""
     import os
 
     from validation.guards import check_design, check_uc_table
 
-    design = load_cup_design(args)
-    contact = contact_choice(args, design)
-    geometry = design.geometry
+    contact = None
+    if geometry is None:
+        design = load_cup_design(args)
+        contact = contact_choice(args, design)
+        geometry = design.geometry
     check_design(geometry.describe(), args.allow_unusual_design, source=geometry.name)
     if args.uc_table is not None:
         if not os.path.isfile(args.uc_table):
@@ -177,6 +187,60 @@ def check_fields(args: argparse.Namespace) -> None:
     check_route(values, given, "cli")
 
 
+def _curve_inputs(args: argparse.Namespace) -> tuple[Any, ContactChoice, dict[str, Any]]:
+    """(the FEM geometry, the contact law, the Study's fields) of a --stiffness curve: the design,
+    law, mesh level and material its sidecar records. An option that contradicts them, or a curve
+    that names no FEM design or law, is refused (ValueError naming the option)."""
+    from fem.geometry import geometry_from_mapping
+    from fem.interface import ContactChoice, ContactLaw
+    from reduced.stiffness_curve import StiffnessCurve
+    from validation.bridge.design import preset_design, resolve_cup, same_design
+    from validation.bridge.study import CupDesign, Material
+
+    path = Path(args.stiffness)
+    if not path.is_file():
+        raise ValueError(f"--stiffness: no such file '{path}'")
+    curve = StiffnessCurve.from_csv(path)
+    record, law, prov = curve.design, curve.contact, curve.provenance
+    if record is None or law is None or not isinstance(prov.get("material"), dict):
+        raise ValueError(f"--stiffness: '{path.name}' records no FEM design, contact law or material (a measured "
+                         f"or Appendix A curve); give --cup or --geometry and the example computes the FEM curve")
+    label = f"the stiffness curve '{path.name}'"
+    resolve_cup(curve, cup=args.cup, geometry_file=args.geometry, curve_label=label, laws="curve")
+    was = f"{law['law']}" + (f" mu = {law['friction']:g}" if law["law"] == "coulomb" else "")
+    if args.contact is not None and args.contact != law["law"]:
+        raise ValueError(f"--contact: {label} was computed with {was} contact; drop --contact {args.contact} "
+                         f"(the curve's law is used) or derive a {args.contact} curve")
+    if args.friction is not None and (law["law"] != "coulomb" or args.friction != law["friction"]):
+        raise ValueError(f"--friction: {label} was computed with {was} contact; drop --friction")
+    fidelity = prov.get("fidelity")
+    if args.fidelity is not None and fidelity is not None and args.fidelity != fidelity:
+        raise ValueError(f"--fidelity: {label} was computed at the {fidelity} level; drop --fidelity "
+                         f"{args.fidelity} or derive a curve at that level")
+    args.fidelity = args.fidelity or fidelity
+    preset = next((name for name in ("A", "B") if same_design(record, preset_design(name))), None)
+    shape = {k: record[k] for k in ("name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention") if k in record}
+    thickness = record.get("thickness_profile", {})
+    if thickness.get("kind") in ("linear", "table"):
+        shape["thickness"] = {"r_mm": thickness["r_mm"], "d_mm": thickness["d_mm"]}
+    geometry = geometry_from_mapping(shape, source=path.name)
+    if not same_design(geometry.describe(), record):
+        raise ValueError(f"--stiffness: {label} records a wall this example cannot rebuild; give --geometry")
+    contact = ContactChoice(ContactLaw(law["law"], law["friction"]),
+                            f"stiffness curve {path.name}" + (f", from its {law['source']}" if law["source"] else ""))
+    material = Material(E_MPa=prov["material"]["E_Pa"] / 1e6, nu=prov["material"]["nu"])
+    design = CupDesign(preset=preset) if preset else CupDesign(preset=args.cup or "A", geometry=geometry)
+    return geometry, contact, {"design": replace(design, l0_mm=args.l0_mm, l1_mm=args.l1_mm),
+                               "material": material, "stiffness_file": str(path)}
+
+
+def _steps(response, curve) -> Any:
+    """The FEM path's load steps: the run's, or those a given curve's sidecar records."""
+    if response is not None:
+        return response.stats.steps
+    return curve.provenance.get("solver", {}).get("steps", len(curve.u_m) - 1)
+
+
 def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
     """--suction-table: only with the coupled route, an existing table of this very design."""
     if args.suction_table is None:
@@ -226,8 +290,6 @@ def plot(series: dict, curve, cup, path: Path, title: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from dataclasses import replace
-
     from validation.bridge import handoff
     from validation.output import atomic_directory, terminal_progress
     from validation.bridge.products import Products
@@ -237,12 +299,21 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     from validation.output import check_outputs, command_inputs
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
+    given = curve_study = None
+    if args.stiffness is not None:
+        given = _curve_inputs(args)                    # the curve's design, law, level, material
+        geometry, contact, curve_study = given
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     laws = cup_laws(args, coupled=True, fem=True)
     check_fields(args)
-    geometry, contact, uc_label = _inputs(args)
+    if given is None:
+        geometry, contact, uc_label = _inputs(args)
+    else:
+        uc_label = _inputs(args, geometry)[2]
     _check_suction_table(args, geometry, contact)
     study = study_of(args, contact)
+    if curve_study is not None:
+        study = replace(study, **curve_study)
     products = Products(study, suction_cache_dir=None if args.no_cache else args.cache_dir,
                         fem_progress=terminal_progress("FEM"))
     from fem.solver import ConvergenceError
@@ -250,12 +321,16 @@ def run(args: argparse.Namespace) -> int:
 
     with atomic_directory(args.out) as tmp:
         try:
-            response, curve = products.fem_path(None), products.curve()
+            response = None if args.stiffness else products.fem_path(None)
+            curve = products.curve()
         except ConvergenceError as exc:
             raise solver_failure(exc, Path(f"{Path(args.out)}.failure.json")) from None
         choice = products.cup_choice()
-        curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
-        handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
+        if response is None:                           # the given curve, with its own sidecar
+            curve.to_csv(tmp / "stiffness_fem.csv")
+        else:
+            curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
+            handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
         if args.route == "coupled":
             products.suction_table().to_json(tmp / "suction_table.json")
         results = products.lifetimes()
@@ -284,7 +359,7 @@ def run(args: argparse.Namespace) -> int:
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
                                                             if laws == "cone" else "")}[_seal(args.route)]
     print(f"{choice.label}: FEM {contact.contact.label()} stiffness (from the "
-          f"{contact.source}; {args.fidelity}, {response.stats.steps} steps), "
+          f"{contact.source}; {args.fidelity}, {_steps(response, curve)} steps), "
           f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
           f"{_rv_source(args.route, laws)}; {args.route} route: the leak "
