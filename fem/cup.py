@@ -137,7 +137,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
 
     contact: the law at the plane, a `fem.interface.ContactLaw` (frictionless, sticking, or
     coulomb with Coulomb's mu in [0, 100]; a design file's law is
-    `fem.geometry.load_design(path).contact`); or, the older spelling, the law's name with mu as
+    `fem.design_file.load_design(path).contact`); or, the older spelling, the law's name with mu as
     `friction` (`fem.laws.plane_law` converts either).
     admissible_only: end the path with `fem.integrity.StateRejected` at the first converged state
     that violates contact between the nodes or crosses itself (module docstring); False follows

@@ -16,7 +16,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
 from fem.geometry import cup_geometry  # noqa: E402
-from fem.mesh import cup_mesh, write_mesh  # noqa: E402
+from fem.mesh import cup_mesh  # noqa: E402
+from fem.mesh_files import write_mesh  # noqa: E402
 
 CUPS = ("A", "B")
 LEVELS = ("coarse", "medium")

@@ -20,6 +20,7 @@ from typing import Any
 _WHERE = {
     "CupParameters": "reduced.cup", "CUP_A": "reduced.cup", "CUP_B": "reduced.cup", "CUPS": "reduced.cup",
     "StiffnessCurve": "reduced.stiffness_curve", "appendix_a_curve": "reduced.appendix_a",
+    "CupShape": "reduced.design", "ContactRecord": "reduced.design",
     "Gas": "reduced.gas", "AIR": "reduced.gas",
     "RelaxationModulus": "reduced.viscoelastic", "default_relaxation": "reduced.viscoelastic",
     "measurement_contact_time": "reduced.viscoelastic",

@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fem.geometry import Design, geometry_from_mapping, load_design, load_geometry
+from fem.design_file import Design, geometry_from_mapping, load_design, load_geometry
 from fem.interface import (API, CONTACT_LAWS, FILE, ContactChoice, ContactLaw, choose_contact,
                            contact_law)
+from reduced.design import ContactRecord
 from reduced.stiffness_curve import StiffnessCurve
 from tests.cli import run_cli as _run
 
@@ -96,19 +97,19 @@ def test_stiffness_takes_the_files_law_and_the_command_line_wins(capsys, tmp_pat
         curves[name] = StiffnessCurve.from_csv(tmp_path / f"{name}.csv")
     # the file's law is the command line's, to the solver's tolerance
     np.testing.assert_allclose(curves["file"].F0_N, curves["cli"].F0_N, rtol=1e-9, atol=1e-12)
-    assert curves["file"].contact == {"law": "coulomb", "friction": 0.3, "source": "geometry file d.toml"}
-    assert curves["cli"].contact == {"law": "coulomb", "friction": 0.3, "source": "command line"}
+    assert curves["file"].contact == ContactRecord("coulomb", 0.3, "geometry file d.toml")
+    assert curves["cli"].contact == ContactRecord("coulomb", 0.3, "command line")
     sidecar = json.loads((tmp_path / "file.json").read_text())["provenance"]
     assert (sidecar["contact"], sidecar["friction"], sidecar["contact_source"]) == \
         ("coulomb", 0.3, "geometry file d.toml")
     # --contact on the command line wins over the file
-    assert curves["override"].contact == {"law": "frictionless", "friction": 0.0, "source": "command line"}
+    assert curves["override"].contact == ContactRecord("frictionless", 0.0, "command line")
     np.testing.assert_allclose(curves["override"].F0_N, curves["frictionless"].F0_N, rtol=1e-9, atol=1e-12)
-    assert curves["frictionless"].contact["source"] == "default"
+    assert curves["frictionless"].contact.source == "default"
     assert curves["file"].F0_N[-1] > 1.05 * curves["frictionless"].F0_N[-1]   # the law made a difference
     # --friction alone sets the mu of a coulomb file
-    assert curves["mu"].contact["friction"] == 0.6
-    assert curves["mu"].contact["source"] == "geometry file d.toml (law), command line (friction)"
+    assert curves["mu"].contact.friction == 0.6
+    assert curves["mu"].contact.source == "geometry file d.toml (law), command line (friction)"
 
 
 def test_a_lifetime_refuses_a_design_file_whose_contact_contradicts_the_curve(capsys, tmp_path):
@@ -182,6 +183,6 @@ def test_a_scene_run_records_the_design_files_law_with_its_curve(capsys, tmp_pat
     code, _, err = _run(capsys, "run", tmp_path / "s.toml", "--out", tmp_path / "out", "--no-cache")
     assert code == 0, err
     curve = StiffnessCurve.from_csv(tmp_path / "out" / "curve.csv")
-    assert curve.contact == {"law": "coulomb", "friction": 0.3, "source": "geometry file d.toml"}
+    assert curve.contact == ContactRecord("coulomb", 0.3, "geometry file d.toml")
     manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
     assert manifest["scene"]["contact"] == {"law": "coulomb", "friction": 0.3, "source": "geometry file d.toml"}

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from fem.geometry import (CupGeometry, LinearThickness, TabulatedThickness, cup_geometry,
-                          load_geometry, polygon_self_intersects)
+from fem.design_file import load_geometry
+from fem.geometry import CupGeometry, LinearThickness, TabulatedThickness, cup_geometry, polygon_self_intersects
 
 MM = 1e-3
 

@@ -9,7 +9,8 @@ from skfem import Basis, Functional, MeshQuad2, MeshTri2
 
 from fem.geometry import TabulatedThickness, cup_geometry
 from fem.mesh import (BOUNDARY_NAMES, FIDELITIES, MeshSpec, boundary_path, check_cup_mesh,
-                      cup_mesh, mesh_spec, read_mesh, write_mesh)
+                      cup_mesh, mesh_spec)
+from fem.mesh_files import read_mesh, write_mesh
 
 MM = 1e-3
 

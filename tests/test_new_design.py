@@ -36,9 +36,9 @@ def _curve_for(design: dict, path: Path) -> Path:
 
 def test_a_design_differing_only_in_r1_detaches_at_its_own_r1(capsys, tmp_path):
     # the same F0(u) recorded once for cup A and once for cup A with r1 = 21 mm
-    wide = {**preset_design("A"), "name": "wide rim", "r1_mm": 21.0}
+    wide = {**preset_design("A").describe(), "name": "wide rim", "r1_mm": 21.0}
     runs = {}
-    for name, design in (("A", preset_design("A")), ("wide", wide)):
+    for name, design in (("A", preset_design("A").describe()), ("wide", wide)):
         path = _curve_for(design, tmp_path / f"{name}.csv")
         code, out, err = _run(capsys, "lifetime", "--stiffness", path, "--force", "10", "--json",
                               "--l0-mm", "4", "--l1-mm", "0.8")

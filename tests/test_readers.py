@@ -9,7 +9,8 @@ import meshio
 import numpy as np
 import pytest
 
-from fem.mesh import read_mesh
+from fem.mesh_files import read_mesh
+from reduced.design import ContactRecord, CupShape
 from reduced.stiffness_curve import StiffnessCurve
 from reduced.suction_table import SuctionTable
 from tests.catalogue.bad_inputs import GOOD_CURVE, GOOD_TABLE
@@ -88,7 +89,9 @@ def test_a_good_sidecar_reads_back():
     (Path(pytest.tmp) / "c.csv").write_text(GOOD_CURVE)
     _write(SIDECAR, "c.json")
     curve = StiffnessCurve.from_csv(Path(pytest.tmp) / "c.csv")
-    assert curve.contact["friction"] == 0.3 and curve.design["r0_mm"] == 5
+    assert curve.contact == ContactRecord("coulomb", 0.3, None)
+    assert curve.design.same_cup(CupShape(r0_m=5e-3, r1_m=19e-3, alpha_deg=33.0, h1_m=9e-3))
+    assert curve.design.h1_m == pytest.approx(9e-3) and curve.design.name is None
 
 
 @pytest.mark.parametrize("path,value", [c for c in _cases(SIDECAR) if c[0]])

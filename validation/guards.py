@@ -127,9 +127,9 @@ def check_design_data(data: Mapping[str, Any], source: str = "design") -> None:
 def load_design(path: str | Path, cup: str = "A", field: str | None = None, allow_unusual: bool = False,
                 override: str = "pass --allow-unusual-design"):
     """A design file read and guarded: its raw lengths (`check_design_data`), then the file as
-    `fem.geometry.load_design` reads it (its own structural checks), then the built wall
+    `fem.design_file.load_design` reads it (its own structural checks), then the built wall
     (`check_design`). `field` names where the user gave the file (``cup.geometry``, ``--geometry``)."""
-    from fem.geometry import load_design as read_design
+    from fem.design_file import load_design as read_design
 
     path = Path(path)
     source = f"{field} ({path.name})" if field else path.name

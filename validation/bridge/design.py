@@ -1,12 +1,14 @@
 """Which cup a lifetime is computed for: the stiffness curve's recorded design, a geometry file or a
 Table 1 preset, turned into the reduced model's `CupParameters` (eqs 3-6).
 
-An FEM stiffness curve records the design it was computed for (`StiffnessCurve.design`: r0, r1,
-alpha, h1, the thickness profile). A lifetime takes the cup from there; an explicit ``--cup`` or
-``--geometry FILE`` must describe the same cup, or the run is refused with both named. A curve
-that names no design (a measured CSV, a user's mesh) takes the explicit cup, else cup A with a
-note saying so. The curve also records its interface with the plane (`StiffnessCurve.contact`);
-a ``--geometry FILE`` whose ``[contact]`` table names another law or mu is refused the same way.
+An FEM stiffness curve records the design it was computed for, which it reads back as a typed
+`reduced.design.CupShape` (`StiffnessCurve.design`: r0, r1, alpha, h1, the thickness at both
+ends). A lifetime takes the cup from there; an explicit ``--cup`` or ``--geometry FILE`` must
+describe the same cup, or the run is refused with both named. A curve that names no design (a
+measured CSV, a user's mesh) takes the explicit cup, else cup A with a note saying so. The curve also records its interface with the plane (`StiffnessCurve.contact`,
+a `reduced.design.ContactRecord`); a ``--geometry FILE`` whose ``[contact]`` table names another
+law or mu is refused the same way. Every decision compares these typed values; an FEM design
+becomes one through its own record (`shape_of`), the form the curve's sidecar keeps.
 
 For a Table 1 cup (A, B) the reduced model keeps the paper's r_start = 12 mm, l0, l1 and
 beta = 0.8. Any other design keeps beta = 0.8 (Table 1's value for both cups), starts at the middle
@@ -17,21 +19,24 @@ widths l0, l1 from a least-squares line through the curve's l(r_c) samples, unle
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from reduced.cup import CUPS, CupParameters
+from reduced.design import ContactRecord, CupShape
 from reduced.stiffness_curve import StiffnessCurve
 
-__all__ = ["CupChoice", "resolve_cup", "explicit_design", "preset_design", "same_design"]
+if TYPE_CHECKING:
+    from fem.geometry import CupGeometry
+    from fem.interface import ContactLaw
+
+__all__ = ["CupChoice", "resolve_cup", "explicit_design", "preset_design", "shape_of"]
 
 _MM = 1e-3
-#: relative tolerance of two designs being the same cup
-_SAME = 1e-6
 
 
 @dataclass(frozen=True)
@@ -39,12 +44,12 @@ class CupChoice:
     """The cup a lifetime uses, where it came from, and what was assumed on the way."""
 
     cup: CupParameters
-    design: dict[str, Any]     # the design record (`CupGeometry.describe`: mm, degrees)
+    design: CupShape
     label: str                 # e.g. "cup A (Table 1)", "my_cup.toml: r0 5, r1 25 mm, alpha 40 deg"
     source: str                # "stiffness curve", "geometry file", "preset" or "default preset"
     l_source: str              # where eq (5)'s l0, l1 come from
     notes: tuple[str, ...] = ()
-    contact: dict[str, Any] | None = None    # the curve's interface (`StiffnessCurve.contact`)
+    contact: ContactRecord | None = None    # the curve's interface (`StiffnessCurve.contact`)
 
     def describe(self) -> dict[str, Any]:
         """JSON-ready description (mm, degrees) for every lifetime output."""
@@ -53,22 +58,20 @@ class CupChoice:
                 "r0_mm": c.r0_m / _MM, "r1_mm": c.r1_m / _MM, "alpha_deg": c.alpha_deg,
                 "h1_mm": c.h1_m / _MM, "r_start_mm": c.r_start_m / _MM, "l0_mm": c.l0_m / _MM,
                 "l1_mm": c.l1_m / _MM, "beta": c.beta, "l_source": self.l_source,
-                "contact": self.contact}
+                "contact": None if self.contact is None else self.contact.describe()}
 
 
-def preset_design(name: str) -> dict[str, Any]:
-    """The FEM design record (`fem.geometry.CupGeometry.describe`) of Table 1 cup `name`."""
+def shape_of(geometry: CupGeometry) -> CupShape:
+    """The `CupShape` of an FEM design, through its record (`CupGeometry.describe`, mm and degrees):
+    the form a curve's sidecar keeps, so that a design and a curve's read-back compare alike."""
+    return CupShape.from_record(geometry.describe())
+
+
+@cache
+def preset_design(name: str) -> CupShape:
+    """The shape of Table 1 cup `name` as the FEM builds it (`fem.geometry.cup_geometry`)."""
     from fem.geometry import cup_geometry          # numpy only: no FEM machinery is imported
-    return cup_geometry(name).describe()
-
-
-def same_design(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
-    """True if two design records describe the same cup (radii, angle, thickness at both ends)."""
-    keys = ("r0_mm", "r1_mm", "alpha_deg", "d_at_r0_mm", "d_at_r1_mm")
-    for k in keys:
-        if k in a and k in b and not math.isclose(float(a[k]), float(b[k]), rel_tol=_SAME, abs_tol=1e-9):
-            return False
-    return a.get("thickness_convention", "normal") == b.get("thickness_convention", "normal")
+    return shape_of(cup_geometry(name))
 
 
 def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
@@ -83,7 +86,7 @@ def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
     explicit_label = f"--geometry {geometry_file}" if geometry_file is not None else f"--cup {cup}"
     recorded = curve.design if curve is not None else None
     notes: list[str] = []
-    if recorded is not None and explicit is not None and not same_design(recorded, explicit):
+    if recorded is not None and explicit is not None and not recorded.same_cup(explicit):
         raise ValueError(f"cup: {curve_label} was computed for {_label(recorded)}, but "
                          f"{explicit_label} is {_label(explicit)}; drop the option or use that "
                          f"cup's curve")
@@ -100,67 +103,67 @@ def resolve_cup(curve: StiffnessCurve | None, *, cup: str | None = None,
     if curve is not None:
         _check_height(design, curve, curve_label)
     params, l_source = _parameters(design, curve, r_start_mm, l0_mm, l1_mm, laws)
-    return CupChoice(cup=params, design=dict(design), label=_label(design), source=source, l_source=l_source,
+    return CupChoice(cup=params, design=design, label=_label(design), source=source, l_source=l_source,
                      notes=tuple(notes), contact=getattr(curve, "contact", None))
 
 
-def explicit_design(cup: str | None, geometry_file: str | Path | None) -> dict[str, Any]:
-    """The design record of a geometry file (starting from preset `cup`) or of preset `cup`
-    (cup A when neither is given)."""
+def explicit_design(cup: str | None, geometry_file: str | Path | None) -> CupShape:
+    """The shape of a geometry file (starting from preset `cup`) or of preset `cup` (cup A when
+    neither is given)."""
     return _explicit(cup, geometry_file)[0]
 
 
-def _explicit(cup: str | None, geometry_file: str | Path | None) -> tuple[dict[str, Any], dict[str, Any] | None]:
-    """(the design record, the file's [contact] table as plain data or None) of `explicit_design`."""
+def _explicit(cup: str | None, geometry_file: str | Path | None) -> tuple[CupShape, ContactRecord | None]:
+    """(the shape, the file's [contact] law or None) of `explicit_design`."""
     if geometry_file is not None:
         from validation.guards import load_design
         design = load_design(geometry_file, cup=cup or "A", allow_unusual=True)   # the caller checks the rest
-        return design.geometry.describe(), None if design.contact is None else design.contact.describe()
+        return shape_of(design.geometry), None if design.contact is None else _contact_record(design.contact)
     return preset_design(cup or "A"), None
 
 
-def _check_contact(curve: StiffnessCurve | None, file_contact: Mapping[str, Any] | None,
+def _contact_record(law: ContactLaw) -> ContactRecord:
+    """A design file's law as the record a curve keeps (who chose it is the curve's to say)."""
+    return ContactRecord(law.law, law.friction)
+
+
+def _check_contact(curve: StiffnessCurve | None, file_contact: ContactRecord | None,
                    curve_label: str, explicit_label: str) -> None:
     """Refuse a design file whose [contact] law or mu differs from the one the curve was computed with."""
     recorded = getattr(curve, "contact", None)   # a curve-like record without it (the suction table's) names none
     if recorded is None or file_contact is None:
         return
-    same = (recorded["law"] == file_contact["law"]
-            and math.isclose(recorded["friction"], file_contact.get("friction", 0.0), rel_tol=_SAME, abs_tol=1e-12))
-    if not same:
-        raise ValueError(f"contact: {curve_label} was computed with {_contact_label(recorded)} contact, but "
-                         f"{explicit_label} says {_contact_label(file_contact)}; drop the option or use "
+    if not recorded.same_law(file_contact):
+        raise ValueError(f"contact: {curve_label} was computed with {recorded.label()} contact, but "
+                         f"{explicit_label} says {file_contact.label()}; drop the option or use "
                          f"that design's curve")
 
 
-def _contact_label(contact: Mapping[str, Any]) -> str:
-    return f"coulomb (mu = {contact['friction']:g})" if contact["law"] == "coulomb" else str(contact["law"])
+def _preset_of(design: CupShape) -> str | None:
+    return next((name for name in CUPS if design.same_cup(preset_design(name))), None)
 
 
-def _preset_of(design: Mapping[str, Any]) -> str | None:
-    return next((name for name in CUPS if same_design(design, preset_design(name))), None)
-
-
-def _label(design: Mapping[str, Any]) -> str:
+def _label(design: CupShape) -> str:
     preset = _preset_of(design)
     if preset is not None:
         return f"cup {preset} (Table 1)"
-    return (f"{design.get('name', 'a custom design')} (r0 {design['r0_mm']:.4g} mm, r1 "
-            f"{design['r1_mm']:.4g} mm, alpha {design['alpha_deg']:.4g} deg)")
+    name = "a custom design" if design.name is None else design.name
+    return (f"{name} (r0 {design.r0_m / _MM:.4g} mm, r1 {design.r1_m / _MM:.4g} mm, alpha "
+            f"{design.alpha_deg:.4g} deg)")
 
 
-def _check_height(design: Mapping[str, Any], curve: StiffnessCurve, curve_label: str) -> None:
-    h1 = (design["r1_mm"] - design["r0_mm"]) * math.tan(math.radians(design["alpha_deg"]))
-    if not math.isclose(h1, 1e3 * curve.h1_m, rel_tol=1e-4):
+def _check_height(design: CupShape, curve: StiffnessCurve, curve_label: str) -> None:
+    h1 = design.cone_height_m
+    if not math.isclose(h1, curve.h1_m, rel_tol=1e-4):
         raise ValueError(f"cup: {curve_label} has h1 = {1e3 * curve.h1_m:.6g} mm but {_label(design)} "
-                         f"has h1 = (r1 - r0) tan(alpha) = {h1:.6g} mm: not the same cup")
+                         f"has h1 = (r1 - r0) tan(alpha) = {h1 / _MM:.6g} mm: not the same cup")
 
 
-def _parameters(design: Mapping[str, Any], curve: StiffnessCurve | None, r_start_mm: float | None,
+def _parameters(design: CupShape, curve: StiffnessCurve | None, r_start_mm: float | None,
                 l0_mm: float | None, l1_mm: float | None, laws: str = "cone") -> tuple[CupParameters, str]:
     """Table 1's parameters for a preset; the design's own otherwise (module docstring)."""
     preset = _preset_of(design)
-    r0, r1 = design["r0_mm"] * _MM, design["r1_mm"] * _MM
+    r0, r1 = design.r0_m, design.r1_m
     if r_start_mm is not None and not (math.isfinite(r_start_mm) and r0 < r_start_mm * _MM < r1):
         raise ValueError(f"r_start_mm: start radius must be in (r0, r1) = ({r0 / _MM:g}, "
                          f"{r1 / _MM:g}) mm, got {r_start_mm:g}")
@@ -185,14 +188,14 @@ def _parameters(design: Mapping[str, Any], curve: StiffnessCurve | None, r_start
             if laws == "cone":
                 raise
             l0, l1, l_source = 0.1 * (r1 - r0), 0.1 * (r1 - r0), "not used: r, V, l from the curve"
-    cup = CupParameters(r0_m=r0, r1_m=r1, alpha_deg=float(design["alpha_deg"]),
+    cup = CupParameters(r0_m=r0, r1_m=r1, alpha_deg=design.alpha_deg,
                         r_start_m=r_start or 0.5 * (r0 + r1), l0_m=l0, l1_m=l1, beta=0.8,
-                        name=str(design.get("name", "custom")))
+                        name="custom" if design.name is None else design.name)
     return cup, l_source
 
 
 def _fitted_strip_widths(curve: StiffnessCurve | None, r0: float, r1: float,
-                         design: Mapping[str, Any]) -> tuple[float, float, str]:
+                         design: CupShape) -> tuple[float, float, str]:
     """l0, l1 of eq (5) from a least-squares line through the curve's (r_c, l > 0) samples."""
     refuse = (f"l0_mm, l1_mm: {_label(design)} is not a Table 1 cup, so eq (5)'s strip widths "
               f"are unknown")

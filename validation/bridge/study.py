@@ -40,7 +40,8 @@ class CupDesign:
         """The `fem.geometry.CupGeometry` of the design."""
         if self.geometry is not None:
             return self.geometry
-        from fem.geometry import cup_geometry, load_geometry
+        from fem.design_file import load_geometry
+        from fem.geometry import cup_geometry
         return load_geometry(self.file, cup=self.preset) if self.file else cup_geometry(self.preset)
 
     @property

@@ -3,9 +3,10 @@ FEM the contact law (`--contact`, `--friction`) and, for the lifetime, where r(h
 from (`--cup-laws`) and the reduced model's start.
 
 `--cup` takes A or B in any case; `--geometry` is always a design file (.toml or .json, the keys of
-`fem.geometry.load_design`, with an optional [contact] table). Shared by `stiffness`, `lifetime`,
+`fem.design_file.load_design`, with an optional [contact] table). Shared by `stiffness`, `lifetime`,
 `example` and `suction`. The flags, their types, choices and defaults are the study's fields
-(`validation.study_schema.add_flags`); the help here says what each means on the command line. `--contact`/`--friction` given on the command line win over the design
+(`validation.study_schema.add_flags`); the help here says what each means on the command line.
+`--contact`/`--friction` given on the command line win over the design
 file's [contact] table, which wins over frictionless (`contact_choice`).
 """
 
@@ -16,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:                          # building the parser imports no fem
-    from fem.geometry import Design
+    from fem.design_file import Design
     from fem.interface import ContactChoice
 
 from reduced.cup import CUPS
@@ -127,7 +128,8 @@ def contact_choice(args: argparse.Namespace, design: Design | None = None) -> Co
 
 def load_cup_design(args: argparse.Namespace) -> Design:
     """The design of --geometry FILE (on top of --cup), or the --cup preset (cup A) without a file."""
-    from fem.geometry import Design, cup_geometry
+    from fem.design_file import Design
+    from fem.geometry import cup_geometry
     from validation.guards import load_design as guarded_design
 
     if args.geometry is not None:

@@ -191,43 +191,44 @@ def _curve_inputs(args: argparse.Namespace) -> tuple[Any, ContactChoice, dict[st
     """(the FEM geometry, the contact law, the Study's fields) of a --stiffness curve: the design,
     law, mesh level and material its sidecar records. An option that contradicts them, or a curve
     that names no FEM design or law, is refused (ValueError naming the option)."""
-    from fem.geometry import geometry_from_mapping
+    from fem.design_file import geometry_from_mapping
     from fem.interface import ContactChoice, ContactLaw
     from reduced.stiffness_curve import StiffnessCurve
-    from validation.bridge.design import preset_design, resolve_cup, same_design
+    from validation.bridge.design import preset_design, resolve_cup, shape_of
     from validation.bridge.study import CupDesign, Material
 
     path = Path(args.stiffness)
     if not path.is_file():
         raise ValueError(f"--stiffness: no such file '{path}'")
     curve = StiffnessCurve.from_csv(path)
-    record, law, prov = curve.design, curve.contact, curve.provenance
-    if record is None or law is None or not isinstance(prov.get("material"), dict):
+    shape, law, prov = curve.design, curve.contact, curve.provenance
+    if shape is None or law is None or not isinstance(prov.get("material"), dict):
         raise ValueError(f"--stiffness: '{path.name}' records no FEM design, contact law or material (a measured "
                          f"or Appendix A curve); give --cup or --geometry and the example computes the FEM curve")
     label = f"the stiffness curve '{path.name}'"
     resolve_cup(curve, cup=args.cup, geometry_file=args.geometry, curve_label=label, laws="curve")
-    was = f"{law['law']}" + (f" mu = {law['friction']:g}" if law["law"] == "coulomb" else "")
-    if args.contact is not None and args.contact != law["law"]:
+    was = law.law + (f" mu = {law.friction:g}" if law.law == "coulomb" else "")
+    if args.contact is not None and args.contact != law.law:
         raise ValueError(f"--contact: {label} was computed with {was} contact; drop --contact {args.contact} "
                          f"(the curve's law is used) or derive a {args.contact} curve")
-    if args.friction is not None and (law["law"] != "coulomb" or args.friction != law["friction"]):
+    if args.friction is not None and (law.law != "coulomb" or args.friction != law.friction):
         raise ValueError(f"--friction: {label} was computed with {was} contact; drop --friction")
     fidelity = prov.get("fidelity")
     if args.fidelity is not None and fidelity is not None and args.fidelity != fidelity:
         raise ValueError(f"--fidelity: {label} was computed at the {fidelity} level; drop --fidelity "
                          f"{args.fidelity} or derive a curve at that level")
     args.fidelity = args.fidelity or fidelity
-    preset = next((name for name in ("A", "B") if same_design(record, preset_design(name))), None)
-    shape = {k: record[k] for k in ("name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention") if k in record}
+    preset = next((name for name in ("A", "B") if shape.same_cup(preset_design(name))), None)
+    record = prov["geometry"]                           # the wall as written, its thickness profile included
+    data = {k: record[k] for k in ("name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention") if k in record}
     thickness = record.get("thickness_profile", {})
     if thickness.get("kind") in ("linear", "table"):
-        shape["thickness"] = {"r_mm": thickness["r_mm"], "d_mm": thickness["d_mm"]}
-    geometry = geometry_from_mapping(shape, source=path.name)
-    if not same_design(geometry.describe(), record):
+        data["thickness"] = {"r_mm": thickness["r_mm"], "d_mm": thickness["d_mm"]}
+    geometry = geometry_from_mapping(data, source=path.name)
+    if not shape_of(geometry).same_cup(shape):
         raise ValueError(f"--stiffness: {label} records a wall this example cannot rebuild; give --geometry")
-    contact = ContactChoice(ContactLaw(law["law"], law["friction"]),
-                            f"stiffness curve {path.name}" + (f", from its {law['source']}" if law["source"] else ""))
+    contact = ContactChoice(ContactLaw(law.law, law.friction),
+                            f"stiffness curve {path.name}" + (f", from its {law.source}" if law.source else ""))
     material = Material(E_MPa=prov["material"]["E_Pa"] / 1e6, nu=prov["material"]["nu"])
     design = CupDesign(preset=preset) if preset else CupDesign(preset=args.cup or "A", geometry=geometry)
     return geometry, contact, {"design": replace(design, l0_mm=args.l0_mm, l1_mm=args.l1_mm),

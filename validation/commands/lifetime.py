@@ -141,8 +141,8 @@ def build_model(args: argparse.Namespace) -> LifetimeCase:
     laws = cup_laws(args)
     options = route_options(args.route, args.cup_laws)
     curve, choice = _curve_and_cup(args, laws)
-    check_design(choice.design, args.allow_unusual_design, source=choice.label)
-    check_stiffness_curve(curve, choice.design["h1_mm"], f"--stiffness '{args.stiffness}'", args.E_MPa)
+    check_design(choice.design.describe(), args.allow_unusual_design, source=choice.label)
+    check_stiffness_curve(curve, 1e3 * choice.design.h1_m, f"--stiffness '{args.stiffness}'", args.E_MPa)
     cup = choice.cup
     uc = build_uc(args)
     if args.reference_mode:
@@ -193,7 +193,7 @@ def _curve_and_cup(args: argparse.Namespace, laws: str):
                              f"'{args.route if args.route == 'profile' else 'curve'}' needs an FEM "
                              f"stiffness curve (--stiffness FILE.csv with r_c_mm, V_mm3, l_mm)")
         return None, resolve_cup(None, **options)
-    h1 = None if _has_h(args.stiffness) else 1e-3 * explicit_design(args.cup, args.geometry)["h1_mm"]
+    h1 = None if _has_h(args.stiffness) else explicit_design(args.cup, args.geometry).h1_m
     curve = StiffnessCurve.from_csv(args.stiffness, h1_m=h1)
     return curve, resolve_cup(curve, curve_label=f"'{args.stiffness}'", laws=laws, **options)
 

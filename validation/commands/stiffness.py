@@ -112,7 +112,8 @@ def run(args: argparse.Namespace) -> int:
 def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     """Validate every input and build the mesh and material (cheap); raise ValueError."""
     from fem.cup import cup_height
-    from fem.mesh import DEFAULT_FIDELITY, cup_mesh, read_mesh
+    from fem.mesh import DEFAULT_FIDELITY, cup_mesh
+    from fem.mesh_files import read_mesh
     from validation.bridge.pipeline import mesh_record, neo_hookean
 
     out = Path(args.out)

@@ -266,7 +266,7 @@ def _design_contact(tables: dict[str, dict[str, Any]], given: Any, source: str) 
         return scene
     if not tables["cup"]["geometry"]:
         return "default"
-    from fem.geometry import load_design
+    from fem.design_file import load_design
     from fem.interface import FILE, choose_contact
 
     path = Path(tables["cup"]["geometry"])

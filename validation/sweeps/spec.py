@@ -287,7 +287,7 @@ def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
     if sc["stiffness"]["route"] != "paper":
         base["route"] = sc["stiffness"]["route"]
     if sc["cup"]["geometry"]:
-        from fem.geometry import load_geometry
+        from fem.design_file import load_geometry
         d = load_geometry(sc["cup"]["geometry"], cup=sc["cup"]["preset"]).describe()
         base.update(r0_mm=d["r0_mm"], r1_mm=d["r1_mm"], alpha_deg=d["alpha_deg"], d0_mm=d["d_at_r0_mm"],
                     d1_mm=d["d_at_r1_mm"])

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from reduced.design import CupShape, recorded_design
+
 __all__ = ["CoupledOptions", "coupled_model"]
 
 
@@ -39,8 +41,12 @@ class CoupledOptions:
 class _TableDesign:
     """What `validation.bridge.design.resolve_cup` reads of a curve: the recorded design and h1."""
 
-    design: dict[str, Any] | None
+    design: CupShape | None
     h1_m: float
+
+    def has(self, name: str) -> bool:
+        """No column of a stiffness curve: the table's r, V, l replace eq (5)'s l0, l1."""
+        return False
 
 
 def coupled_model(options: CoupledOptions, uc: Callable[[float], float]):
@@ -54,8 +60,8 @@ def coupled_model(options: CoupledOptions, uc: Callable[[float], float]):
 
     table = SuctionTable.from_json(options.suction_table)
     h1 = table.h1_m
-    recorded = _TableDesign(table.provenance.get("geometry"), h1)
-    choice = resolve_cup(recorded if recorded.design else None, cup=options.cup,
+    recorded = _TableDesign(recorded_design(table.provenance), h1)
+    choice = resolve_cup(recorded if recorded.design is not None else None, cup=options.cup,
                          geometry_file=options.geometry_file, r_start_mm=options.r_start_mm,
                          curve_label=f"'{options.suction_table}'", laws="curve")
     cup = choice.cup
