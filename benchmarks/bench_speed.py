@@ -1,15 +1,18 @@
 """Where users wait: whole-process times of the commands users run, and their ratio to a baseline.
 
-    OMP_NUM_THREADS=1 python benchmarks/bench_speed.py [--repeat 5] [--with-suction]
+    OMP_NUM_THREADS=1 python benchmarks/bench_speed.py [--repeat 5] [--with-suction] [--against ../pristine]
     python benchmarks/bench_speed.py --tree ../old-checkout --write-baseline    # record a baseline
 
 Every figure is a whole `cupcheck` process (start-up included), the median of --repeat runs:
 `cupcheck --help`, a coarse and a medium frictionless stiffness curve of cup A, the main job cold
-(--no-cache) and warm (its cache filled), one lifetime per route (paper and profile at 10 N; the
-profile route's cost per force from 16 forces against one), and with --with-suction a coarse suction
-table on the default grid and the coupled route's lifetime on it. Each is printed beside
-benchmarks/speed_baseline.json (the same figures on an earlier main) as a ratio, new / baseline,
-so a change's speed-up or slow-down is one number, and beside its target.
+(--no-cache) and warm (its cache filled, the same output directory), one lifetime per route (paper
+and profile at 10 N; the profile route's cost per force from 16 forces against one), and with
+--with-suction a coarse suction table on the default grid and the coupled route's lifetime on it.
+Each is printed beside benchmarks/speed_baseline.json (the same figures on an earlier main) as a
+ratio, new / baseline, so a change's speed-up or slow-down is one number, and beside its target.
+The CPU time (user + system) of each process is printed too: on a machine shared with other work
+it moves much less than the wall time. --against times another checkout in the same run, each of
+its runs next to this tree's, so that the ratio to it holds on a loaded machine too.
 """
 
 from __future__ import annotations
@@ -17,12 +20,13 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from datetime import date
 from pathlib import Path
 
@@ -41,77 +45,97 @@ class Runner:
         self.tree, self.work = tree, work
         self.env = {**os.environ, "PYTHONPATH": str(tree), "MPLBACKEND": "Agg"}
 
-    def __call__(self, *args: str) -> float:
+    def __call__(self, *args: str) -> tuple[float, float]:
+        """(wall time, CPU time: user + system) of one run [s]."""
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         subprocess.run([sys.executable, "-m", "validation.cli", *args], cwd=self.tree, env=self.env,
                        check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        return time.perf_counter() - t0
+        wall = time.perf_counter() - t0
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def median(run: Callable[[], float], repeat: int, prepare: Callable[[], None] | None = None) -> float:
+def median(run: Callable[[], tuple[float, float]], repeat: int,
+           prepare: Callable[[], None] | None = None) -> tuple[float, float]:
+    """The medians of the wall and CPU times of `repeat` runs."""
     times = []
     for _ in range(repeat):
         if prepare is not None:
             prepare()
         times.append(run())
-    return statistics.median(times)
+    return statistics.median(t[0] for t in times), statistics.median(t[1] for t in times)
 
 
-def figures(cli: Runner, repeat: int, with_suction: bool) -> dict[str, float]:
+def figures(cli: Runner, repeat: int, with_suction: bool) -> Iterator[tuple[str, tuple[float, float]]]:
+    """(name, (wall, CPU) [s]) of each figure, in turn."""
     w = cli.work
-    out: dict[str, float] = {}
-    out["help"] = median(lambda: cli("--help"), repeat)
-    out["curve_coarse"] = median(lambda: cli("stiffness", "--cup", "A", "--fidelity", "coarse",
+    yield "help", median(lambda: cli("--help"), repeat)
+    yield "curve_coarse", median(lambda: cli("stiffness", "--cup", "A", "--fidelity", "coarse",
                                              "--out", str(w / "coarse.csv")), repeat)
-    out["curve_medium"] = median(lambda: cli("stiffness", "--cup", "A", "--fidelity", "medium",
+    yield "curve_medium", median(lambda: cli("stiffness", "--cup", "A", "--fidelity", "medium",
                                              "--out", str(w / "medium.csv")), repeat)
     main = ["run", "scenes/main.toml", "--quiet", "--out"]
-    out["main_cold"] = median(lambda: cli(*main, str(w / "main_cold"), "--no-cache"), repeat)
+    yield "main_cold", median(lambda: cli(*main, str(w / "main_cold"), "--no-cache"), repeat)
     cli(*main, str(w / "main_warm"), "--cache-dir", str(w / "cache"))          # fill the cache
-    out["main_warm"] = median(lambda: cli(*main, str(w / "main_warm"), "--cache-dir", str(w / "cache")), repeat)
+    yield "main_warm", median(lambda: cli(*main, str(w / "main_warm"), "--cache-dir", str(w / "cache")), repeat)
     paper = ["lifetime", "--cup", "A", "--surface", "pmma-1.89", "--force"]
-    out["lifetime_paper"] = median(lambda: cli(*paper, "10"), repeat)
+    yield "lifetime_paper", median(lambda: cli(*paper, "10"), repeat)
     profile = ["lifetime", "--stiffness", str(w / "medium.csv"), "--route", "profile", "--surface",
                "pmma-1.89", "--force"]
     one = median(lambda: cli(*profile, "10"), repeat)
     many = median(lambda: cli(*profile, *FORCES), repeat)
-    out["lifetime_profile"] = one
-    out["profile_per_force"] = (many - one) / (len(FORCES) - 1)
+    yield "lifetime_profile", one
+    yield "profile_per_force", tuple((m - o) / (len(FORCES) - 1) for m, o in zip(many, one))
     if with_suction:
         table = str(w / "suction.json")
-        out["suction_coarse"] = median(lambda: cli("suction", "--cup", "A", "--fidelity", "coarse",
+        yield "suction_coarse", median(lambda: cli("suction", "--cup", "A", "--fidelity", "coarse",
                                                    "--out", table), 1)
-        out["lifetime_coupled"] = median(lambda: cli("lifetime", "--route", "coupled", "--suction-table",
+        yield "lifetime_coupled", median(lambda: cli("lifetime", "--route", "coupled", "--suction-table",
                                                      table, "--surface", "pmma-1.89", "--force", "10"), repeat)
-    return out
+
+
+def _cell(value: float | None, width: int, digits: int = 3) -> str:
+    return f"{value:{width}.{digits}f}" if value is not None else f"{'-':>{width}s}"
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="runs per figure (median; default 5)")
     ap.add_argument("--tree", type=Path, default=ROOT, help="the checkout to time (default: this one)")
+    ap.add_argument("--against", type=Path, default=None,
+                    help="another checkout timed in the same run, figure by figure (its ratio: tree / against)")
     ap.add_argument("--with-suction", action="store_true", help="also the coarse suction table (minutes)")
     ap.add_argument("--write-baseline", action="store_true", help=f"store the figures as {BASELINE.name}")
     args = ap.parse_args()
     tree = args.tree.resolve()
-    with tempfile.TemporaryDirectory() as d:
-        got = figures(Runner(tree, Path(d)), args.repeat, args.with_suction)
     base = json.loads(BASELINE.read_text())["seconds"] if BASELINE.is_file() else {}
-    print(f"{'figure':20s} {'time (s)':>9s} {'baseline':>9s} {'ratio':>6s} {'target':>7s}")
-    for name, t in got.items():
-        b = base.get(name)
-        ratio = f"{t / b:6.2f}" if b else f"{'-':>6s}"
-        target = TARGETS.get(name)
-        mark = "" if target is None else ("  met" if t <= target else "  not met")
-        print(f"{name:20s} {t:9.3f} {b if b else float('nan'):9.3f} {ratio} "
-              f"{target if target else float('nan'):7.2f}{mark}")
+    got: dict[str, float] = {}
+    head = f"{'figure':18s} {'time (s)':>9s} {'cpu (s)':>8s} {'baseline':>9s} {'ratio':>6s}"
+    if args.against is not None:
+        head += f" {'against':>8s} {'cpu':>7s} {'ratio':>6s} {'cpu':>6s}"
+    print(head + f" {'target':>7s}", flush=True)
+    with tempfile.TemporaryDirectory() as d, tempfile.TemporaryDirectory() as e:
+        other = figures(Runner(args.against.resolve(), Path(e)), args.repeat, args.with_suction) \
+            if args.against is not None else None
+        for name, (t, cpu) in figures(Runner(tree, Path(d)), args.repeat, args.with_suction):
+            got[name] = t
+            b = base.get(name)
+            line = (f"{name:18s} {t:9.3f} {cpu:8.3f} {_cell(b, 9)} "
+                    f"{_cell(t / b if b else None, 6, 2)}")
+            if other is not None:
+                _, (ta, ca) = next(other)
+                line += (f" {ta:8.3f} {ca:7.3f} {_cell(t / ta if ta > 0 else None, 6, 2)}"
+                         f" {_cell(cpu / ca if ca > 0 else None, 6, 2)}")
+            target = TARGETS.get(name)
+            mark = "" if target is None else ("  met" if t <= target else "  not met")
+            print(f"{line} {_cell(target, 7, 2)}{mark}", flush=True)
     if args.write_baseline:
         commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=tree, capture_output=True,
                                 text=True).stdout.strip()
         BASELINE.write_text(json.dumps({"commit": commit, "date": date.today().isoformat(),
                                         "repeat": args.repeat, "seconds": got}, indent=1) + "\n")
         print(f"wrote {BASELINE}")
-
 
 if __name__ == "__main__":
     main()

@@ -83,14 +83,21 @@ class CondensedCholesky:
         sub = csr[B][:, B].tocsr()
         sub.sort_indices()
         sub_rows = np.repeat(np.arange(len(B)), np.diff(sub.indptr))
-        self._BB = position(B[sub_rows], B[sub.indices])
-        self._sub = sub
+        BB = position(B[sub_rows], B[sub.indices])
         sub_position = _positions(sub)
         lb = local[Bb]
-        self._update = sub_position(lb[:, :, None], lb[:, None, :])          # [nb, m, m]
+        update = sub_position(lb[:, :, None], lb[:, None, :])               # [nb, m, m]
         perm = strip_ordering(coordinates, pattern, mesh)
         self._inner = BandedCholesky(sub, None, perm=local[perm[is_B[perm]]])
-        self._diag = sub_position(np.arange(len(B)), np.arange(len(B)))
+        # the band holds the upper triangle only: K_BB, the diagonal and the update's entries
+        # there, in the band's order (`BandedCholesky.upper_band_factor`)
+        upper = np.full(sub.nnz, -1)
+        upper[self._inner.upper_entries] = np.arange(len(self._inner.upper_entries))
+        self._BB_upper = BB[self._inner.upper_entries]
+        self._diag_upper = upper[sub_position(np.arange(len(B)), np.arange(len(B)))]
+        to = upper[update].ravel()
+        self._update_at = np.flatnonzero(to >= 0)
+        self._update_to = to[self._update_at]
         self._Bb_local = lb
         self.n, self.kd, self._B = n, self._inner.kd, B
 
@@ -101,11 +108,10 @@ class CondensedCholesky:
             raise ValueError("CondensedCholesky: the element-interior dofs must be free")
         data = K.data
         K_II = data[self._II]
-        K_BB = data[self._BB]
+        K_BB = data[self._BB_upper]                                          # its upper triangle
         if shift:                           # shift diag(K_ff) before condensing: exact
             K_II = K_II + shift * np.abs(K_II) * np.eye(2)
-            K_BB = K_BB.copy()
-            K_BB[self._diag] += shift * np.abs(K_BB[self._diag])
+            K_BB[self._diag_upper] += shift * np.abs(K_BB[self._diag_upper])
         a, b, d = K_II[:, 0, 0], 0.5 * (K_II[:, 0, 1] + K_II[:, 1, 0]), K_II[:, 1, 1]
         det = a * d - b * b
         if np.any(a <= 0.0) or np.any(det <= 0.0):
@@ -113,8 +119,9 @@ class CondensedCholesky:
         inv = np.stack([np.stack([d, -b], -1), np.stack([-b, a], -1)], -2) / det[:, None, None]
         K_IB = np.where(free[self._Bb][:, None, :], data[self._IB], 0.0)     # fixed columns dropped
         W = inv @ K_IB                                                       # K_II^-1 K_IB
-        S = K_BB - _scatter(self._update, np.transpose(K_IB, (0, 2, 1)) @ W, self._sub.nnz)
-        inner = self._inner.band_factor(S, free[self._B])
+        update = (np.transpose(K_IB, (0, 2, 1)) @ W).ravel()[self._update_at]     # K_BI K_II^-1 K_IB
+        S = K_BB - np.bincount(self._update_to, weights=update, minlength=K_BB.size)
+        inner = self._inner.upper_band_factor(S, free[self._B])
         return CondensedFactor(self, K, free, shift, inner, inv, K_IB, W)
 
 
@@ -154,7 +161,9 @@ def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
     if values.ndim == index.ndim:
         return np.bincount(flat, weights=values.ravel(), minlength=size)
     cols = values.reshape(flat.size, -1)
-    return np.stack([np.bincount(flat, weights=c, minlength=size) for c in cols.T], axis=1)
+    m = cols.shape[1]                      # one bincount over (slot, column) pairs
+    return np.bincount((flat[:, None] * m + np.arange(m)).ravel(), weights=cols.ravel(),
+                       minlength=size * m).reshape(size, m)
 
 
 def _positions(csr: sp.csr_matrix):

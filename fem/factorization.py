@@ -22,20 +22,36 @@ SHIFT_MIN = 1e-10       # smallest diagonal shift (relative); cond(K_ff + s D) s
 class ShiftPolicy:
     """The memory of the diagonal shift across the iterations of a path (`factor_shifted`): the
     shift that worked first in the last unstable episode, where the search of the next one
-    starts; and the count of factorizations (attempted, failed)."""
+    starts; the count of factorizations (attempted, failed); and the last factor, reused when
+    the same tangent is factored again with the same free set and shift (a step's convergence
+    test factors the converged state's tangent, and the next step's first iteration starts there)."""
 
     def __init__(self) -> None:
         self.onset = 0.0
         self.factorizations = self.failed = 0
+        self._last: tuple | None = None
 
     def factor(self, solver, K, free, shift):
-        """solver.factor(K, free, shift), counted."""
+        """solver.factor(K, free, shift), counted; the last factor if it is of the same (read-only)
+        K, free set and shift."""
+        last = self._last
+        if last is not None and last[0] is solver and last[1] is K and last[3] == shift \
+                and np.array_equal(last[2], free):
+            return last[4]
         self.factorizations += 1
         try:
-            return solver.factor(K, free, shift)
+            fac = solver.factor(K, free, shift)
         except NotPositiveDefinite:
             self.failed += 1
             raise
+        self._last = (solver, K, free.copy(), shift, fac) if _read_only(K) else None
+        return fac
+
+
+def _read_only(K) -> bool:
+    """Whether K's entries cannot change in place (the tangents of `fem.forms.Mechanics.evaluate`)."""
+    data = getattr(K, "data", None)
+    return isinstance(data, np.ndarray) and not data.flags.writeable
 
 
 def factor_shifted(solver, K, free, shift, history, policy=None, lower=True):

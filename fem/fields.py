@@ -20,7 +20,6 @@ import secrets
 from pathlib import Path
 from typing import Protocol
 
-import meshio
 import numpy as np
 from skfem import Mesh
 
@@ -56,6 +55,8 @@ def element_cauchy_stress(mech: Mechanics, u: np.ndarray) -> np.ndarray:
 
 def write_fields(resp: FieldSeries, path: str | Path, step: int | None = -1) -> Path:
     """Write step `step` of `resp` (None: every step, .xdmf only) to `path`, atomically."""
+    import meshio           # here, not at import: a cup job that writes no fields does not load it
+
     path = Path(path)
     n_steps = len(resp.u_m)
     xdmf = path.suffix.lower() == ".xdmf"

@@ -18,6 +18,8 @@ that violates the contact conditions beyond it ends the path.
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 from skfem import Mesh
 
@@ -68,12 +70,23 @@ def facet_dip(mesh: Mesh, x: np.ndarray, names=("cavity", "rim", "outer")) -> tu
 
 def outline_crossing(points: np.ndarray) -> tuple[int, int] | None:
     """The first pair (i, j), i < j - 1, of crossing segments of the closed polyline `points`
-    [2, n] (segment k joins points k and k+1 mod n), or None if it does not cross itself."""
+    [2, n] (segment k joins points k and k+1 mod n), or None if it does not cross itself.
+    Only the pairs whose extents in r overlap can cross: they are found by sorting the segments
+    by their smallest r (a sweep), so the cost grows with the overlaps, not with n^2."""
     p, q = points, np.roll(points, -1, axis=1)
     n = p.shape[1]
     d = q - p
-    i, j = np.triu_indices(n, 2)
-    keep = ~((i == 0) & (j == n - 1))                                 # neighbours across the seam
+    lo, hi = np.minimum(p[0], q[0]), np.maximum(p[0], q[0])
+    order = np.argsort(lo, kind="stable")
+    # for each segment a, the segments b that start within its extent (lo_a <= lo_b <= hi_a)
+    first = np.arange(n) + 1
+    last = np.searchsorted(lo[order], hi[order], side="right")
+    counts = np.maximum(last - first, 0)
+    a = np.repeat(order, counts)
+    b = order[np.repeat(last - counts, counts) + np.arange(counts.sum())
+              - np.repeat(np.cumsum(counts) - counts, counts)]
+    i, j = np.minimum(a, b), np.maximum(a, b)
+    keep = (j - i >= 2) & ~((i == 0) & (j == n - 1))                # neighbours across the seam
     i, j = i[keep], j[keep]
     denom = d[0, i] * d[1, j] - d[1, i] * d[0, j]
     w = p[:, j] - p[:, i]
@@ -83,13 +96,27 @@ def outline_crossing(points: np.ndarray) -> tuple[int, int] | None:
     hit = (denom != 0) & (s > 0) & (s < 1) & (t > 0) & (t < 1)
     if not hit.any():
         return None
-    k = int(np.flatnonzero(hit)[0])
+    k = np.flatnonzero(hit)
+    k = k[np.lexsort((j[k], i[k]))[0]]                                # the first in (i, j) order
     return int(i[k]), int(j[k])
 
 
 def _outline(mesh: Mesh) -> tuple[np.ndarray, list[str]]:
     """Node indices of the closed outline cavity -> rim -> outer -> top_plate and, per segment,
-    the boundary it belongs to."""
+    the boundary it belongs to; kept for the last mesh asked (a path checks every state)."""
+    key = tuple((name, id(f)) for name, f in (mesh.boundaries or {}).items())
+    ref, last_key, outline = _LAST_OUTLINE
+    if ref is None or ref() is not mesh or last_key != key:
+        outline = _mesh_outline(mesh)
+        _LAST_OUTLINE[:] = [weakref.ref(mesh), key, outline]
+    return outline
+
+
+_LAST_OUTLINE: list = [None, None, None]
+
+
+def _mesh_outline(mesh: Mesh) -> tuple[np.ndarray, list[str]]:
+    """`_outline` computed from the boundary tags."""
     from .mesh import boundary_path
 
     nodes: list[int] = []

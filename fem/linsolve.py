@@ -31,6 +31,7 @@ snap-through), `NotPositiveDefinite` is raised and the caller may shift the diag
 
 from __future__ import annotations
 
+import contextlib
 import functools
 
 import numpy as np
@@ -48,13 +49,23 @@ class NotPositiveDefinite(np.linalg.LinAlgError):
 
 
 @functools.cache
-def _blas() -> ThreadpoolController:
-    return ThreadpoolController()
+def _blas_libraries() -> tuple:
+    """threadpoolctl's controllers of the loaded BLAS libraries (found once)."""
+    return tuple(ThreadpoolController().select(user_api="blas").lib_controllers)
 
 
+@contextlib.contextmanager
 def _one_thread():
-    """A context that limits BLAS/LAPACK to one thread (~15 us to enter)."""
-    return _blas().limit(limits=1, user_api="blas")
+    """A context that limits BLAS/LAPACK to one thread (a few us: only the libraries that run
+    more threads are set, through threadpoolctl's controllers, and restored afterwards)."""
+    changed = [(lib, n) for lib in _blas_libraries() if (n := lib.get_num_threads()) != 1]
+    for lib, _ in changed:
+        lib.set_num_threads(1)
+    try:
+        yield
+    finally:
+        for lib, n in changed:
+            lib.set_num_threads(n)
 
 
 def strip_ordering(coordinates: np.ndarray, pattern: sp.csr_matrix,
@@ -126,8 +137,8 @@ class BandedCholesky:
         self.n, self.kd = n, int(np.max(pj - pi))
         self._indptr, self._indices = pattern.indptr, pattern.indices
         self._sel = np.flatnonzero(upper)
-        self._rows, self._cols = rows[self._sel], pattern.indices[self._sel]
-        self._band = (self.kd + pi[upper] - pj[upper]) * n + pj[upper]     # flat index into ab
+        # flat index into ab [kd + 1, n] in Fortran order, the layout LAPACK takes without a copy
+        self._band = (self.kd + pi[upper] - pj[upper]) + (self.kd + 1) * pj[upper]
         self._perm, self._inv = perm, inv
 
     def factor(self, K: sp.csr_matrix, free: np.ndarray, shift: float = 0.0) -> "Factor":
@@ -137,14 +148,29 @@ class BandedCholesky:
             raise ValueError("BandedCholesky: the matrix does not have the pattern it was built for")
         return Factor(self, K, free, self.band_factor(K.data, free, shift), shift)
 
+    @property
+    def upper_entries(self) -> np.ndarray:
+        """The positions in the pattern's CSR data of the entries the band holds (the upper
+        triangle in the band's ordering), in the order `upper_band_factor` takes them."""
+        return self._sel
+
     def band_factor(self, data: np.ndarray, free: np.ndarray, shift: float = 0.0) -> np.ndarray:
         """The banded Cholesky factor of K_ff from the CSR `data` of K (the pattern's layout)."""
-        keep = free[self._rows] & free[self._cols]
+        return self.upper_band_factor(data[self._sel], free, shift)
+
+    def upper_band_factor(self, upper: np.ndarray, free: np.ndarray, shift: float = 0.0) -> np.ndarray:
+        """`band_factor` from K's entries at `upper_entries` only."""
         ab = np.zeros((self.kd + 1) * self.n)
-        ab[self._band] = np.where(keep, data[self._sel], 0.0)
-        ab = ab.reshape(self.kd + 1, self.n)
-        diag = ab[self.kd]                                     # a view, in permuted order
+        ab[self._band] = upper
+        ab = ab.reshape((self.kd + 1, self.n), order="F")
         fixed_p = ~free[self._perm]
+        at = np.flatnonzero(fixed_p)                           # the constrained rows and columns
+        ab[:, at] = 0.0
+        offset = np.arange(self.kd + 1)                        # row i is ab[kd - o, i + o]
+        cols = at[:, None] + offset
+        inside = cols < self.n
+        ab[np.broadcast_to(self.kd - offset, cols.shape)[inside], cols[inside]] = 0.0
+        diag = ab[self.kd]                                     # a view, in permuted order
         if shift:
             diag += shift * np.where(fixed_p, 0.0, np.abs(diag))
         diag[fixed_p] = 1.0
@@ -229,5 +255,6 @@ def _constrained_rhs(K: sp.csr_matrix, free: np.ndarray, rhs: np.ndarray,
     mask = fixed if rhs.ndim == 1 else fixed[:, None]
     if du_fixed is None:
         return np.where(mask, 0.0, rhs)
-    b = rhs - K @ np.where(fixed, du_fixed, 0.0)
+    moved = np.where(fixed, du_fixed, 0.0)
+    b = rhs - K @ moved if moved.any() else rhs      # a finite K @ 0 is +0: rhs - 0 is rhs
     return np.where(mask, du_fixed if rhs.ndim == 1 else du_fixed[:, None], b)

@@ -198,7 +198,14 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             state1 = plane.law.commit(plane, state1, u1)
         u0, r0, W0, state, t, jumps, m0 = u1, r1, W1, state1, t1, 0, m1
         if on_step:
-            on_step(StepResult(t, u1, r1, W1, state1, its, bool(indefinite)))
+            try:
+                on_step(StepResult(t, u1, r1, W1, state1, its, bool(indefinite)))
+            except ConvergenceError as exc:      # the caller refused the state: the cost up to it
+                if exc.stats is None:
+                    exc.stats = SolverStats(steps - 1, iterations, cutbacks, time.perf_counter() - begin,
+                                            int(n), unstable, float(dissipated), policy.factorizations,
+                                            policy.failed)
+                raise
         if progress:
             progress(t / t_max, f"step {steps}: {name} = {t:.4g}, {its} Newton iterations")
         if its <= options.easy_iterations:

@@ -1,6 +1,8 @@
 """`cupcheck` command line: one subcommand per module in `validation.commands`.
 
-Each command module defines ``NAME``, ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``.
+`COMMANDS` lists each command with its module and one-line help; a command's module (which defines
+``HELP``, the same line, ``add_arguments(parser)`` and ``run(args) -> int``) is imported only when that
+command is invoked, so bare ``cupcheck`` and ``--help`` import none of them (nor numpy).
 Every error is one line on stderr, ``cupcheck <command>: error: <what>``, with exit status 2 for
 bad input, whether argparse finds it (an unknown choice, a value that is not a number, a missing
 required option) or the command does (a ``ValueError`` whose message names the field and its
@@ -21,13 +23,32 @@ import os
 import signal
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import NoReturn
 
 #: errno values that mean an output could not be written
 _WRITE_ERRORS = {errno.ENOSPC, errno.EROFS, errno.EACCES, errno.EFBIG, errno.EDQUOT, errno.EPERM}
-#: subcommand modules, in the order `cupcheck --help` lists them
-COMMANDS = ("example", "lifetime", "render", "run", "stiffness", "suction", "sweep", "uc", "validate")
+#: command -> (its module, its one-line help), in the order `cupcheck --help` lists them
+COMMANDS: dict[str, tuple[str, str]] = {
+    "example": ("validation.commands.example",
+                "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"),
+    "lifetime": ("validation.commands.lifetime",
+                 "lifetime of a suction cup under pull forces (reduced leakage model, eqs 3-24)"),
+    "render": ("validation.commands.render",
+               "3D view (cut-away, footprint from below, squeeze GIF) of a stiffness run's fields file"),
+    "run": ("validation.commands.run", "run a scene file: the curves, lifetimes and figures it asks for (cached)"),
+    "stiffness": ("validation.commands.stiffness",
+                  "FEM stiffness curve F0(h), r_c, l, V of cup A, B or your own design (CSV + JSON sidecar)"),
+    "suction": ("validation.commands.suction",
+                "FEM response to the cavity suction on a (u, dp) grid, for lifetime --route coupled (JSON)"),
+    "sweep": ("validation.commands.sweep",
+              "many cup designs on dask.distributed: stiffness, Appendix A ratio, lifetimes (Parquet, CSV, maps)"),
+    "uc": ("validation.commands.uc",
+           "critical gap u_c(p) of a rough surface (Persson theory; presets, PSD or line scan)"),
+    "validate": ("validation.commands.validate",
+                 "cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes, the paper's "
+                 "numbers, Coulomb friction (CSV, MD, PNG, JSON)"),
+}
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -51,22 +72,37 @@ def version() -> str:
         return "unknown (not installed)"
 
 
-def build_parser() -> argparse.ArgumentParser:
+class _VersionAction(argparse.Action):
+    """``--version``: the version is looked up only when asked (the package metadata is slow to import)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str = argparse.SUPPRESS,
+                 default: str = argparse.SUPPRESS, help: str = "show program's version number and exit"):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> NoReturn:
+        print(f"cupcheck {version()}")
+        parser.exit()
+
+
+def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
+    """The `cupcheck` parser with the full parsers (the command's module imported, its options
+    added) of `commands` (None: of every command); none given, every command is listed by its help
+    line alone (bare ``cupcheck``, ``--help``, an unknown command)."""
     parser = OneLineParser(
         prog="cupcheck",
         description="Suction-cup cross-checks: axisymmetric FEM stiffness and the Tiwari-Persson "
                     "leakage model (Soft Matter 2019, arXiv:1906.01459). SI units inside; every "
                     "option names its unit.")
-    parser.add_argument("--version", action="version", version=f"cupcheck {version()}")
+    parser.add_argument("--version", action=_VersionAction)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in COMMANDS:
-        try:
-            module = importlib.import_module(f"validation.commands.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"validation.commands.{name}":
-                raise
+    full = set(COMMANDS if commands is None else commands)
+    for name, (module_name, line) in COMMANDS.items():
+        if name not in full:
+            if not full:
+                sub.add_parser(name, help=line)
             continue
-        p = sub.add_parser(module.NAME, help=module.HELP, description=module.__doc__,
+        module = importlib.import_module(module_name)
+        p = sub.add_parser(name, help=line, description=module.__doc__,
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         module.add_arguments(p)
         p.set_defaults(_run=module.run, _parser=p)
@@ -90,8 +126,10 @@ def _interrupted(who: str) -> int:
 
 
 def _main(argv: Sequence[str] | None) -> int:
-    parser = build_parser()
     given = list(sys.argv[1:] if argv is None else argv)
+    # the command is the first word that is not an option (`cupcheck` itself takes no values)
+    invoked = next((a for a in given if not a.startswith("-")), None)
+    parser = build_parser([invoked] if invoked in COMMANDS else [])
     if not given:                            # bare `cupcheck`: what it can do
         parser.print_help()
         return 0

@@ -20,9 +20,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["ImplausibleInput", "PLAUSIBLE", "check_modulus", "check_forces", "check_start_radius", "check_length",
            "check_design_data", "load_design", "check_design", "check_stiffness_curve", "check_uc_table",
@@ -212,6 +213,8 @@ def check_stiffness_curve(curve: Any | None, h1_mm: float, field: str, E_MPa: fl
 
 def check_uc_table(p_over_E: np.ndarray, u_c_m: np.ndarray, field: str = "u_c_m") -> None:
     """Critical gaps in metres (a table in um or nm is the usual slip)."""
+    import numpy as np          # a scene's checks import numpy only for a u_c table
+
     u = np.asarray(u_c_m, dtype=float)
     worst = float(np.max(u, initial=0.0))
     if worst > PLAUSIBLE["u_c_m"][1]:

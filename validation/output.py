@@ -13,7 +13,6 @@ import sys
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
-from importlib import metadata
 from pathlib import Path
 
 #: the packages whose versions every output's provenance records
@@ -22,6 +21,8 @@ _PACKAGES = ("cupcheck", "numpy", "scipy", "scikit-fem", "meshio")
 
 def software_versions() -> dict[str, str]:
     """Versions of Python and of the packages the FEM result depends on."""
+    from importlib import metadata      # slow to import: only when a provenance is written
+
     versions = {"python": platform.python_version()}
     for name in _PACKAGES:
         try:

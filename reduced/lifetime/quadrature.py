@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import math
 
-from scipy.integrate import quad
-
 from reduced.lifetime.paper import sealed_on_branch, start_height
 from reduced.lifetime.routes import _resolve
 from reduced.model import LeakageModel
@@ -54,6 +52,8 @@ def lifetime_by_quadrature(model: LeakageModel, force_N: float, *, route: str = 
         t_bubble = (core.n_eq(h0, 1.0, F1)[0] - N0) / core.state(h0, N0, 1.0, core.m.E_Pa, F1)[0]
     # the PCHIP breakpoints are kinks of higher derivatives: hand them to quad
     knots = sorted(x for x in (core.h1 - u for u in core.F0.x) if h0 < x < h_end)
+    from scipy.integrate import quad        # only here: a lifetime by integration never imports it
+
     t, err = quad(integrand, h0, h_end, epsabs=0.0, epsrel=epsrel, limit=4 * len(knots) + 200,
                   points=knots[:: max(1, len(knots) // 100)] or None)
     return t_bubble + t

@@ -11,13 +11,17 @@ Every command, scene, sweep and report section that needs an FEM path or a stiff
 * the default surface and its u_c table (`DEFAULT_SURFACE`, `surface_uc_table`: Persson theory,
   EMT, nu = 0.5);
 * the contact law: a `fem.interface.ContactLaw` (or a `ContactChoice`, which also says who chose
-  it) travels unchanged from the caller to `compress_cup`.
+  it) travels unchanged from the caller to `compress_cup`;
+* a path that fails after some converged steps: `converged_part` keeps them as a response and a
+  `PathStop` (where and why it stopped, and the u_max that runs), and `fem_curve` flags the curve
+  partial in its provenance (``partial``, ``failed_at_u_mm``, ``failure_reason``,
+  ``u_max_mm_that_runs``); `fem_stiffness(keep_partial=True)` does both.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import asdict
+from dataclasses import asdict, dataclass, field
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
@@ -26,11 +30,12 @@ if TYPE_CHECKING:                          # importing this module imports no fe
     from fem.geometry import CupGeometry
     from fem.interface import ContactChoice, ContactLaw
     from fem.material import NeoHookean
+    from fem.solver import ConvergenceError
     from reduced.critical_gap import UcTable
     from reduced.stiffness_curve import StiffnessCurve
 
 __all__ = ["LOCKING_NU", "DEFAULT_SURFACE", "neo_hookean", "surface_uc_table",
-           "mesh_record", "fem_path", "fem_curve", "fem_stiffness"]
+           "mesh_record", "fem_path", "fem_curve", "fem_stiffness", "PathStop", "converged_part", "partial_note"]
 
 #: above this Poisson's ratio the displacement (Q2) formulation locks (F0 stiffens)
 LOCKING_NU = 0.495
@@ -92,27 +97,79 @@ def fem_path(geometry: CupGeometry | str | None, material: NeoHookean, contact: 
     return compress_cup(mesh, material, contact=law, u_max_m=u_max_m, progress=progress, **solver_opts)
 
 
+@dataclass(frozen=True)
+class PathStop:
+    """Where and why an FEM path stopped before its u_max: the step from `u_max_m_that_runs` (the
+    last converged u [m]) to `failed_at_u_m` [m] did not converge or gave a state that was refused
+    (`reason`); `error` is the `fem.solver.ConvergenceError` itself (its residual history)."""
+
+    failed_at_u_m: float
+    u_max_m_that_runs: float
+    reason: str
+    error: ConvergenceError = field(repr=False, compare=False)
+
+    def provenance(self) -> dict[str, Any]:
+        """The keys that flag a curve partial (lengths in mm, like the sidecar)."""
+        return {"partial": True, "failed_at_u_mm": 1e3 * self.failed_at_u_m,
+                "u_max_mm_that_runs": 1e3 * self.u_max_m_that_runs, "failure_reason": self.reason}
+
+
+def converged_part(exc: ConvergenceError) -> tuple[CupResponse, PathStop] | None:
+    """The converged part of a failed `fem_path` (the response `fem.cup.compress_cup` kept, flagged
+    partial) and its `PathStop`; None when no step beyond u = 0 converged (nothing to keep)."""
+    part = getattr(exc, "partial", None)
+    if part is None or len(part.u_m) < 2 or not part.u_m[-1] > 0.0:
+        return None
+    reason = exc.cause or str(exc)
+    return part, PathStop(float(exc.t_to), float(part.u_m[-1]), reason, exc)
+
+
+def partial_note(provenance: Mapping[str, Any]) -> str | None:
+    """What a partial curve's provenance says of it, in a few words ("a partial curve: converged to
+    u = 8.467 mm, its FEM path stopped at 8.921 mm"), or None for a complete curve."""
+    if provenance.get("partial") is not True:
+        return None
+    runs, failed = provenance.get("u_max_mm_that_runs"), provenance.get("failed_at_u_mm")
+    if not isinstance(runs, (int, float)) or not isinstance(failed, (int, float)):
+        return "a partial curve (its FEM path stopped before its u_max)"
+    return f"a partial curve: converged to u = {runs:.4g} mm, its FEM path stopped at {failed:.4g} mm"
+
+
 def fem_curve(response: CupResponse, geometry: Mapping[str, Any], fidelity: str | None,
-              contact_source: str | None = None, mesh: Mapping[str, Any] | None = None) -> StiffnessCurve:
+              contact_source: str | None = None, mesh: Mapping[str, Any] | None = None,
+              stop: PathStop | None = None) -> StiffnessCurve:
     """The hand-off `StiffnessCurve` of an FEM path, with its provenance (`validation.bridge.handoff`):
-    the design's description, the mesh (`mesh_record` of the path's mesh unless given) and who
-    chose the contact law."""
+    the design's description, the mesh (`mesh_record` of the path's mesh unless given), who
+    chose the contact law, and, for the converged part of a failed path, its `PathStop`."""
     from validation.bridge import handoff
 
     record = dict(mesh) if mesh is not None else mesh_record(response.mesh, fidelity)
     prov = handoff.provenance(response, geometry=geometry, mesh=record, fidelity=fidelity,
                               contact_source=contact_source)
+    if stop is not None:
+        prov.update(stop.provenance())
     return handoff.stiffness_curve(response, prov)
 
 
 def fem_stiffness(geometry: CupGeometry | str, material: NeoHookean, contact: ContactLaw | ContactChoice,
-                  fidelity: str, u_max_m: float | None = None,
-                  progress: Progress | None = None) -> tuple[CupResponse, StiffnessCurve]:
+                  fidelity: str, u_max_m: float | None = None, progress: Progress | None = None, *,
+                  keep_partial: bool = False) -> tuple[CupResponse, StiffnessCurve]:
     """(CupResponse, StiffnessCurve) of a generated cup: `fem_path`, then `fem_curve`; the contact
-    source is recorded when `contact` is a `ContactChoice`."""
+    source is recorded when `contact` is a `ContactChoice`. A path that fails raises
+    `fem.solver.ConvergenceError`; with `keep_partial`, one that converged beyond u = 0 returns its
+    converged part instead (``response.partial``; the curve's provenance says where and why)."""
     from fem.geometry import cup_geometry
+    from fem.solver import ConvergenceError
 
     if isinstance(geometry, str):
         geometry = cup_geometry(geometry)
-    response = fem_path(geometry, material, contact, fidelity, u_max_m, progress)
-    return response, fem_curve(response, geometry.describe(), fidelity, getattr(contact, "source", None))
+    stop = None
+    try:
+        response = fem_path(geometry, material, contact, fidelity, u_max_m, progress)
+    except ConvergenceError as exc:
+        kept = converged_part(exc) if keep_partial else None
+        if kept is None:
+            raise
+        response, stop = kept
+    return response, fem_curve(response, geometry.describe(), fidelity, getattr(contact, "source", None),
+                               stop=stop)

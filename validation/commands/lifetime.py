@@ -21,6 +21,8 @@ import argparse
 import json
 import math
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -176,8 +178,25 @@ def build_model(args: argparse.Namespace) -> LifetimeCase:
                          fluid=args.fluid, liquid_viscosity_Pa_s=args.liquid_viscosity,
                          cavitation_pressure_Pa=None if p_cav is None else 1e3 * p_cav,
                          label=choice.label)
-    lifetimes(model, [], args.route, **options)   # builds the start state: checks geometry and curve range now
+    with within_partial_curve(curve, args.stiffness):
+        lifetimes(model, [], args.route, **options)   # builds the start state: checks geometry and curve range now
     return LifetimeCase(model, choice, laws, options)
+
+
+@contextmanager
+def within_partial_curve(curve: Any, path: str) -> Iterator[None]:
+    """A partial curve (the converged part of a failed FEM path) is used within its range only: a
+    state beyond it (the reduced model never extrapolates) is refused naming --stiffness."""
+    from validation.bridge.pipeline import partial_note
+
+    note = partial_note(getattr(curve, "provenance", {}))
+    try:
+        yield
+    except ValueError as exc:
+        if note is None:
+            raise
+        raise ValueError(f"--stiffness: '{path}' is {note}, and this lifetime needs a state beyond it: "
+                         f"{exc}") from None
 
 
 def _curve_and_cup(args: argparse.Namespace, laws: str):
@@ -229,6 +248,7 @@ def summaries(results, cup: dict) -> list[dict]:
 
 def run(args: argparse.Namespace) -> int:
     from validation.bridge.lifetimes import lifetimes
+    from validation.bridge.pipeline import partial_note
     from validation.output import atomic_directory, terminal_progress
 
     from validation.output import check_file_names, check_outputs, command_inputs
@@ -258,9 +278,14 @@ def run(args: argparse.Namespace) -> int:
     cost = len(args.force_N) * (1 if model.reference else 30)
     progress = terminal_progress("lifetime") if cost >= 100 else None
 
+    note = partial_note(getattr(model.stiffness, "provenance", {}))
+    if note is not None:
+        print(f"note: --stiffness '{args.stiffness}' is {note}; used within that range", file=sys.stderr)
+
     def compute():
-        return lifetimes(model, args.force_N, args.route, progress=progress, t_max_s=args.t_max_s,
-                         rtol=args.rtol, **case.options)
+        with within_partial_curve(model.stiffness, args.stiffness):
+            return lifetimes(model, args.force_N, args.route, progress=progress, t_max_s=args.t_max_s,
+                             rtol=args.rtol, **case.options)
 
     if args.out:
         with atomic_directory(args.out) as tmp:

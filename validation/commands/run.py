@@ -4,7 +4,9 @@ Writes the scene's outputs into DIR atomically, with DIR/manifest.json (every fi
 its name and kind, the scene as resolved with its defaults, software versions and timings).
 Products are cached on disk, in the user's cache (--cache-dir; default the platform's cache directory,
 ~/.cache/cupcheck/scenes on Linux, or $CUPCHECK_CACHE_DIR/scenes): a second run of the same scene
-computes nothing; --no-cache computes everything afresh.
+computes nothing. A rerun into the same DIR draws only the outputs whose inputs changed or whose
+files were edited or deleted (the manifest records what each file was made from and its sha256);
+one that changes nothing writes nothing. --no-cache computes and draws everything afresh.
 
 examples:
   cupcheck run scenes/lifetime_vs_force_cupA.toml --out out/lifetime
@@ -64,10 +66,15 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         result = run_scene(scene, args.out, cache_dir=None if args.no_cache else args.cache_dir,
-                           progress=progress if bar is not None else None)
+                           progress=progress if bar is not None else None, reuse=not args.no_cache)
     finally:
         if bar is not None:
             bar.close()
     timing = ", ".join(f"{k} {v:.2f} s" for k, v in result.timings.items())
-    print(f"run: wrote {len(result.files)} files and manifest.json to {args.out} ({timing or 'nothing computed'})")
+    if result.up_to_date:
+        print(f"run: the {len(result.files)} files in {args.out} are up to date (nothing written)")
+        return 0
+    kept = f", {len(result.kept)} unchanged kept" if result.kept else ""
+    print(f"run: wrote {len(result.files) - len(result.kept)} files{kept} and manifest.json to {args.out} "
+          f"({timing or 'nothing computed'})")
     return 0

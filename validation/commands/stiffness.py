@@ -10,7 +10,13 @@ flags and the other widths (lengths in mm). All files appear together or not at 
 Every input is checked before the solve: a bad value, an output path that cannot be written, or
 --nu above 0.495 with the displacement formulation (which locks there: use --formulation mixed)
 stops with one line and exit status 2 (without --formulation, nu above 0.495 takes the mixed
-formulation); a solve that fails exits 1. Neither leaves a file behind.
+formulation); a solve that fails before any step converged exits 1. Neither writes a curve.
+
+A path that fails after some converged steps keeps them: the curve and sidecar are written up to
+the last converged u, flagged partial in the sidecar's provenance ("partial": true,
+"failed_at_u_mm", "failure_reason", "u_max_mm_that_runs"), one line says where and why it stopped
+and which --u-max-mm runs, and the exit status is 3. Any failure leaves its record (the residual
+history) in <out>.failure.json; a later complete run removes it.
 
 examples:
   cupcheck stiffness --cup A --contact sticking --out out/cupA_sticking.csv
@@ -33,6 +39,8 @@ from validation.commands._paths import check_writable
 from validation.bridge.pipeline import LOCKING_NU
 
 NAME = "stiffness"
+#: exit status of a run that wrote only the converged part of its path (a partial curve)
+PARTIAL_EXIT = 3
 HELP = "FEM stiffness curve F0(h), r_c, l, V of cup A, B or your own design (CSV + JSON sidecar)"
 
 #: --fields-out suffixes (any case): .vtu, .vtk hold the last step, .xdmf every step; meshio's
@@ -78,17 +86,23 @@ def run(args: argparse.Namespace) -> int:
     from fem.postprocess import BIOT_STRETCH
     from validation.bridge import handoff
     from validation.output import atomic_file, terminal_progress
-    from validation.bridge.pipeline import fem_curve, fem_path
+    from validation.bridge.pipeline import converged_part, fem_curve, fem_path
 
     from fem.solver import ConvergenceError
-    from validation.commands._failure import solver_failure
+    from validation.commands._failure import failure_record, solver_failure
 
+    log = Path(args.out).with_suffix(".failure.json")
+    stop = None
     try:
         response = fem_path(None, job["material"], job["contact"], job["fidelity"], job["u_max_m"],
                             terminal_progress("stiffness"), mesh=job["mesh"])
     except ConvergenceError as exc:
-        raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
-    curve = fem_curve(response, job["geometry"], job["fidelity"], job["contact"].source, job["mesh_info"])
+        kept = converged_part(exc)
+        if kept is None:                     # nothing beyond u = 0 converged
+            raise solver_failure(exc, log) from None
+        response, stop = kept
+    curve = fem_curve(response, job["geometry"], job["fidelity"], job["contact"].source, job["mesh_info"],
+                      stop=stop)
     prov = curve.provenance
     with atomic_file(job["sidecar"]) as tmp_json, atomic_file(args.out) as tmp_csv:
         curve.to_csv(tmp_csv, sidecar=False)
@@ -97,15 +111,25 @@ def run(args: argparse.Namespace) -> int:
             with atomic_file(args.fields_out) as tmp_fields:
                 every_step = tmp_fields.suffix.lower() == ".xdmf"
                 response.write_fields(tmp_fields, step=None if every_step else -1)
+    if stop is not None:                     # after the writes, which removed an earlier record
+        failure_record(stop.error, log)
     s = response.stats
-    print(f"cupcheck stiffness: wrote {args.out} and {job['sidecar'].name}: {job['contact'].contact.label()} "
-          f"contact (from the {job['contact'].source}), {s.steps} steps, "
-          f"{s.newton_iterations} Newton iterations, {s.dofs} dofs, {s.wall_time_s:.1f} s; "
-          f"F0 = {response.F0_N[-1]:.4g} N at u = {1e3 * response.u_m[-1]:.4g} mm")
+    if stop is None:
+        print(f"cupcheck stiffness: wrote {args.out} and {job['sidecar'].name}: "
+              f"{job['contact'].contact.label()} contact (from the {job['contact'].source}), {s.steps} steps, "
+              f"{s.newton_iterations} Newton iterations, {s.dofs} dofs, {s.wall_time_s:.1f} s; "
+              f"F0 = {response.F0_N[-1]:.4g} N at u = {1e3 * response.u_m[-1]:.4g} mm")
     if response.folding_u_m is not None:
         print(f"cupcheck stiffness: note: from u = {1e3 * response.folding_u_m:.4g} mm the wall is "
               f"compressed beyond Biot's stretch {BIOT_STRETCH} (smallest {response.min_stretch.min():.3f}): "
               "a free surface may fold there, and the curve beyond depends on the mesh", file=sys.stderr)
+    if stop is not None:
+        runs = _round_down(1e3 * stop.u_max_m_that_runs)
+        print(f"cupcheck stiffness: partial: the path stopped at u = {1e3 * stop.failed_at_u_m:.4g} mm "
+              f"({stop.reason}); wrote the converged part, u = 0 to {1e3 * stop.u_max_m_that_runs:.4g} mm, "
+              f"to {args.out} and {job['sidecar'].name} (flagged partial); --u-max-mm {runs:.4g} runs; "
+              f"the record is in {log}", file=sys.stderr)
+        return PARTIAL_EXIT
     return 0
 
 
@@ -167,6 +191,14 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
             "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json"),
             "contact": contact}
+
+
+def _round_down(value: float, digits: int = 4) -> float:
+    """`value` > 0 rounded down to `digits` significant digits (a --u-max-mm that stays within)."""
+    import math
+
+    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return math.floor(value / scale) * scale
 
 
 def _positive(value: float, name: str, what: str) -> float:

@@ -5,63 +5,185 @@ Each output pulls only the products it needs (`validation.bridge.products.Produc
 PNG and SVG, axes labelled with units; tables name design, contact law, mesh, route and surface.
 `run_scene` is the Python entry point (a scene file, a dict or a `Scene`; the results in memory,
 and on disk when given a directory, written atomically with ``manifest.json``).
+
+A rerun into the same directory does no work for what has not changed: the manifest records, for
+every file, the key of what its output was made from (`made_from`) and the sha256 of its bytes;
+an output whose key is unchanged and whose files are present and intact is kept as it is (its
+files linked into the new directory, mtimes unchanged), any other is drawn again; a rerun that
+changes nothing writes nothing.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
+import os
+import shutil
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from validation.bridge.cache import file_digest, source_hash
 from validation.bridge.products import Products
-from validation.scenes.schema import Scene, load_scene, scene_from_mapping
+from validation.bridge.study import Study
+from validation.scenes.schema import STATE_KINDS, Scene, load_scene, scene_from_mapping
 
-__all__ = ["run_scene", "SceneResult"]
+__all__ = ["run_scene", "SceneResult", "made_from"]
 
+#: the manifest's name in a scene's output directory
+MANIFEST = "manifest.json"
+#: what an FEM state (render, footprint, squeeze) is made from; an FEM curve adds the stiffness
+#: source; every other output (tables, figures) depends on the whole study
+_FEM_PARTS = ("design", "material", "contact", "fidelity")
 
 
 @dataclass
 class SceneResult:
-    """What a scene produced: the products in memory, the files written (name, kind, path)."""
+    """What a scene produced: the products in memory, the files written (name, kind, path), and
+    of those the files kept unchanged from the previous run into the same directory."""
 
     scene: Scene
     products: dict[str, Any]
     files: list[dict[str, str]] = field(default_factory=list)
     timings: dict[str, float] = field(default_factory=dict)
+    kept: list[dict[str, str]] = field(default_factory=list)
+    up_to_date: bool = False        # the directory was left as it was: nothing written
+
+
+def made_from(output: Mapping[str, Any], study: Study) -> dict[str, Any]:
+    """What `output` is made from, for the manifest: ``key``, a content key of its own keys, the part
+    of the study it depends on (input files by path and by the sha256 of their bytes) and the
+    sources of fem, reduced and validation (like the products' cache keys: no package versions);
+    ``made_from``, the study parts by name; ``sources``, the sources' hash."""
+    record = study.describe()
+    record["design"]["file_sha256"] = file_digest(study.design.file)
+    record["surface"]["uc_table_sha256"] = file_digest(study.surface.uc_table)
+    record["suction_table_sha256"] = file_digest(study.suction_table)
+    if output["kind"] in STATE_KINDS:
+        parts = _FEM_PARTS
+    elif output["kind"] == "curve" and study.stiffness == "fem":
+        parts = (*_FEM_PARTS, "stiffness")
+    else:
+        parts = tuple(record)
+    sources = source_hash("fem", "reduced", "validation")
+    inputs = {"output": dict(output), "study": {p: record[p] for p in parts}, "sources": sources}
+    key = hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()[:32]
+    return {"key": key, "made_from": list(parts), "sources": sources}
 
 
 def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
-              cache_dir: str | Path | None = None, progress=None) -> SceneResult:
-    """Compute a scene's outputs; with `out`, write them (atomically) and ``out/manifest.json``."""
+              cache_dir: str | Path | None = None, progress=None, reuse: bool = True) -> SceneResult:
+    """Compute a scene's outputs; with `out`, write them (atomically) and ``out/manifest.json``.
+
+    reuse: keep the outputs of an earlier run in `out` whose key and files are unchanged (False:
+    draw every output afresh)."""
     from validation.output import atomic_directory, software_versions
 
     if not isinstance(scene, Scene):
         scene = scene_from_mapping(scene) if isinstance(scene, dict) else load_scene(scene)
     from validation.output import check_file_names
-    check_file_names(planned_files(scene), reserved={"manifest.json": "the scene's manifest"})
-    products = Products(scene.study(), cache_dir=cache_dir, progress=progress)
+    check_file_names(planned_files(scene), reserved={MANIFEST: "the scene's manifest"})
+    study = scene.study()
     t0 = time.perf_counter()
-    def each(tmp):
-        n = len(scene.outputs)
+    n = len(scene.outputs)
+    if out is None:
+        products = Products(study, cache_dir=cache_dir, progress=progress)
         for k, o in enumerate(scene.outputs):
             if progress is not None:
                 progress(f"output {k + 1} of {n}: {o['name']}")
-            yield from _write(o, products, tmp)
+            _write(o, products, None)
+        return SceneResult(scene, products.computed(), [], dict(products.timings))
 
-    if out is None:
-        files = list(each(None))
-        return SceneResult(scene, products.computed(), files, dict(products.timings))
+    out = Path(out)
+    made = [made_from(o, study) for o in scene.outputs]
+    previous = _manifest(out) if reuse else None
+    intact = [_intact_files(o, m["key"], previous, out) for o, m in zip(scene.outputs, made)]
+    if previous is not None and _up_to_date(previous, scene, intact):
+        files = [{**f, "path": str(out / f["path"])} for kept in intact for f in kept]
+        return SceneResult(scene, {}, files, {}, kept=list(files), up_to_date=True)
+    products = Products(study, cache_dir=cache_dir, progress=progress)
     with atomic_directory(out) as tmp:
-        files = list(each(Path(tmp)))
+        files, kept = [], []
+        for k, (o, origin, old) in enumerate(zip(scene.outputs, made, intact)):
+            if progress is not None:
+                progress(f"output {k + 1} of {n}: {o['name']}")
+            linked = _link(old, out, Path(tmp)) if old else None
+            if linked is not None:
+                kept += linked
+                files += linked
+                continue
+            files += [{**f, **origin, "sha256": file_digest(f["path"])} for f in _write(o, products, Path(tmp))]
         manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
                     "scene": scene.resolved(), "source": scene.source,
-                    "versions": software_versions(), "timings_s": {**products.timings,
-                                                                   "total": time.perf_counter() - t0}}
-        (Path(tmp) / "manifest.json").write_text(json.dumps(manifest, indent=1, default=str) + "\n")
-    files = [{**f, "path": str(Path(out) / Path(f["path"]).name)} for f in files]
-    return SceneResult(scene, products.computed(), files, dict(products.timings))
+                    "versions": software_versions(),
+                    "timings_s": {**products.timings, "total": time.perf_counter() - t0}}
+        (Path(tmp) / MANIFEST).write_text(json.dumps(manifest, indent=1, default=str) + "\n")
+    rename = lambda f: {**f, "path": str(out / Path(f["path"]).name)}    # noqa: E731
+    return SceneResult(scene, products.computed(), [rename(f) for f in files], dict(products.timings),
+                       kept=[rename(f) for f in kept])
+
+
+def _manifest(out: Path) -> dict | None:
+    """The manifest of the previous run into `out` (None: no readable one)."""
+    try:
+        manifest = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return manifest if isinstance(manifest, dict) and isinstance(manifest.get("files"), list) else None
+
+
+def _intact_files(output: Mapping[str, Any], key: str, manifest: dict | None, out: Path) -> list[dict]:
+    """The previous run's files of `output` if it was made from the same key and every file is
+    present with the bytes the manifest recorded; else [] (the output is drawn again)."""
+    if manifest is None:
+        return []
+    files = [f for f in manifest["files"]
+             if isinstance(f, dict) and (f.get("name"), f.get("kind")) == (output["name"], output["kind"])]
+    if not files or any(f.get("key") != key or not _same_bytes(out, f) for f in files):
+        return []
+    return files
+
+
+def _same_bytes(directory: Path, entry: Mapping[str, Any]) -> bool:
+    """`entry`'s file (a plain name in `directory`) is there and its sha256 is the recorded one."""
+    name, digest = entry.get("path"), entry.get("sha256")
+    if not (isinstance(name, str) and isinstance(digest, str)) or Path(name).name != name or name in ("", ".", ".."):
+        return False
+    path = directory / name
+    return path.is_file() and not path.is_symlink() and file_digest(path) == digest
+
+
+def _up_to_date(manifest: dict, scene: Scene, intact: list[list[dict]]) -> bool:
+    """Every output intact, the manifest lists no other file and records this very scene: nothing to write."""
+    if not all(intact) or sum(map(len, intact)) != len(manifest["files"]):
+        return False
+    resolved = json.loads(json.dumps(scene.resolved(), default=str))
+    return manifest.get("scene") == resolved and manifest.get("source") == scene.source
+
+
+def _link(entries: list[dict], out: Path, tmp: Path) -> list[dict] | None:
+    """Link an intact output's files from the previous directory into the new one (a copy keeping
+    the mtime where links are not possible); None if one changed meanwhile (draw it again)."""
+    done = []
+    for entry in entries:
+        source, target = out / entry["path"], tmp / entry["path"]
+        try:
+            os.link(source, target)
+        except OSError:
+            try:
+                shutil.copy2(source, target)
+            except OSError:
+                break
+        done.append(target)
+        if file_digest(target) != entry["sha256"]:
+            break
+    else:
+        return [{**e, "path": str(tmp / e["path"])} for e in entries]
+    for target in done:
+        target.unlink(missing_ok=True)
+    return None
 
 
 def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str, str]]:

@@ -16,8 +16,11 @@ from __future__ import annotations
 import json
 import os
 import secrets
+import signal
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -74,12 +77,14 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     computed = failed = 0
     dashboard, startup = None, 0.0
     if todo:
+        cluster = client = None
         with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
-            cluster = None if scheduler else LocalCluster(
-                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                dashboard_address=":0", silence_logs=40)
-            client = Client(scheduler or cluster)
             try:
+                with _ctrl_c_held():
+                    cluster = None if scheduler else LocalCluster(
+                        n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                        dashboard_address=":0", silence_logs=40)
+                    client = Client(scheduler or cluster)
                 dashboard, startup = client.dashboard_link, time.perf_counter() - t0
                 futures = {client.submit(evaluate, d, key=f"design-{design_hash(d)}", pure=False): d
                            for d in todo}
@@ -99,12 +104,34 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
                     dashboard=dashboard)
 
 
+@contextmanager
+def _ctrl_c_held() -> Iterator[None]:
+    """Start the cluster with Ctrl-C held back: SIGINT is ignored, so the worker processes spawned
+    now start ignoring it (a Ctrl-C reaching the process group while a worker still imports dask,
+    before its preload `validation.sweeps.worker` runs, would print that worker's traceback), and
+    blocked in this thread, so a Ctrl-C meanwhile stays pending and lands here on leaving, once
+    the cluster exists to be shut down. multiprocessing's resource tracker unblocks SIGINT after
+    starting, so it is started first."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    from multiprocessing import resource_tracker
+    resource_tracker.ensure_running()
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, handler)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
 def _shut_down(client, cluster) -> None:
     """Close the client and the local cluster. Every finished design is committed by then, so a
     cluster that does not stop cleanly (a nanny still restarting a killed worker) is reported on
     stderr, not raised: it must not turn a finished sweep into a failed one."""
     import sys
-    for close in (client.close, *((cluster.close,) if cluster is not None else ())):
+    for close in (part.close for part in (client, cluster) if part is not None):
         try:
             close()
         except Exception as exc:      # noqa: BLE001 - shutdown only, results already on disk

@@ -1,0 +1,214 @@
+"""Where a stiffness curve's time goes: cup A, frictionless, u = 0 .. 0.9 h1, per fidelity level.
+
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_fem_profile.py [--levels coarse medium]
+        [--contact frictionless] [--repeat 3] [--whole]
+
+Runs `fem.cup.compress_cup` in-process (no start-up, no CSV) and prints per curve: load steps,
+Newton iterations, dofs, factorizations, the in-process wall time (first call and the median of
+--repeat further calls), the time per Newton iteration, and the exclusive time of each part with
+its share of the wall time:
+
+  assembly   energy, internal force and tangent (`fem.forms.Mechanics`: the element kernels, the
+             CSR assembly), per evaluation;
+  factor     the shifted factorizations of K_ff (`fem.factorization.ShiftPolicy.factor`, with the
+             condensation of the interior nodes) and the Schur complements of freed contact
+             nodes (`fem.linsolve.BorderedFactor`); its calls count the requests, a reused
+             factor included (the header gives the factorizations done);
+  solve      the triangular solves with those factors;
+  lcp        the contact step's small LCP (non-negative least squares);
+  post       the per-step outputs (`fem.cup._measure`: pressure profile, r_c, l, V, stretch) and
+             the admissibility check of each converged state (`fem.integrity.check_state`);
+  other      the rest: the Newton loop, line search, contact projections, convergence tests.
+
+and, on the tangent of the last factorization of the path (its free block K_ff), the time of one
+factorization by the solver itself and by scipy's sparse LU (`scipy.sparse.linalg.splu`, COLAMD
+ordering): the scale of the linear algebra alone against the time per Newton iteration.
+With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
+--repeat runs, CPU time of the child and wall time), whose excess over the in-process curve is
+start-up (imports), the mesh and the output files.
+Times are the process's CPU time (`time.process_time`; one thread with OMP_NUM_THREADS=1, so on a
+quiet machine the wall time, which a busy second core inflates); the wrappers cost ~1 us a call.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import fem.contact_step  # noqa: E402
+import fem.cup  # noqa: E402
+import fem.factorization  # noqa: E402
+import fem.linsolve  # noqa: E402
+import fem.condensation  # noqa: E402
+from fem.cup import compress_cup  # noqa: E402
+from fem.forms import Mechanics  # noqa: E402
+from fem.geometry import cup_geometry  # noqa: E402
+from fem.material import NeoHookean  # noqa: E402
+from fem.mesh import cup_mesh  # noqa: E402
+
+PARTS = ("assembly", "factor", "solve", "lcp", "post")
+
+
+class Clock:
+    """Exclusive wall time per part: a part's time excludes that of the parts called inside it."""
+
+    def __init__(self) -> None:
+        self.stack: list[list] = []
+        self.reset()
+
+    def reset(self) -> None:
+        self.time = dict.fromkeys(PARTS, 0.0)
+        self.calls = dict.fromkeys(PARTS, 0)
+        self.last_factor: tuple | None = None
+
+    def wrap(self, part: str, fn):
+        @functools.wraps(fn)
+        def timed(*args, **kwargs):
+            frame = [time.process_time(), 0.0]
+            self.stack.append(frame)
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                elapsed = time.process_time() - frame[0]
+                self.stack.pop()
+                self.time[part] += elapsed - frame[1]
+                self.calls[part] += 1
+                if self.stack:
+                    self.stack[-1][1] += elapsed
+        return timed
+
+
+CLOCK = Clock()
+
+
+def _instrument() -> None:
+    """Wrap the functions of each part (module docstring), once."""
+    w = CLOCK.wrap
+    Mechanics._evaluate = w("assembly", Mechanics._evaluate)
+    Mechanics.energy = w("assembly", Mechanics.energy)
+    Mechanics.internal_force = w("assembly", Mechanics.internal_force)
+    policy_factor = fem.factorization.ShiftPolicy.factor
+
+    def factor(self, solver, K, free, shift):
+        CLOCK.last_factor = (solver, K, free.copy())
+        return policy_factor(self, solver, K, free, shift)
+
+    fem.factorization.ShiftPolicy.factor = w("factor", factor)
+    fem.linsolve.BorderedFactor.__init__ = w("factor", fem.linsolve.BorderedFactor.__init__)
+    for cls in (fem.linsolve.Factor, fem.linsolve.BorderedFactor, fem.condensation.CondensedFactor):
+        cls.solve = w("solve", cls.solve)
+    fem.contact_step.lcp = w("lcp", fem.contact_step.lcp)
+    fem.cup._measure = w("post", fem.cup._measure)
+    fem.cup.check_state = w("post", fem.cup.check_state)
+
+
+def _median_time(fn, repeat: int = 7) -> float:
+    times = []
+    for _ in range(repeat):
+        t = time.process_time()
+        fn()
+        times.append(time.process_time() - t)
+    return statistics.median(times)
+
+
+def profile_curve(level: str, contact: str, repeat: int) -> dict:
+    """One level: the first call, then `repeat` timed calls; the parts of the last one."""
+    geometry = cup_geometry("A")
+    mesh = cup_mesh(geometry, level)
+    run = lambda: compress_cup(mesh, NeoHookean(), contact=contact,       # noqa: E731
+                               u_max_m=0.9 * geometry.h1_m)
+    t = time.process_time()
+    run()
+    first = time.process_time() - t
+    walls, parts = [], []
+    for _ in range(repeat):
+        CLOCK.reset()
+        t = time.process_time()
+        resp = run()
+        walls.append(time.process_time() - t)
+        parts.append((dict(CLOCK.time), dict(CLOCK.calls)))
+    wall = statistics.median(walls)
+    i = int(np.argsort(walls)[len(walls) // 2])
+    part_time, part_calls = parts[i]
+    solver, K, free = CLOCK.last_factor
+    own = _median_time(lambda: solver.factor(K, free))
+    K_ff = K[free][:, free].tocsc()
+    lu = _median_time(lambda: spla.splu(K_ff))
+    s = resp.stats
+    return {"level": level, "steps": s.steps, "newton": s.newton_iterations, "dofs": s.dofs,
+            "factorizations": s.factorizations, "first": first, "wall": walls[i], "median": wall,
+            "min": min(walls),
+            "parts": part_time, "calls": part_calls, "own_factor": own, "splu": lu,
+            "free": int(free.sum())}
+
+
+def whole_process(level: str, contact: str, repeat: int) -> tuple[float, float]:
+    """(CPU, wall) [s] of `cupcheck stiffness` for cup A at `level`, the medians of `repeat` runs."""
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root), "OMP_NUM_THREADS": "1"}
+    cpu, wall = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(repeat):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "validation.cli", "stiffness", "--cup", "A",
+                            "--fidelity", level, "--contact", contact, "--out",
+                            str(Path(tmp) / "curve.csv")], cwd=root, env=env, check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            wall.append(time.perf_counter() - t)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
+    return statistics.median(cpu), statistics.median(wall)
+
+
+def report(r: dict) -> None:
+    n = r["newton"]
+    print(f"\ncup A {r['level']}: {r['steps']} steps, {n} Newton iterations, {r['dofs']} dofs "
+          f"({r['free']} free at the end), {r['factorizations']} factorizations")
+    print(f"  in-process CPU time: first call {r['first']:.3f} s, median {r['median']:.3f} s "
+          f"(min {r['min']:.3f} s); "
+          f"per Newton iteration {1e3 * r['wall'] / n:.2f} ms")
+    print(f"  one factorization of the last tangent's K_ff: the solver's own {1e3 * r['own_factor']:.2f} ms, "
+          f"scipy splu {1e3 * r['splu']:.2f} ms")
+    print(f"  {'part':9} {'time/s':>7} {'share':>6} {'calls':>6} {'per call/ms':>11} {'per iteration/ms':>16}")
+    total = r["wall"]
+    for part in PARTS + ("other",):
+        t = r["parts"].get(part, total - sum(r["parts"].values()))
+        calls = r["calls"].get(part, 0)
+        per_call = f"{1e3 * t / calls:11.3f}" if calls else f"{'':11}"
+        print(f"  {part:9} {t:7.3f} {t / total:6.1%} {calls:6d} {per_call} {1e3 * t / n:16.2f}")
+    if "whole_cpu" in r:
+        print(f"  whole process (cupcheck stiffness): CPU {r['whole_cpu']:.3f} s, wall {r['whole_wall']:.3f} s; "
+              f"beyond the curve (start-up, mesh, output): CPU {r['whole_cpu'] - r['median']:.3f} s")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--levels", nargs="+", default=["coarse", "medium"])
+    ap.add_argument("--contact", default="frictionless", choices=["frictionless", "sticking"])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--whole", action="store_true", help="also time the whole cupcheck process")
+    args = ap.parse_args()
+    _instrument()
+    for level in args.levels:
+        r = profile_curve(level, args.contact, args.repeat)
+        if args.whole:
+            r["whole_cpu"], r["whole_wall"] = whole_process(level, args.contact, args.repeat)
+        report(r)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,85 @@
+"""A command imports only what it uses: `cupcheck --help` and bare `cupcheck` import no command
+module (nor numpy); a reduced-model-only command (`lifetime --route paper`, `uc`) imports no FEM
+machinery, no plotting, no dask, no pyvista, no scipy.signal. Each case is a fresh process (the
+modules a test session has already loaded say nothing), its `sys.modules` read after the command ran.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from validation.cli import COMMANDS
+
+ROOT = Path(__file__).resolve().parents[1]
+#: top-level packages no reduced-model-only command may import
+HEAVY = ("skfem", "matplotlib", "dask", "distributed", "pyvista", "vtk", "meshio", "pandas", "joblib")
+#: the only fem modules a reduced-model command may touch: the numpy-only design records (a Table 1
+#: cup's shape, its interface with the plane), never the mesh, forms or solver
+FEM_RECORDS = {"fem", "fem.geometry", "fem.interface"}
+
+
+def _modules_after(argv: list[str], tmp_path: Path) -> set[str]:
+    """The modules loaded in a fresh process that ran `cupcheck ARGV` (exit status 0 asserted)."""
+    code = ("import contextlib, io, json, sys\n"
+            "from validation.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    try:\n"
+            f"        status = main({argv!r})\n"
+            "    except SystemExit as exc:\n"
+            "        status = exc.code\n"
+            "print(json.dumps({'status': status, 'modules': sorted(sys.modules)}))\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "CUPCHECK_CACHE_DIR": str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    assert result["status"] in (0, None), done.stderr
+    return set(result["modules"])
+
+
+def _top(modules: set[str]) -> set[str]:
+    return {m.split(".")[0] for m in modules}
+
+
+@pytest.mark.parametrize("argv", [[], ["--help"], ["--version"]], ids=["bare", "help", "version"])
+def test_listing_the_commands_imports_none_of_them(argv, tmp_path):
+    modules = _modules_after(argv, tmp_path)
+    assert not {m for m in modules if m.startswith("validation.commands.")}
+    assert not _top(modules) & {"numpy", "scipy", "fem", "reduced", *HEAVY}
+
+
+@pytest.mark.parametrize("argv", [
+    ["lifetime", "--cup", "A", "--force", "10", "--route", "paper"],
+    ["uc", "--surface", "pmma-1.89", "--E-MPa", "4", "--p-kPa", "10", "50"],
+], ids=["lifetime-paper", "uc"])
+def test_a_reduced_model_command_imports_no_fem_and_no_plotting(argv, tmp_path):
+    modules = _modules_after(argv, tmp_path)
+    assert not _top(modules) & set(HEAVY), sorted(m for m in modules if m.split(".")[0] in HEAVY)[:10]
+    assert "scipy.signal" not in modules
+    assert {m for m in modules if m.split(".")[0] == "fem"} <= FEM_RECORDS
+    assert "validation.crosscheck" not in modules
+    # the test can fail: the command did run the reduced model
+    assert "reduced.lifetime" in modules or "reduced.roughness" in modules
+
+
+def test_a_fem_command_does_import_the_fem(tmp_path):
+    """The check above sees imports: a command that runs the FEM shows skfem."""
+    modules = _modules_after(["stiffness", "--cup", "A", "--fidelity", "coarse", "--out",
+                              str(tmp_path / "c.csv")], tmp_path)
+    assert "skfem" in _top(modules)
+
+
+@pytest.mark.parametrize("name", COMMANDS)
+def test_the_table_names_each_commands_module_and_its_help(name):
+    """The listing's one line is the command module's own HELP, and the module is a command."""
+    module_name, line = COMMANDS[name]
+    module = importlib.import_module(module_name)
+    assert module.HELP == line
+    assert callable(module.add_arguments) and callable(module.run)
