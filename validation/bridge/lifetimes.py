@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:                          # importing this module imports no reduced
     from reduced.lifetime import LeakageModel, Lifetime
 
-__all__ = ["ROUTES", "Lifetimes", "lifetimes", "route_options", "route_laws"]
+__all__ = ["ROUTES", "Lifetimes", "lifetimes", "route_options", "route_laws", "end_state_columns"]
 
 #: the names of `reduced.ROUTES`, spelled out so that building the command line imports no reduced
 #: model (a test pins them equal)
@@ -91,3 +91,18 @@ def lifetimes(model: LeakageModel, forces_N: Iterable[float], route: str, *, t_m
         if progress:
             progress((i + 1) / len(forces), f"F1 = {force:g} N")
     return Lifetimes(route, tuple(results), largest)
+
+
+def end_state_columns(results: Lifetimes) -> dict[str, list]:
+    """A lifetime table's route-specific columns, one value per force (units in the names): on
+    the fem route the largest holdable force and the FEM's end state (plate displacement, cavity
+    pressure, seal radius; empty where the cup held no state); on the paper and profile routes
+    the ballistic share and the cone's end state (contact radius, cavity pressure)."""
+    if results.route == "fem":
+        def end(key: str) -> list:
+            return [r.details.get(key, "") for r in results]
+        return {"largest_force_N": [results.largest_force_N] * len(results), "u_final_mm": end("u_final_mm"),
+                "p_b_final_Pa": end("p_b_final_Pa"), "seal_r_final_mm": end("seal_r_final_mm")}
+    return {"ballistic_share": [r.details["ballistic_share"] for r in results],
+            "r_final_mm": [float(r.trajectory["r_mm"][-1]) for r in results],
+            "p_b_final_Pa": [float(r.trajectory["p_b_Pa"][-1]) for r in results]}

@@ -5,7 +5,8 @@ outputs need only the u_c table never builds a curve, and a lifetime fed by Appe
 imports `fem`. The expensive products (u_c table, FEM path, curve, frames, lifetimes) go through
 `validation.bridge.cache`: the key is the function's code, its arguments with every input file (design
 file, u_c table) by the sha256 of its bytes instead of its path, and a hash of the sources that
-compute the product. `COMPUTED` counts the products actually computed in this process (a second
+compute the product. The fem route's lifetimes need no curve: they come from the FEM cup of the
+study's design, material, contact law and mesh level (`fem_route_options`). `COMPUTED` counts the products actually computed in this process (a second
 run of the same study computes none).
 """
 
@@ -21,7 +22,7 @@ from typing import Any
 from validation.bridge.cache import Cache, file_digest, source_hash
 from validation.bridge.study import Contact, Study
 
-__all__ = ["Products", "COMPUTED"]
+__all__ = ["Products", "COMPUTED", "fem_route_options"]
 
 #: products computed (not taken from the cache) in this process, by name
 COMPUTED: Counter = Counter()
@@ -39,6 +40,7 @@ def _study_key(study: Study) -> dict:
     data["design"] = {**data["design"], **_design_key(study)}
     data["surface"] = {**data["surface"], "uc_table": file_digest(study.surface.uc_table)}
     data["suction_table"] = file_digest(study.suction_table)
+    data["stiffness_file"] = file_digest(study.stiffness_file)
     return data
 
 
@@ -99,9 +101,24 @@ def _lifetimes(study_key: dict, stiffness, uc, cup, code: str, study=None, progr
     def each(fraction: float, message: str) -> None:
         if progress is not None:
             progress(f"lifetime {round(fraction * len(forces))} of {len(forces)} done ({message})")
+    options = fem_route_options(study) if study.route == "fem" else route_options(study.route, study.cup_laws)
     return lifetimes(_model(study, stiffness, uc, cup), forces, study.route, progress=each,
-                     refine=1 if study.route == "coupled" else study.refine,
-                     **route_options(study.route, study.cup_laws))
+                     refine=1 if study.route in ("coupled", "fem") else study.refine, **options)
+
+
+def fem_route_options(study: Study) -> dict[str, Any]:
+    """The fem route's options for the study (`validation.bridge.fem_route.FemRoute`): the FEM cup
+    of its design, material, contact law and mesh level, the loads' press (None: to the cup's
+    r_start) and plate step."""
+    from validation.bridge.fem_route import FemCup, Press
+
+    s = study
+    design = s.design
+    geometry = design.cup_geometry() if (design.file or design.geometry is not None) else design.preset
+    press = s.loads.press()
+    return {"cup": FemCup(geometry, s.fidelity, E_Pa=s.material.E_MPa * 1e6, nu=s.material.nu,
+                          contact=s.contact.contact_law()),
+            "press": None if press is None else Press(*press), "du_m": 1e-3 * s.loads.du_mm}
 
 
 def _model(study: Study, stiffness, uc, cup):
@@ -113,6 +130,8 @@ def _model(study: Study, stiffness, uc, cup):
 
     loads = study.loads
     feed = {"suction": stiffness} if study.route == "coupled" else {"stiffness": stiffness}
+    if study.route == "fem":               # the FEM states are the cup's mechanics: no curve
+        feed = {}
     return LeakageModel(cup=cup, u_c=uc, gas=Gas(T_K=293.15), p_a_Pa=1e5, E_Pa=study.material.E_MPa * 1e6,
                         kappa=loads.kappa, relaxation=default_relaxation() if loads.relaxation == "default" else None,
                         fluid=loads.fluid, **feed)
@@ -174,9 +193,13 @@ class Products:
             {**asdict(surface), "uc_table": file_digest(surface.uc_table)}, source_hash("reduced"), surface=surface))
 
     def curve(self):
-        """The stiffness curve: the FEM's to 0.9 h1, or Appendix A's (d0 = 2 mm) of the study's cup."""
+        """The stiffness curve: the FEM's to 0.9 h1 (or the study's curve file), or Appendix A's
+        (d0 = 2 mm) of the study's cup."""
         if self.study.stiffness == "appendix-a":
             return self._get("curve", self._appendix_a_curve)
+        if self.study.stiffness_file is not None:
+            from reduced.stiffness_curve import StiffnessCurve
+            return self._get("curve", lambda: StiffnessCurve.from_csv(self.study.stiffness_file))
         return self._get("curve", lambda: self._cached(_fem_curve, ignore=["design", "path"])(
             *self._fem_args(self._u_max_m(None)), source_hash("fem", "validation"), self.study.contact.source,
             design=self.study.design,
@@ -196,6 +219,9 @@ class Products:
             from validation.bridge.design import resolve_cup
             from validation.bridge.lifetimes import route_laws
             s = self.study
+            if s.route == "fem" and s.design.geometry is None:     # the FEM route needs no curve
+                return resolve_cup(None, cup=s.design.preset, geometry_file=s.design.file,
+                                   r_start_mm=s.loads.r_start_mm, laws="curve")
             return resolve_cup(self.curve(), r_start_mm=s.loads.r_start_mm, l0_mm=s.design.l0_mm,
                                l1_mm=s.design.l1_mm, curve_label="the FEM curve",
                                laws=route_laws(s.route, s.cup_laws))
@@ -255,10 +281,10 @@ class Products:
         """The lifetimes (`validation.bridge.lifetimes.Lifetimes`) of the study's forces on its route."""
         s = self.study
         def compute():
-            feed = self.suction_table() if s.route == "coupled" else self.curve()
+            feed = {"coupled": self.suction_table, "fem": lambda: None}.get(s.route, self.curve)()
+            code = source_hash("fem", "reduced", "validation") if s.route == "fem" else source_hash("reduced", "validation")
             return self._cached(_lifetimes, ignore=["study", "progress"])(
-                _study_key(s), feed, self.uc_table(), self.cup(), source_hash("reduced", "validation"),
-                study=s, progress=self._progress)
+                _study_key(s), feed, self.uc_table(), self.cup(), code, study=s, progress=self._progress)
         return self._get("lifetimes", compute)
 
     def derived(self, study: Study, inherit: tuple[str, ...] = ()) -> Products:

@@ -96,13 +96,27 @@ class Surface:
 class Loads:
     """The pull forces F1 [N], the stiffness factor kappa, the contact radius after pressing on
     (None: Table 1's 12 mm for the presets), the relaxation ("none" | "default") and what fills
-    the cavity ("air" | "water")."""
+    the cavity ("air" | "water"). The fem route presses the cup to r_start_mm, or instead to a
+    plate displacement press_u_mm [mm] or a pressing force press_force_N [N] (at most one of the
+    three given), and follows its branch in plate steps of du_mm [mm]."""
 
     forces_N: tuple[float, ...] = (5.0, 10.0, 20.0, 40.0, 80.0)
     kappa: float = 1.0
     r_start_mm: float | None = None
     relaxation: str = "none"
     fluid: str = "air"
+    press_u_mm: float | None = None
+    press_force_N: float | None = None
+    du_mm: float = 0.25
+
+    def press(self) -> tuple[str, float] | None:
+        """How the fem route presses the cup, as (`validation.bridge.fem_route.Press` kind, value in
+        SI), or None: to the cup's r_start (Table 1's or r_start_mm, through the study's cup)."""
+        if self.press_u_mm is not None:
+            return ("u_m", 1e-3 * self.press_u_mm)
+        if self.press_force_N is not None:
+            return ("force_N", float(self.press_force_N))
+        return None
 
 
 @dataclass(frozen=True)
@@ -116,10 +130,13 @@ class Sweep:
 @dataclass(frozen=True)
 class Study:
     """One case end to end (module docstring). stiffness: "fem" or "appendix-a" (d0 = 2 mm);
-    route: a lifetime route (`validation.bridge.lifetimes.ROUTES`); cup_laws: the paper route's r, V, l
+    route: a lifetime route (`validation.bridge.lifetimes.ROUTES`; "fem" keeps the cup in the FEM
+    for its whole life, from the design, material, contact law, fidelity and the loads' press); cup_laws: the paper route's r, V, l
     ("cone" or "curve", `validation.bridge.lifetimes.route_laws`; None: the route's own); refine: output points per integration
     step of the lifetimes; suction_table: the coupled route's table file (None: built from the
-    design at `fidelity`); outputs: what to write (the scene's [[outputs]])."""
+    design at `fidelity`); stiffness_file: a stiffness curve file (`cupcheck stiffness`) used as
+    the FEM curve instead of running the FEM (its design, law, mesh level and material are then
+    the study's: `cupcheck example --stiffness`); outputs: what to write (the scene's [[outputs]])."""
 
     design: CupDesign = CupDesign()
     material: Material = Material()
@@ -132,6 +149,7 @@ class Study:
     loads: Loads = Loads()
     refine: int = 2
     suction_table: str | None = None
+    stiffness_file: str | None = None
     outputs: tuple[Mapping[str, Any], ...] = field(default=(), compare=False)
     sweep: Sweep | None = None
 

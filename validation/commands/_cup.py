@@ -4,7 +4,9 @@ from (`--cup-laws`) and the reduced model's start.
 
 `--cup` takes A or B in any case; `--geometry` is always a design file (.toml or .json, the keys of
 `fem.design_file.load_design`, with an optional [contact] table). Shared by `stiffness`, `lifetime`,
-`example` and `suction`. `--contact`/`--friction` given on the command line win over the design
+`example` and `suction`. The flags, their types, choices and defaults are the study's fields
+(`validation.study_schema.add_flags`); the help here says what each means on the command line.
+`--contact`/`--friction` given on the command line win over the design
 file's [contact] table, which wins over frictionless (`contact_choice`).
 """
 
@@ -19,7 +21,7 @@ if TYPE_CHECKING:                          # building the parser imports no fem
     from fem.interface import ContactChoice
 
 from reduced.cup import CUPS
-from validation.bridge.lifetimes import ROUTES
+from validation.study_schema import add_flags, field_of
 
 
 def cup_name(value: str) -> str:
@@ -42,17 +44,16 @@ def add_cup_arguments(parser: argparse.ArgumentParser, role: str):
     """--cup, --geometry FILE, --allow-unusual-design in a group "cup" (returned for more options);
     `role` says what the cup is used for."""
     g = parser.add_argument_group("cup")
-    g.add_argument("--cup", type=cup_name, default=None, metavar="A|B",
-                   help="Table 1 cup preset, any case (A: alpha 33 deg, d 2.5 -> 0.3 mm; B: 21 deg, "
-                        f"1.5 -> 0.3 mm; r0 5 mm, r1 19 mm); {role} (default: A)")
-    g.add_argument("--geometry", type=design_file, default=None, metavar="FILE",
-                   help="your design (.toml or .json; keys cup, r0_mm, r1_mm, alpha_deg, "
+    add_flags(g, ("cup.preset", "cup.geometry", "cup.allow_unusual_design"), helps={
+        "cup.preset": "Table 1 cup preset, any case (A: alpha 33 deg, d 2.5 -> 0.3 mm; B: 21 deg, "
+                      f"1.5 -> 0.3 mm; r0 5 mm, r1 19 mm); {role} (default: A)",
+        "cup.geometry": "your design (.toml or .json; keys cup, r0_mm, r1_mm, alpha_deg, "
                         "thickness_convention, thickness = {r_mm = [...], d_mm = [...]}, and "
                         "optionally contact = {law = ..., friction = MU}, the FEM's contact law "
-                        "unless --contact is given), starting from --cup")
-    g.add_argument("--allow-unusual-design", action="store_true",
-                   help="accept a cone angle outside 5..80 deg or a wall more than 400x longer "
-                        "than thick (refused by default: the FEM meshes cannot resolve them)")
+                        "unless --contact is given), starting from --cup",
+        "cup.allow_unusual_design": "accept a cone angle outside 5..80 deg or a wall more than 400x longer "
+                                    "than thick (refused by default: the FEM meshes cannot resolve them)"},
+        **{"--cup": {"type": cup_name, "metavar": "A|B"}, "--geometry": {"type": design_file}})
     return g
 
 
@@ -61,59 +62,57 @@ def add_cup_arguments(parser: argparse.ArgumentParser, role: str):
 def add_cup_law_arguments(parser: argparse.ArgumentParser, default_route: str = "paper") -> None:
     """--route, --cup-laws, --r-start-mm, --l0-mm, --l1-mm: the reduced model's cup and seal."""
     g = parser.add_argument_group("reduced-model cup")
-    g.add_argument("--route", default=default_route, choices=tuple(ROUTES),
-                   help="what the leak crosses: paper (eqs 3-7: one strip at the uniform pressure of "
+    add_flags(g, ("stiffness.route",), defaults={"stiffness.route": default_route}, helps={"stiffness.route":
+                   "what the leak crosses: paper (eqs 3-7: one strip at the uniform pressure of "
                         "eq 6, beta = 0.8), or profile (the FEM curve's own contact-pressure profile "
                         "p(r) + beta (p_a - p_b), ring by ring, with its r_c and V; needs an FEM curve; "
                         "not mesh-converged where only the sharp rim corner touches, see docs/lifetime.md), "
-                        "or coupled (lifetime only: the cup's state from the FEM's (u, dp) suction table of "
-                        "`cupcheck suction`, --suction-table; replaces eqs 3-7 and beta), or fem (lifetime only: "
+                        "or coupled (lifetime and example: the cup's state from the FEM's (u, dp) suction table of "
+                        "`cupcheck suction`, --suction-table; replaces eqs 3-7 and beta), or fem (lifetime and example: "
                         "the cup pressed, sealed and held at F1 along its FEM equilibrium branch while "
                         "the gas leaks in through each state's own profile; --contact, --fidelity) "
-                        f"(default: {default_route})")
+                        f"(default: {default_route})"})
     g.add_argument("--cup-laws", default=None, choices=("cone", "curve"),
                    help="r(h), V(h), l(h) from the rigid-cone laws eqs 3-5 with the cup's r0, r1, "
                         "alpha (cone), or from the stiffness curve's r_c_mm, V_mm3, l_mm columns "
                         "(curve; l = 0 is a line contact, sealed) (default: cone for the paper route, "
                         "curve for the profile route, which needs it)")
-    g.add_argument("--r-start-mm", dest="r_start_mm", type=float, default=None,
-                   help="inner contact radius after pressing on, in (r0, r1) mm (default: 12 mm "
-                        "for cups A and B (Table 1), (r0 + r1)/2 for other designs)")
-    g.add_argument("--l0-mm", dest="l0_mm", type=float, default=None,
-                   help="eq (5)'s strip width at r0 in mm (default: Table 1 for cups A and B; for "
-                        "other designs fitted to the FEM curve's l(r_c))")
-    g.add_argument("--l1-mm", dest="l1_mm", type=float, default=None,
-                   help="eq (5)'s strip width at r1 in mm (with --l0-mm)")
+    add_flags(g, ("loads.r_start_mm", "cup.l0_mm", "cup.l1_mm"), helps={
+        "loads.r_start_mm": "inner contact radius after pressing on, in (r0, r1) mm (default: 12 mm "
+                            "for cups A and B (Table 1), (r0 + r1)/2 for other designs)",
+        "cup.l0_mm": "eq (5)'s strip width at r0 in mm (default: Table 1 for cups A and B; for "
+                     "other designs fitted to the FEM curve's l(r_c))",
+        "cup.l1_mm": "eq (5)'s strip width at r1 in mm (with --l0-mm)"})
 
 
-def cup_laws(args: argparse.Namespace, coupled: bool = False) -> str:
+def cup_laws(args: argparse.Namespace, coupled: bool = False, fem: bool = False) -> str:
     """Where r(h), V(h), l(h) come from for the --route and --cup-laws given
     (`validation.bridge.lifetimes.route_laws`: the route's default, or --cup-laws checked against it).
-    `coupled`: the command runs the coupled route itself (else it is refused here)."""
+    `coupled`, `fem`: the command runs that route itself (else it is refused here)."""
     from validation.bridge.lifetimes import route_laws
 
     if args.route == "coupled" and not coupled:
         raise ValueError("--route: coupled is a route of `cupcheck lifetime` (with --suction-table)")
-    if args.route == "fem":
-        raise ValueError("--route: fem is a route of `cupcheck lifetime`")
+    if args.route == "fem" and not fem:
+        raise ValueError("--route: fem is a route of `cupcheck lifetime` and `cupcheck example`")
     return route_laws(args.route, args.cup_laws)
 
 
 #: `fem.interface.CONTACT_LAWS`, spelled out so that building the parser imports no fem (a test pins them equal)
-CONTACT_CHOICES = ("frictionless", "sticking", "coulomb")
+CONTACT_CHOICES = field_of("contact.law").choices
 
 
 def add_contact_arguments(group: argparse._ArgumentGroup, default: str) -> None:
     """--contact and --friction (None when not given: the design file's [contact] table, else
     frictionless); `default` says why frictionless is the default for this command."""
-    group.add_argument("--contact", choices=CONTACT_CHOICES, default=None,
-                       help="contact with the plane: frictionless, sticking (a touching point stops "
-                            "sliding), or coulomb (stick while |t| <= mu p, slide otherwise; give "
-                            "--friction) (default: the --geometry file's [contact] law, else "
-                            f"frictionless: {default})")
-    group.add_argument("--friction", type=float, default=None, metavar="MU",
-                       help="Coulomb's friction coefficient mu, in [0, 100] (with --contact coulomb, "
-                            "or alone to change the mu of a coulomb design file)")
+    add_flags(group, ("contact.law", "contact.friction"), helps={
+        "contact.law": "contact with the plane: frictionless, sticking (a touching point stops "
+                       "sliding), or coulomb (stick while |t| <= mu p, slide otherwise; give "
+                       "--friction) (default: the --geometry file's [contact] law, else "
+                       f"frictionless: {default})",
+        "contact.friction": "Coulomb's friction coefficient mu, in [0, 100] (with --contact coulomb, "
+                            "or alone to change the mu of a coulomb design file)"},
+        **{"--friction": {"metavar": "MU"}})
 
 
 def contact_choice(args: argparse.Namespace, design: Design | None = None) -> ContactChoice:

@@ -18,7 +18,13 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
      built here and cached in --cache-dir, or read from --suction-table): F1, V and the profile of
      every state from the FEM, replacing eqs (3)-(7) and beta (`reduced.coupled`). Building the
      table takes ~3 min (coarse) to ~8 min (medium) once per design and law.
+   - fem: the cup's whole life in the FEM (`validation.bridge.fem_route`): pressed to r_start (or
+     --press-u-mm, --press-force-N) with the gas escaping, sealed, held at F1 along its equilibrium
+     branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse).
    Another design (--geometry FILE) runs the same chain on its own geometry (`validation.bridge.design`).
+   A curve of `cupcheck stiffness` (--stiffness CURVE.csv) replaces step 1: its design, contact law,
+   mesh level and material are the example's; a --cup, --geometry, --contact, --friction or
+   --fidelity that contradicts the curve is refused.
 
 Writes to DIR, atomically:
 
@@ -28,6 +34,8 @@ Writes to DIR, atomically:
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
+  trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N, p_b, u, plate force, V, r_c,
+                          seal radius, r_out, leak rate)
   manifest.json           the files and the study (`validation.bridge.study.Study`) they were computed for
 """
 
@@ -36,12 +44,14 @@ from __future__ import annotations
 import argparse
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from validation.bridge.cache import user_cache_dir
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
                                       contact_choice, cup_laws, load_cup_design)
+from validation.study_schema import add_flags, check_route, field_of, parse, values_from_args
 
 if TYPE_CHECKING:
     from fem.interface import ContactChoice
@@ -51,20 +61,28 @@ NAME = "example"
 HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.89 (CSV and PNG)"
 
 FORCES_N = tuple(float(f) for f in range(5, 85, 5))
+#: the study's fields `example` spells as flags (`validation.study_schema`; contact: `contact_choice`)
+KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "cup.l0_mm", "cup.l1_mm", "stiffness.route",
+        "loads.r_start_mm", "stiffness.fidelity", "surface.preset", "surface.uc_table", "loads.press_u_mm",
+        "loads.press_force_N", "stiffness.du_mm")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (written atomically)")
-    add_cup_arguments(p, "the FEM runs on it and the lifetimes use it")
+    g = add_cup_arguments(p, "the FEM runs on it and the lifetimes use it")
+    g.add_argument("--stiffness", default=None, metavar="CURVE.csv",
+                   help="a stiffness curve of `cupcheck stiffness` (with its .json sidecar) instead of the "
+                        "FEM run: its design, contact law, mesh level and material are used; an option "
+                        "that contradicts them is refused")
     add_cup_law_arguments(p, default_route="profile")
     add_contact_arguments(p.add_argument_group("FEM contact"),
                           "as in the paper: its F0 was measured on soap-lubricated glass and its "
                           "lifetimes on soap-cleaned surfaces, Sec. 5.3-5.5; sticking is Appendix A's "
                           "no-slip bound, whose contact-pressure profile is singular at the stick "
                           "edges and not mesh-converged")
-    p.add_argument("--fidelity", default=None, choices=("coarse", "medium", "fine"),
-                   help="FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
-                        "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)")
+    add_flags(p, ("stiffness.fidelity",), helps={
+        "stiffness.fidelity": "FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
+                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)"})
     c = p.add_argument_group("coupled route")
     c.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
                    help="the design's table from `cupcheck suction` (default: built at --fidelity "
@@ -73,23 +91,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="where built suction tables are kept (default: %(default)s, the user's cache; "
                         "$CUPCHECK_CACHE_DIR moves it)")
     c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
-    src = p.add_mutually_exclusive_group()
-    src.add_argument("--surface", default=None, metavar="NAME",
-                     help="calibrated surface preset for u_c(p/E) (default: pmma-1.89)")
-    src.add_argument("--uc-table", default=None, metavar="FILE.csv",
-                     help="critical gap table instead, columns p_over_E,u_c_m (u_c in m)")
+    add_flags(p.add_argument_group("fem route"), ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"))
+    add_flags(p.add_mutually_exclusive_group(), ("surface.preset", "surface.uc_table"), helps={
+        "surface.preset": "calibrated surface preset for u_c(p/E) (default: pmma-1.89)",
+        "surface.uc_table": "critical gap table instead, columns p_over_E,u_c_m (u_c in m)"},
+        **{"--uc-table": {"metavar": "FILE.csv"}})
 
 
-def _inputs(args: argparse.Namespace):
+def _inputs(args: argparse.Namespace, geometry=None):
     """Every check before the solve: (the FEM geometry, its contact law (`contact_choice`), the
-    u_c table's label)."""
+    u_c table's label); `geometry`: the design of a --stiffness curve (its law is checked there)."""
     import os
 
     from validation.guards import check_design, check_uc_table
 
-    design = load_cup_design(args)
-    contact = contact_choice(args, design)
-    geometry = design.geometry
+    contact = None
+    if geometry is None:
+        design = load_cup_design(args)
+        contact = contact_choice(args, design)
+        geometry = design.geometry
     check_design(geometry.describe(), args.allow_unusual_design, source=geometry.name)
     if args.uc_table is not None:
         if not os.path.isfile(args.uc_table):
@@ -110,13 +130,27 @@ def write_table(results, path: Path, cup: str, study: Study) -> None:
 
     route = study.route
     s = [r.summary() for r in results]
-    own = ("u_final_mm",) if route == "coupled" else ("ballistic_share", "r_final_mm")
+    own = {"coupled": ("u_final_mm",), "fem": ("u_final_mm", "seal_r_final_mm")}.get(
+        route, ("ballistic_share", "r_final_mm"))
+    largest = {"largest_force_N": results.largest_force_N} if route == "fem" else {}
     record = {k: v for k, v in study.record().items() if k not in ("design", "route")}
     write_csv(path, {"cup": cup, "route": route, **record, "force_N": [r.force_N for r in results],
                      "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in s],
-                     "reason": [r.reason for r in results],
-                     **{key: [_blank(x[key]) for x in s] for key in (*own, "p_b_final_Pa")}},
+                     "reason": [r.reason for r in results], **largest,
+                     **{key: [_blank(x.get(key)) for x in s] for key in (*own, "p_b_final_Pa")}},
               stage="example lifetimes")
+
+
+def _write_trajectories(results, tmp: Path, cup: str) -> None:
+    """The fem route's FEM states of each force, one CSV per force (none where the cup let go at once)."""
+    from validation.output import write_table as write_csv
+
+    for r in results:
+        columns = r.trajectory_columns()
+        if columns:
+            write_csv(tmp / f"trajectory_F1_{r.force_N:g}N.csv",
+                      {"cup": cup, "t_s": columns["t_s"], **{k: v for k, v in columns.items() if k != "t_s"}},
+                      stage=f"example trajectory at F1 = {r.force_N:g} N")
 
 
 def _blank(value):
@@ -125,22 +159,87 @@ def _blank(value):
 
 
 def study_of(args: argparse.Namespace, contact: ContactChoice) -> Study:
-    """The main job as a `validation.bridge.study.Study`: the design of --cup/--geometry (E = 4 MPa,
-    nu = 0.49, `contact`) at --fidelity, through --route on the surface, at F1 = 5, 10, ..., 80 N."""
-    from validation.bridge.pipeline import DEFAULT_SURFACE
-    from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
+    """The main job as a `validation.bridge.study.Study`: the study's fields as the flags give them
+    (`KEYS`; E = 4 MPa, nu = 0.49, `contact`), at F1 = 5, 10, ..., 80 N."""
+    from validation.study_schema import study_from_values
 
     law = contact.contact
-    return Study(design=CupDesign(preset=args.cup or "A", file=None if args.geometry is None else str(args.geometry),
-                                  l0_mm=args.l0_mm, l1_mm=args.l1_mm),
-                 material=Material(E_MPa=4.0, nu=0.49),
-                 contact=Contact(law=law.law, friction=law.friction if law.law == "coulomb" else None,
-                                 source=contact.source),
-                 fidelity=args.fidelity, stiffness="fem",
-                 surface=Surface(preset=None if args.uc_table else (args.surface or DEFAULT_SURFACE),
-                                 uc_table=args.uc_table),
-                 route=args.route, cup_laws=args.cup_laws, loads=Loads(forces_N=FORCES_N, r_start_mm=args.r_start_mm),
-                 refine=4, suction_table=args.suction_table)
+    values = {k: v for k, v in values_from_args(args, KEYS).items() if v is not None}
+    if args.geometry is not None:
+        values["cup.geometry"] = str(args.geometry)
+    if args.uc_table is not None:                       # the table instead of the default preset
+        values["surface.preset"] = None
+    values.update({"contact.law": law.law, "contact.friction": law.friction if law.law == "coulomb" else None,
+                   "loads.F1_N": FORCES_N})
+    return study_from_values(values, contact_source=contact.source, stiffness="fem", cup_laws=args.cup_laws,
+                             refine=4, suction_table=args.suction_table)
+
+
+def check_fields(args: argparse.Namespace) -> None:
+    """The study's numbers as the flags give them (`validation.study_schema.parse`: sign and shared
+    guard, named by flag) and the rules between the route and the other fields (`check_route`)."""
+    values = values_from_args(args, KEYS)
+    defaults = {k: field_of(k).default_in("cli") for k in KEYS}
+    for key, value in values.items():
+        if field_of(key).type == "number" and value is not None:
+            parse(field_of(key), value, "cli")
+    given = {k for k, v in values.items() if v is not None and v != defaults[k]}
+    check_route(values, given, "cli")
+
+
+def _curve_inputs(args: argparse.Namespace) -> tuple[Any, ContactChoice, dict[str, Any]]:
+    """(the FEM geometry, the contact law, the Study's fields) of a --stiffness curve: the design,
+    law, mesh level and material its sidecar records. An option that contradicts them, or a curve
+    that names no FEM design or law, is refused (ValueError naming the option)."""
+    from fem.design_file import geometry_from_mapping
+    from fem.interface import ContactChoice, ContactLaw
+    from reduced.stiffness_curve import StiffnessCurve
+    from validation.bridge.design import preset_design, resolve_cup, shape_of
+    from validation.bridge.study import CupDesign, Material
+
+    path = Path(args.stiffness)
+    if not path.is_file():
+        raise ValueError(f"--stiffness: no such file '{path}'")
+    curve = StiffnessCurve.from_csv(path)
+    shape, law, prov = curve.design, curve.contact, curve.provenance
+    if shape is None or law is None or not isinstance(prov.get("material"), dict):
+        raise ValueError(f"--stiffness: '{path.name}' records no FEM design, contact law or material (a measured "
+                         f"or Appendix A curve); give --cup or --geometry and the example computes the FEM curve")
+    label = f"the stiffness curve '{path.name}'"
+    resolve_cup(curve, cup=args.cup, geometry_file=args.geometry, curve_label=label, laws="curve")
+    was = law.law + (f" mu = {law.friction:g}" if law.law == "coulomb" else "")
+    if args.contact is not None and args.contact != law.law:
+        raise ValueError(f"--contact: {label} was computed with {was} contact; drop --contact {args.contact} "
+                         f"(the curve's law is used) or derive a {args.contact} curve")
+    if args.friction is not None and (law.law != "coulomb" or args.friction != law.friction):
+        raise ValueError(f"--friction: {label} was computed with {was} contact; drop --friction")
+    fidelity = prov.get("fidelity")
+    if args.fidelity is not None and fidelity is not None and args.fidelity != fidelity:
+        raise ValueError(f"--fidelity: {label} was computed at the {fidelity} level; drop --fidelity "
+                         f"{args.fidelity} or derive a curve at that level")
+    args.fidelity = args.fidelity or fidelity
+    preset = next((name for name in ("A", "B") if shape.same_cup(preset_design(name))), None)
+    record = prov["geometry"]                           # the wall as written, its thickness profile included
+    data = {k: record[k] for k in ("name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention") if k in record}
+    thickness = record.get("thickness_profile", {})
+    if thickness.get("kind") in ("linear", "table"):
+        data["thickness"] = {"r_mm": thickness["r_mm"], "d_mm": thickness["d_mm"]}
+    geometry = geometry_from_mapping(data, source=path.name)
+    if not shape_of(geometry).same_cup(shape):
+        raise ValueError(f"--stiffness: {label} records a wall this example cannot rebuild; give --geometry")
+    contact = ContactChoice(ContactLaw(law.law, law.friction),
+                            f"stiffness curve {path.name}" + (f", from its {law.source}" if law.source else ""))
+    material = Material(E_MPa=prov["material"]["E_Pa"] / 1e6, nu=prov["material"]["nu"])
+    design = CupDesign(preset=preset) if preset else CupDesign(preset=args.cup or "A", geometry=geometry)
+    return geometry, contact, {"design": replace(design, l0_mm=args.l0_mm, l1_mm=args.l1_mm),
+                               "material": material, "stiffness_file": str(path)}
+
+
+def _steps(response, curve) -> Any:
+    """The FEM path's load steps: the run's, or those a given curve's sidecar records."""
+    if response is not None:
+        return response.stats.steps
+    return curve.provenance.get("solver", {}).get("steps", len(curve.u_m) - 1)
 
 
 def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
@@ -192,8 +291,6 @@ def plot(series: dict, curve, cup, path: Path, title: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from dataclasses import replace
-
     from validation.bridge import handoff
     from validation.output import atomic_directory, terminal_progress
     from validation.bridge.products import Products
@@ -203,11 +300,21 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     from validation.output import check_outputs, command_inputs
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
+    given = curve_study = None
+    if args.stiffness is not None:
+        given = _curve_inputs(args)                    # the curve's design, law, level, material
+        geometry, contact, curve_study = given
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
-    laws = cup_laws(args, coupled=True)
-    geometry, contact, uc_label = _inputs(args)
+    laws = cup_laws(args, coupled=True, fem=True)
+    check_fields(args)
+    if given is None:
+        geometry, contact, uc_label = _inputs(args)
+    else:
+        uc_label = _inputs(args, geometry)[2]
     _check_suction_table(args, geometry, contact)
     study = study_of(args, contact)
+    if curve_study is not None:
+        study = replace(study, **curve_study)
     products = Products(study, suction_cache_dir=None if args.no_cache else args.cache_dir,
                         fem_progress=terminal_progress("FEM"))
     from fem.solver import ConvergenceError
@@ -215,12 +322,16 @@ def run(args: argparse.Namespace) -> int:
 
     with atomic_directory(args.out) as tmp:
         try:
-            response, curve = products.fem_path(None), products.curve()
+            response = None if args.stiffness else products.fem_path(None)
+            curve = products.curve()
         except ConvergenceError as exc:
             raise solver_failure(exc, Path(f"{Path(args.out)}.failure.json")) from None
         choice = products.cup_choice()
-        curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
-        handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
+        if response is None:                           # the given curve, with its own sidecar
+            curve.to_csv(tmp / "stiffness_fem.csv")
+        else:
+            curve.to_csv(tmp / "stiffness_fem.csv", sidecar=False)
+            handoff.write_sidecar(handoff.sidecar(response, curve.provenance), tmp / "stiffness_fem.json")
         if args.route == "coupled":
             products.suction_table().to_json(tmp / "suction_table.json")
         results = products.lifetimes()
@@ -232,6 +343,8 @@ def run(args: argparse.Namespace) -> int:
                 paper, inherit=("uc_table", "curve", "cup")).lifetimes()
         series["Appendix A-fed, paper route (d0 2 mm)"] = products.appendix_a(refine=1).lifetimes()
         write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, study)
+        if args.route == "fem":
+            _write_trajectories(results, tmp, choice.cup.name)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
              f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
         _write_manifest(tmp, study)
@@ -242,10 +355,12 @@ def run(args: argparse.Namespace) -> int:
                                                                  if patch else " (raw: the u_c table has no patch length)"),
                "coupled": "the contact-pressure profile of each (u, dp) state of the FEM suction table "
                           f"(largest holdable force {holdable:.4g} N)" if args.route == "coupled" else "",
+               "fem": "the contact-pressure profile of each FEM state along the cup's equilibrium branch "
+                      f"(largest holdable force {holdable:.4g} N)",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
                                                             if laws == "cone" else "")}[_seal(args.route)]
     print(f"{choice.label}: FEM {contact.contact.label()} stiffness (from the "
-          f"{contact.source}; {args.fidelity}, {response.stats.steps} steps), "
+          f"{contact.source}; {args.fidelity}, {_steps(response, curve)} steps), "
           f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
           f"{_rv_source(args.route, laws)}; {args.route} route: the leak "
@@ -255,7 +370,7 @@ def run(args: argparse.Namespace) -> int:
                                          for n in names) + "  end")
     for i, r in enumerate(results):
         print(f"  {r.force_N:7g} " + " ".join(f"{series[n][i].lifetime_s:24.4g}" for n in names) + f"  {r.reason}")
-    extra = ", suction_table.json" if args.route == "coupled" else ""
+    extra = {"coupled": ", suction_table.json", "fem": ", trajectory_F1_*.csv"}.get(args.route, "")
     print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
           f"{extra} in {wall:.1f} s")
     return 0
@@ -274,10 +389,12 @@ def _write_manifest(tmp: Path, study: Study) -> None:
 
 def _seal(route: str) -> str:
     """What the leak crosses on `route` (the key of the printed description)."""
-    return {"paper": "strip", "profile": "profile", "coupled": "coupled"}[route]
+    return {"paper": "strip", "profile": "profile", "coupled": "coupled", "fem": "fem"}[route]
 
 
 def _rv_source(route: str, laws: str) -> str:
     if route == "coupled":
         return "FEM suction table"
+    if route == "fem":
+        return "FEM states"
     return "FEM curve" if laws == "curve" else "cone laws (3)-(4)"

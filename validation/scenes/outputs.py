@@ -242,14 +242,14 @@ def _file(name: str, kind: str, path: Path) -> dict[str, str]:
 def _lifetime_table(results, products: Products, path: Path) -> Path:
     from validation.output import write_table
 
+    from validation.bridge.lifetimes import end_state_columns
+
     s = products.study
     return write_table(path, {
         "route": s.route, "stiffness": s.stiffness, **{k: v for k, v in s.record().items() if k != "route"},
         "force_N": [r.force_N for r in results],
         "lifetime_s": [r.lifetime_s for r in results], "reason": [r.reason for r in results],
-        "ballistic_share": [r.details["ballistic_share"] for r in results],
-        "r_final_mm": [float(r.trajectory["r_mm"][-1]) for r in results],
-        "p_b_final_Pa": [float(r.trajectory["p_b_Pa"][-1]) for r in results]})
+        **end_state_columns(results)})
 
 
 def _sweep_table(products: Products, path: Path) -> Path:
@@ -259,9 +259,15 @@ def _sweep_table(products: Products, path: Path) -> Path:
     rows = [(value, p.study.record(), r) for value, p in products.variants() for r in p.lifetimes()]
     record = {k: [c[k] for _, c, _ in rows] for k in products.study.record()}
     rows = [(v, r) for v, _, r in rows]
+    if products.study.route == "fem":      # the largest holdable force of each value's cup
+        from validation.bridge.lifetimes import end_state_columns
+        own = {k: [x for _, p in products.variants() for x in end_state_columns(p.lifetimes())[k]]
+               for k in ("largest_force_N", "u_final_mm", "p_b_final_Pa", "seal_r_final_mm")}
+    else:
+        own = {"ballistic_share": [r.details["ballistic_share"] for _, r in rows]}
     return write_table(path, {key: [v for v, _ in rows], **record, "force_N": [r.force_N for _, r in rows],
                               "lifetime_s": [r.lifetime_s for _, r in rows], "reason": [r.reason for _, r in rows],
-                              "ballistic_share": [r.details["ballistic_share"] for _, r in rows]}, stage="scene sweep")
+                              **own}, stage="scene sweep")
 
 
 def _trajectory(result, path: Path) -> Path:

@@ -4,8 +4,10 @@
     [sweep]                                                               one parameter varied
     [[outputs]]     kind = curve | lifetimes | trajectories | figure | render | footprint | squeeze
 
-Every key, its default and allowed values live once, in the tables below (`_TABLES`, `_CHOICES`,
-`OUTPUT_KEYS`) with their meaning (`MEANING`); docs/scenes.md is generated from them
+The study's keys (cup, material, contact, surface, fluid, loads, stiffness) are the fields of
+`validation.study_schema.FIELDS`, defined once for scenes, sweeps and the command line; `_TABLES`,
+`_CHOICES` and `MEANING` are derived from them, beside the scene's own `OUTPUT_KEYS` and sweep
+keys; docs/scenes.md is generated from them
 (``python scripts/keys_docs.py``). Every table and key is optional but `outputs`. Unknown keys,
 wrong types, implausible values (the shared guards of `validation.guards`, named by key path) and
 contradictions are ValueErrors naming the key path (``outputs[2].kind: expected one of ...``):
@@ -24,8 +26,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from validation.bridge.pipeline import DEFAULT_SURFACE
-from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface, Sweep
+from validation.bridge.study import Study, Sweep
+from validation.study_schema import FIELDS as STUDY_FIELDS
+from validation.study_schema import check_route, check_surface_preset, field_of, parse, study_from_values
 
 __all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES", "key_rows"]
 
@@ -37,44 +40,18 @@ MAX_FRAMES = 60
 FIGURES = ("lifetime_vs_force", "uc_vs_pressure", "F0_vs_u", "lifetime_vs_parameter", "r_pb_vs_time",
            "p_Ndot_vs_time")
 SWEEP_KEYS = ("loads.kappa", "loads.r_start_mm", "surface.preset", "cup.preset", "contact.friction")
-_TABLES: dict[str, dict[str, Any]] = {
-    "cup": {"preset": "A", "geometry": None, "allow_unusual_design": False},
-    "material": {"E_MPa": 4.0, "nu": 0.49, "relaxation": "none"},
-    "contact": {"law": "frictionless", "friction": None},
-    "surface": {"preset": DEFAULT_SURFACE, "uc_table": None},
-    "fluid": {"kind": "air"},
-    "loads": {"F1_N": [5.0, 10.0, 20.0, 40.0, 80.0], "r_start_mm": None, "kappa": 1.0},
-    "stiffness": {"source": "fem", "route": "paper", "fidelity": "coarse"},
-}
-_CHOICES = {("cup", "preset"): ("A", "B"), ("material", "relaxation"): ("none", "default"),
-            ("contact", "law"): ("frictionless", "sticking", "coulomb"), ("fluid", "kind"): ("air", "water"),
-            ("stiffness", "source"): ("fem", "appendix-a"), ("stiffness", "route"): ("paper", "profile"),
-            ("stiffness", "fidelity"): ("coarse", "medium", "fine")}
+#: the study's tables and keys with their defaults, as `validation.study_schema.FIELDS` defines them
+_TABLES: dict[str, dict[str, Any]] = {}
+for _f in STUDY_FIELDS:
+    if _f.scene:
+        _TABLES.setdefault(_f.key.split(".")[0], {})[_f.key.split(".")[1]] = _f.default
+_CHOICES = {tuple(f.key.split(".")): f.choices for f in STUDY_FIELDS if f.scene and f.type == "choice"}
 
 
 #: what each key means (docs/scenes.md is generated from this, `_TABLES` and `_CHOICES`:
 #: ``python scripts/keys_docs.py``)
 MEANING: dict[str, str] = {
-    "cup.preset": "Table 1 cup the design starts from (A: alpha 33 deg; B: 21 deg)",
-    "cup.geometry": "a design file (.toml or .json, the keys of `cupcheck stiffness --geometry`), relative to "
-                    "the scene file; its [contact] table sets the law unless contact.law is given",
-    "cup.allow_unusual_design": "true: a cone angle outside 5..80 deg or a wall more than 400x longer than thick "
-                                "is run, not refused",
-    "material.E_MPa": "Young's modulus [MPa] of the wall (and of p/E)",
-    "material.nu": "Poisson's ratio, in [0, 0.5)",
-    "material.relaxation": "none, or the default power-law relaxation modulus (4.4 MPa at 1 s, 1.8 MPa at 3e4 s)",
-    "contact.law": "the FEM's contact with the plane (default: the design file's [contact] law, else frictionless)",
-    "contact.friction": "Coulomb's mu, in [0, 100]: with law = \"coulomb\" only, which needs it",
-    "surface.preset": "calibrated rough surface for u_c(p/E) (`cupcheck uc --list-surfaces`)",
-    "surface.uc_table": "a u_c table CSV (columns p_over_E,u_c_m; u_c in m) instead of the preset",
-    "fluid.kind": "what fills the cavity and leaks in",
-    "loads.F1_N": "pull forces F1 [N]: one lifetime (and trajectory) per force",
-    "loads.r_start_mm": "start radius of the contact [mm] (default: Table 1's 12 mm for A and B, mid-wall otherwise)",
-    "loads.kappa": "stiffness factor: F0 replaced by kappa F0 (the paper's Fig. 1stiffnessFactor)",
-    "stiffness.source": "F0(h) from the FEM or from Appendix A's formula",
-    "stiffness.route": "how the FEM reaches the lifetime (README, Routes): eq (6)'s strip on the cone, or the "
-                       "FEM's contact-pressure profile (needs source = \"fem\")",
-    "stiffness.fidelity": "FEM mesh level",
+    **{f.key: f.meaning for f in STUDY_FIELDS if f.scene},
     "sweep.key": "the one parameter varied (contact.friction with law = \"coulomb\")",
     "sweep.values": "its values, each once: one lifetime table row per value and force",
     "outputs[].kind": "what to write: a stiffness curve, lifetimes, trajectories, a figure, or a 3D view "
@@ -94,13 +71,16 @@ OUTPUT_KEYS: dict[str, tuple[Any, str]] = {
 }
 
 
-def key_rows() -> list[tuple[str, Any, str, str]]:
-    """(key path, default, allowed values, meaning) of every scene key, from the parser's own tables."""
+def key_rows() -> list[tuple[str, Any, str, str, str]]:
+    """(key path, default, allowed values, meaning, the same field's sweep key and flag) of every
+    scene key, from the parser's own tables."""
     rows = []
     for table, keys in _TABLES.items():
         for key, default in keys.items():
             allowed = ", ".join(_CHOICES[(table, key)]) if (table, key) in _CHOICES else ""
-            rows.append((f"{table}.{key}", default, allowed, MEANING[f"{table}.{key}"]))
+            f = field_of(f"{table}.{key}")
+            spelled = ", ".join(f"`{n}`" for n in (f.sweep and f"base.{f.sweep}", f.flag) if n)
+            rows.append((f"{table}.{key}", default, allowed, MEANING[f"{table}.{key}"], spelled))
     rows.append(("sweep.key", None, ", ".join(SWEEP_KEYS), MEANING["sweep.key"]))
     rows.append(("sweep.values", None, "a non-empty list", MEANING["sweep.values"]))
     for key, (default, allowed) in OUTPUT_KEYS.items():
@@ -120,19 +100,9 @@ class Scene:
 
     def study(self) -> Study:
         """The scene as a `validation.bridge.study.Study` (its sweep, if any, included)."""
-        t = self.tables
-        return Study(design=CupDesign(preset=t["cup"]["preset"], file=t["cup"]["geometry"]),
-                     material=Material(E_MPa=t["material"]["E_MPa"], nu=t["material"]["nu"]),
-                     contact=Contact(law=t["contact"]["law"], friction=t["contact"]["friction"],
-                                     source=self.contact_source),
-                     fidelity=t["stiffness"]["fidelity"], stiffness=t["stiffness"]["source"],
-                     surface=Surface(preset=t["surface"]["preset"], uc_table=t["surface"]["uc_table"]),
-                     route=t["stiffness"]["route"],
-                     loads=Loads(forces_N=tuple(t["loads"]["F1_N"]), kappa=t["loads"]["kappa"],
-                                 r_start_mm=t["loads"]["r_start_mm"], relaxation=t["material"]["relaxation"],
-                                 fluid=t["fluid"]["kind"]),
-                     outputs=self.outputs,
-                     sweep=None if self.sweep is None else Sweep(self.sweep["key"], tuple(self.sweep["values"])))
+        return study_from_values(_values(self.tables), contact_source=self.contact_source, outputs=self.outputs,
+                                 sweep=None if self.sweep is None else Sweep(self.sweep["key"],
+                                                                             tuple(self.sweep["values"])))
 
     def __getitem__(self, table: str) -> dict[str, Any]:
         return self.tables[table]
@@ -171,6 +141,8 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
     _guards(tables, data.get("sweep"))
     contact_source = _design_contact(tables, data.get("contact", {}), source)
     _cross_checks(tables, data.get("sweep"))
+    sweep_key = data["sweep"].get("key") if isinstance(data.get("sweep"), Mapping) else None
+    check_route(_values(tables), {f"{t}.{k}" for t in _TABLES for k in data.get(t, {})}, "scene", sweep_key)
     outputs = data.get("outputs")
     if not isinstance(outputs, list) or not outputs:
         raise ValueError("outputs: a scene needs a non-empty list of [[outputs]]")
@@ -185,6 +157,11 @@ def scene_from_mapping(data: Mapping[str, Any], base: str | Path = ".", source: 
     if sweep is not None and any(o["kind"] in ("curve", "trajectories", *STATE_KINDS)
                                  or o["figure"] in ("r_pb_vs_time", "p_Ndot_vs_time") for o in parsed):
         raise ValueError("sweep: a swept scene writes lifetimes and figures; drop the curve, trajectories and 3D outputs")
+    if tables["stiffness"]["route"] == "fem":
+        for i, o in enumerate(parsed):
+            if o["figure"] in ("r_pb_vs_time", "p_Ndot_vs_time"):
+                raise ValueError(f"outputs[{i}].figure: {o['figure']} draws the cone's r(t) or the strip's p(t), "
+                                 f"which the fem route has not; write kind = \"trajectories\" (its FEM states)")
     return Scene(tables=tables, outputs=parsed, source=source, sweep=sweep, contact_source=contact_source)
 
 
@@ -231,17 +208,13 @@ def _table(name: str, given: Any, defaults: dict[str, Any]) -> dict[str, Any]:
         raise ValueError(f"{name}.{unknown[0]}: unknown key; allowed: {', '.join(defaults)}")
     table = {**defaults, **given}
     for key, value in table.items():
-        where = f"{name}.{key}"
-        if (name, key) in _CHOICES and value not in _CHOICES[(name, key)]:
-            raise ValueError(f"{where}: expected one of {', '.join(_CHOICES[(name, key)])}, got {value!r}")
-        if key in ("E_MPa", "nu", "kappa", "r_start_mm") and value is not None:
-            table[key] = _number(value, where, positive=key != "nu")
-        if key == "F1_N":
-            values = value if isinstance(value, list) else [value]
-            if not values:
-                raise ValueError(f"{where}: expected at least one pull force")
-            table[key] = [_number(v, f"{where}[{i}]", positive=True) for i, v in enumerate(values)]
+        table[key] = parse(field_of(f"{name}.{key}"), value, "scene")
     return table
+
+
+def _values(tables: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
+    """{key path: value} of the study's tables."""
+    return {f"{t}.{k}": v for t, keys in tables.items() for k, v in keys.items()}
 
 
 def _paths(tables: dict[str, dict[str, Any]], base: Path) -> None:
@@ -262,11 +235,7 @@ def _guards(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
     the modulus, the pull forces, the design file's lengths and wall, the u_c table's gaps."""
     from validation import guards
 
-    guards.check_modulus(tables["material"]["E_MPa"], "material.E_MPa")
-    guards.check_forces(tables["loads"]["F1_N"], "loads.F1_N")
     cup = tables["cup"]
-    if not isinstance(cup["allow_unusual_design"], bool):
-        raise ValueError(f"cup.allow_unusual_design: expected true or false, got {cup['allow_unusual_design']!r}")
     if cup["geometry"]:
         design = guards.load_design(cup["geometry"], cup=cup["preset"], field="cup.geometry",
                                     allow_unusual=cup["allow_unusual_design"],
@@ -281,23 +250,6 @@ def _guards(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
             guards.check_start_radius(value, radii, f"sweep.values[{j}]")
     if tables["surface"]["uc_table"]:
         guards.check_uc_file(tables["surface"]["uc_table"], "surface.uc_table")
-    else:
-        check_surface_preset(tables["surface"]["preset"], "surface.preset")
-
-
-def check_surface_preset(name: Any, where: str) -> None:
-    """A calibrated surface preset's name (read from the presets' data file: importing the
-    roughness model would cost a scene that needs none of it 0.5 s)."""
-    import json
-
-    data = Path(__file__).resolve().parents[2] / "reduced" / "roughness" / "data" / "presets.json"
-    if data.is_file():
-        known = {d["name"] for d in json.loads(data.read_text(encoding="utf-8"))}
-    else:                                  # an unusual install: ask the package
-        from reduced.roughness.surfaces import load_presets
-        known = set(load_presets())
-    if name not in known:
-        raise ValueError(f"{where}: unknown surface preset {name!r}; choose one of {', '.join(sorted(known))}")
 
 
 def _friction(value: Any, where: str) -> float:
@@ -338,8 +290,6 @@ def _cross_checks(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
     if tables["cup"]["geometry"] is not None and tables["stiffness"]["source"] != "fem":
         raise ValueError("stiffness.source: a design file (cup.geometry) needs source = \"fem\"; Appendix A "
                          "is for the Table 1 presets")
-    if tables["stiffness"]["route"] == "profile" and tables["stiffness"]["source"] != "fem":
-        raise ValueError("stiffness.route: 'profile' needs source = \"fem\" (the FEM's contact-pressure profiles)")
     if tables["fluid"]["kind"] == "water" and tables["material"]["relaxation"] != "none":
         raise ValueError("material.relaxation: the water-filled cavity is implemented without relaxation only")
     if not 0.0 <= tables["material"]["nu"] < 0.5:

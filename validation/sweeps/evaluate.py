@@ -9,9 +9,9 @@ cause, so one bad design never stops a sweep. Quantities (units in the names):
   Appendix A's secant for the design's own alpha, r0, r1, E and root thickness d0 (d1 = 0);
 * ``r_c_start_mm``, ``l_start_mm``: the FEM's inner contact radius and strip width at the start
   state (eq 3's height at r_start); ``largest_force_N``: the largest F1 the fresh cup holds;
-* ``lifetime_s``, ``reason`` per pull force (the paper's route, eqs 3-7 with the cone laws and eq
-  (5)'s strip widths l0, l1 as given, by default Table 1's for the base cup, the only measured
-  ones; no relaxation, u_c(p/E) of the surface);
+* ``lifetime_s``, ``reason`` per pull force (by default the paper's route, eqs 3-7 with the cone
+  laws and eq (5)'s strip widths l0, l1 as given, by default Table 1's for the base cup, the only
+  measured ones; or base.route's; no relaxation, u_c(p/E) of the surface);
 * ``volume_mm3``: the wall's material volume (a cost for the Pareto front);
 * cost: ``wall_time_s``, ``dofs``, ``newton_iterations``.
 """
@@ -57,23 +57,23 @@ def material_volume_mm3(geometry) -> float:
 
 
 def study_of(design: dict[str, Any], geometry) -> Study:
-    """The `validation.bridge.study.Study` of one design of a sweep: its geometry, material, contact law
-    and mesh level, the paper's route with the cone laws and eq (5)'s l0, l1 (Table 1's unless
-    given) on its surface, at its pull forces."""
+    """The `validation.bridge.study.Study` of one design of a sweep: its base keys as the study's
+    fields (`validation.study_schema`), its geometry, its route (the paper's with the cone laws
+    and eq (5)'s l0, l1, Table 1's unless given; or profile, fem) on its surface, at its pull forces."""
+    from dataclasses import replace
+
     from reduced.cup import CUPS
-    from validation.bridge.study import Contact, CupDesign, Loads, Material, Study, Surface
+    from validation.study_schema import FIELDS, study_from_values
 
     table1 = CUPS[design["cup"]]
-    l0 = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
-    l1 = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
-    coulomb = design["contact"] == "coulomb"
-    return Study(design=CupDesign(preset=design["cup"], geometry=geometry, l0_mm=l0, l1_mm=l1),
-                 material=Material(E_MPa=design["E_MPa"], nu=design["nu"]),
-                 contact=Contact(law=design["contact"], friction=design.get("friction", 0.0) if coulomb else None,
-                                 source="sweep file"),
-                 fidelity=design["fidelity"], stiffness="fem", surface=Surface(preset=design["surface"]),
-                 route="paper", cup_laws="cone",
-                 loads=Loads(forces_N=tuple(design["F1_N"]), r_start_mm=design.get("r_start_mm")), refine=1)
+    values = {f.key: design[f.sweep] for f in FIELDS if f.sweep and f.sweep in design}
+    values["cup.l0_mm"] = design["l0_mm"] if design.get("l0_mm") is not None else table1.l0_m / _MM
+    values["cup.l1_mm"] = design["l1_mm"] if design.get("l1_mm") is not None else table1.l1_m / _MM
+    values["contact.friction"] = design.get("friction", 0.0) if design["contact"] == "coulomb" else None
+    route = design.get("route", "paper")
+    study = study_from_values(values, contact_source="sweep file", stiffness="fem",
+                              cup_laws="cone" if route == "paper" else None, refine=1)
+    return replace(study, design=replace(study.design, geometry=geometry))
 
 
 def evaluate_design(design: dict[str, Any]) -> list[dict[str, Any]]:

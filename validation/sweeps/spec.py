@@ -54,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from validation.bridge.pipeline import DEFAULT_SURFACE
+from validation.study_schema import FIELDS, check_route, parse
 
 __all__ = ["SweepSpec", "load_sweep", "sweep_from_mapping", "NUMERIC_AXES", "design_hash", "MAX_DESIGNS",
            "lock_store", "key_rows"]
@@ -67,37 +67,29 @@ _LENGTHS = {"r0_mm": "r_mm", "r1_mm": "r_mm", "d0_mm": "d_mm", "d1_mm": "d_mm"}
 NUMERIC_AXES = ("alpha_deg", "r0_mm", "r1_mm", "d0_mm", "d1_mm", "E_MPa", "nu", "r_start_mm", "l0_mm", "l1_mm",
                 "friction")
 CATEGORICAL_AXES = ("contact", "surface")
-_BASE_DEFAULTS: dict[str, Any] = {
-    "cup": "A", "alpha_deg": None, "r0_mm": None, "r1_mm": None, "d0_mm": None, "d1_mm": None,
-    "E_MPa": 4.0, "nu": 0.49, "contact": "frictionless", "surface": DEFAULT_SURFACE, "fidelity": "coarse",
-    "r_start_mm": None, "l0_mm": None, "l1_mm": None, "F1_N": [10.0], "F0_at_u_mm": [1.0], "allow_unusual_design": False,
-}
+#: the study's fields a sweep file spells in [base] (`validation.study_schema.FIELDS`), by base key
+_STUDY = {f.sweep: f for f in FIELDS if f.sweep}
 #: optional base keys, absent unless given (a design's hash is that of its given keys)
-_OPTIONAL = ("friction",)
-_CHOICES = {"contact": ("frictionless", "sticking", "coulomb"), "fidelity": ("coarse", "medium", "fine"),
-            "cup": ("A", "B")}
+_OPTIONAL = ("friction", "route")
+#: the sweep's own base keys (the design's geometry, what it reports) and their meaning
+_OWN: dict[str, tuple[Any, str]] = {
+    "alpha_deg": (None, "cone angle [deg] (default: the cup's)"),
+    "r0_mm": (None, "top-plate radius [mm] (default: the cup's)"), "r1_mm": (None, "rim radius [mm] (default: the cup's)"),
+    "d0_mm": (None, "wall thickness at r0 [mm] (a line to d1 at r1; default: the cup's)"),
+    "d1_mm": (None, "wall thickness at r1 [mm] (default: the cup's)"),
+    "F0_at_u_mm": ([1.0], "plate displacements [mm] at which F0 is reported, each once"),
+}
+_BASE_DEFAULTS: dict[str, Any] = {**{k: f.default_in("sweep") for k, f in _STUDY.items() if k not in _OPTIONAL},
+                                  **{k: d for k, (d, _) in _OWN.items()}}
+_CHOICES = {k: f.choices_in("sweep") for k, f in _STUDY.items() if f.type == "choice"}
 _METHODS = ("grid", "lhs", "sobol")
 
 
 #: what each key means (docs/sweeps.md is generated from this and the parser's tables:
 #: ``python scripts/keys_docs.py``)
 MEANING: dict[str, str] = {
-    "base.cup": "Table 1 cup the geometry keys modify",
-    "base.alpha_deg": "cone angle [deg] (default: the cup's)",
-    "base.r0_mm": "top-plate radius [mm] (default: the cup's)", "base.r1_mm": "rim radius [mm] (default: the cup's)",
-    "base.d0_mm": "wall thickness at r0 [mm] (a line to d1 at r1; default: the cup's)",
-    "base.d1_mm": "wall thickness at r1 [mm] (default: the cup's)",
-    "base.E_MPa": "Young's modulus [MPa]", "base.nu": "Poisson's ratio",
-    "base.contact": "the FEM's contact law with the plane",
-    "base.friction": "Coulomb's mu in [0, 100]: with contact = \"coulomb\" only",
-    "base.surface": "calibrated surface preset for u_c(p/E) (`cupcheck uc --list-surfaces`)",
-    "base.fidelity": "FEM mesh level",
-    "base.r_start_mm": "start radius of the contact [mm] (default: Table 1's for A and B, mid-wall otherwise)",
-    "base.l0_mm": "eq (5)'s strip width at r0 [mm] (default: Table 1's for the base cup, as measured for it)",
-    "base.l1_mm": "eq (5)'s strip width at r1 [mm] (default: Table 1's for the base cup)",
-    "base.F1_N": "pull forces [N], each once: one table row per design and force",
-    "base.F0_at_u_mm": "plate displacements [mm] at which F0 is reported, each once",
-    "base.allow_unusual_design": "true: steep or slender walls are run, not failed (`validation.guards`)",
+    **{f"base.{k}": f.meaning for k, f in _STUDY.items()},
+    **{f"base.{k}": meaning for k, (_, meaning) in _OWN.items()},
     "scene": "a scene file whose cup, material, contact, surface, loads and fidelity are the base ([base] "
              "keys then override them)",
     "sampling.method": "grid: every combination of the axes' values; lhs, sobol: n designs in [low, high]",
@@ -230,7 +222,7 @@ def _check_contact_axes(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) 
 
 def _check_surfaces(base: dict[str, Any], axes: tuple[dict[str, Any], ...]) -> None:
     """Every surface a design uses is a calibrated preset (the base's, or a surface axis's values)."""
-    from validation.scenes.schema import check_surface_preset
+    from validation.study_schema import check_surface_preset
 
     given = [("base.surface", base["surface"])]
     for i, axis in enumerate(axes):
@@ -292,6 +284,8 @@ def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
         base["surface"] = sc["surface"]["preset"]
     if sc["loads"]["r_start_mm"] is not None:
         base["r_start_mm"] = sc["loads"]["r_start_mm"]
+    if sc["stiffness"]["route"] != "paper":
+        base["route"] = sc["stiffness"]["route"]
     if sc["cup"]["geometry"]:
         from fem.design_file import load_geometry
         d = load_geometry(sc["cup"]["geometry"], cup=sc["cup"]["preset"]).describe()
@@ -300,6 +294,9 @@ def _scene_base(scene: Any, root: str | Path) -> dict[str, Any]:
     if sc["surface"]["uc_table"] or sc["stiffness"]["source"] != "fem" or sc["fluid"]["kind"] != "air":
         raise ValueError(f"scene: a sweep evaluates FEM designs in air on a preset surface; '{scene}' asks for "
                          f"another stiffness source, fluid or a u_c table")
+    if sc["loads"]["press_u_mm"] is not None or sc["loads"]["press_force_N"] is not None:
+        raise ValueError(f"scene: a sweep presses each design to its r_start; '{scene}' gives loads.press_u_mm "
+                         f"or loads.press_force_N")
     return base
 
 
@@ -315,27 +312,23 @@ def _keys(table: Any, allowed: tuple[str, ...], where: str) -> None:
 def _base(table: Mapping[str, Any]) -> dict[str, Any]:
     _keys(table, tuple(_BASE_DEFAULTS) + _OPTIONAL, "base")
     base = {**_BASE_DEFAULTS, **table}
-    for key, choices in _CHOICES.items():
-        if base[key] not in choices:
-            raise ValueError(f"base.{key}: expected one of {', '.join(choices)}, got {base[key]!r}")
-    if not isinstance(base["allow_unusual_design"], bool):
-        raise ValueError(f"base.allow_unusual_design: expected true or false, got {base['allow_unusual_design']!r}")
-    if not isinstance(base["surface"], str):
-        raise ValueError(f"base.surface: expected a surface preset name, got {base['surface']!r}")
-    for key in NUMERIC_AXES:
-        if base.get(key) is not None:
+    for key in base:                       # the study's fields: one parser for every spelling
+        if key in _STUDY:
+            base[key] = parse(_STUDY[key], base[key], "sweep")
+    for key in _OWN:
+        if key != "F0_at_u_mm" and base.get(key) is not None:
             base[key] = _number(base[key], f"base.{key}")
             _plausible(key, base[key], f"base.{key}")
+    check_route({_STUDY[k].key: v for k, v in base.items() if k in _STUDY},
+                {_STUDY[k].key for k in table if k in _STUDY}, "sweep")
     for key in ("F1_N", "F0_at_u_mm"):
         values = base[key] if isinstance(base[key], list) else [base[key]]
         if not values:
             raise ValueError(f"base.{key}: expected at least one value (an empty list gives an empty table)")
         base[key] = [_number(v, f"base.{key}[{i}]", positive=True) for i, v in enumerate(values)]
-        if len(set(base[key])) != len(base[key]):
+        if len(set(base[key])) != len(base[key]):   # one table row per design and value
             twice = next(v for v in base[key] if base[key].count(v) > 1)
             raise ValueError(f"base.{key}: {twice:g} appears twice; give each value once")
-    from validation.guards import check_forces
-    check_forces(base["F1_N"], "base.F1_N")
     return base
 
 
