@@ -146,6 +146,7 @@ class FemRoute:
 
     def __init__(self) -> None:
         self._sealed: dict[tuple, Sealed] = {}
+        self._largest: dict[int, tuple[Sealed, float]] = {}     # id(Sealed) -> it, its largest pull [N]
 
     def check(self, model: LeakageModel, options: Mapping[str, Any]) -> None:
         from fem.interface import ContactLaw
@@ -184,8 +185,12 @@ class FemRoute:
         return self._sealed[key]
 
     def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
+        """The largest pull the sealed cup holds (`largest_pull`), once per sealed cup."""
         sealed = self.seal(model, options)
-        return largest_pull(sealed.cup, sealed.state)
+        kept = self._largest.get(id(sealed))
+        if kept is None or kept[0] is not sealed:
+            kept = self._largest[id(sealed)] = (sealed, largest_pull(sealed.cup, sealed.state))
+        return kept[1]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
         from fem.gas_branch import equilibrium_branch
@@ -196,9 +201,8 @@ class FemRoute:
         if run.refine != 1:
             raise ValueError(f"refine: the fem route has no dense output, got {run.refine}")
         sealed = self.seal(model, options, run.progress)
-        if run.progress:
-            run.progress(0.1, f"F1 = {force_N:g} N: following the branch")
-        branch = equilibrium_branch(sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]))
+        branch = equilibrium_branch(sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
+                                    progress=_branch_progress(run.progress, force_N, sealed))
         largest = self.largest_force(model, options)
         s0 = sealed.state
         provenance = {"route": self.name, "options": {**options, "cup": options["cup"].describe(),
@@ -247,6 +251,20 @@ class FemRoute:
             run.progress(1.0, f"F1 = {force_N:g} N: {reason}")
         return Lifetime(reason=reason, lifetime_s=float(t[-1]), trajectory=columns, details=details,
                         message=f"detached at t = {t[-1]:.4g} s: {where}", **common)
+
+
+def _branch_progress(report: Callable[[float, str], None] | None, force_N: float, sealed: Sealed):
+    """One progress line per branch state: the fraction is the plate's travel from the sealed
+    position towards -h1 (the branch's end is not known before it is reached)."""
+    if report is None:
+        return None
+    u0, N0, h1 = sealed.state.u_m, sealed.state.N, sealed.cup.h1_m
+    report(0.1, f"F1 = {force_N:g} N: following the branch")
+
+    def on_state(k: int, u_m: float, N: float) -> None:
+        report(0.1 + 0.85 * min(max((u0 - u_m) / (u0 + h1), 0.0), 1.0),
+               f"F1 = {force_N:g} N: branch state {k}, u = {1e3 * u_m:.3f} mm, N = {N / N0:.4g} N0")
+    return on_state
 
 
 def lifetime_integral(N: np.ndarray, q: np.ndarray) -> np.ndarray:

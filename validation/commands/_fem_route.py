@@ -71,7 +71,8 @@ def run_fem_route(args: argparse.Namespace) -> int:
     model, options, choice, cup = fem_route_case(args)
     for note in choice.notes:
         print(f"note: {note}", file=sys.stderr)
-    progress = terminal_progress("lifetime --route fem") if sys.stderr.isatty() else None
+    # one status line per branch state on a terminal; elsewhere a plain line every ~10 %
+    progress = terminal_progress("lifetime --route fem")
     route = register()
 
     def compute() -> Lifetimes:
