@@ -1,12 +1,12 @@
-"""The held branch of the route "fem" (`fem.gas_branch.equilibrium_branch`) for the sticking law:
-the cup pressed to r_start, sealed and held at F1 follows its branch through the slips of the
-sticking law (the pull jumps as N rises at the held plate; the plate rises until the pull is F1
-again) to a detachment.
+"""The held branch of the route "fem" (`fem.gas_branch.equilibrium_branch`) across a jump of the
+pull: the sticking cup pressed to r_start, sealed and held at F1 slips as gas enters (its pull
+at the held plate jumps from above F1 to below it), crosses the slip at that N and is restored
+to F1 by the plate rising; the frictionless branch for its work balance.
 
-Physics checks, on every state and on the whole branch: the pull is F1; plate, contact pressure
-and suction balance; N rises; the branch's work balance, the stored energy of body and gas
-against the plate's work and the work of the gas let in: it closes for the frictionless branch
-(to the quadrature between its states) and leaves a dissipation >= 0 for the sticking one."""
+Physics checks, on every state and on the branch: the pull is F1; plate, contact pressure and
+suction balance; N rises; the work balance (the stored energy of body and gas against the
+plate's work and the work of the gas let in) closes for the frictionless branch to the
+quadrature between its states, and leaves a dissipation >= 0 across the sticking slip."""
 
 from __future__ import annotations
 
@@ -19,11 +19,11 @@ import reduced
 from fem.gas_branch import equilibrium_branch
 from fem.interface import ContactLaw
 from fem.trapped_gas import K_B
-from validation.bridge.fem_route import FemCup, register
+from validation.bridge.fem_route import DEFAULT_DU_M, FemCup, register
 from validation.bridge.pipeline import surface_uc_table
 
 F1 = 10.0           # N
-DU = 0.5e-3         # m: twice the route's plate step (the test's cost)
+U_END = 4.87e-3     # m: the sticking branch is followed to here: across its first slip (at 4.95 mm)
 
 
 @pytest.fixture(scope="module")
@@ -31,15 +31,15 @@ def model():
     return reduced.reference_model(reduced.CUP_A, surface_uc_table())
 
 
-def _branch(model, law):
+def _branch(model, law, **kw):
     route = register()
     sealed = route.seal(model, {**route.options, "cup": FemCup("A", "coarse", contact=law)})
-    return sealed.cup, equilibrium_branch(sealed.cup, sealed.state, F1, du_m=DU)
+    return sealed.cup, equilibrium_branch(sealed.cup, sealed.state, F1, du_m=DEFAULT_DU_M, **kw)
 
 
 @pytest.fixture(scope="module")
 def sticking(model):
-    return _branch(model, ContactLaw("sticking"))
+    return _branch(model, ContactLaw("sticking"), u_min_m=U_END)
 
 
 @pytest.fixture(scope="module")
@@ -61,46 +61,40 @@ def work_balance(cup, branch) -> tuple[float, float]:
     return plate + gas - (W[-1] - W[0]), max(abs(plate), abs(gas), abs(W[-1] - W[0]))
 
 
-@pytest.mark.parametrize("which", ["frictionless", "sticking"])
-def test_branch_states_hold_the_pull_and_balance(which, request):
-    cup, b = request.getfixturevalue(which)
-    assert b.reason in ("fold", "seal opened"), b.reason
-    assert b.detachment is b.states[-1]
+def test_frictionless_branch_holds_the_pull_and_its_work_balance_closes(frictionless):
+    """No dissipation on a frictionless path: the balance closes to the trapezoid's error."""
+    cup, b = frictionless
+    assert b.reason in ("fold", "seal opened") and b.detachment is b.states[-1]
+    _holds_and_balances(cup, b)
+    D, scale = work_balance(cup, b)
+    print(f"frictionless: D = {D:.4g} J of {scale:.4g} J")
+    assert abs(D) <= 1e-4 * scale           # measured: 6e-6 (coarse, 10 N)
+
+
+def test_sticking_crosses_its_slip_and_dissipates(sticking, frictionless):
+    """The sticking branch's pull jumps across F1 as gas enters at the held plate (a slip,
+    `Branch.snaps`); the state after it holds F1 again, higher (the plate raised), with more gas,
+    and the slip dissipates: the branch's work balance leaves D > 0, beyond the frictionless
+    branch's quadrature error per unit of work, and so does the solver's own count."""
+    cup, b = sticking
+    assert b.reason == "u_min" and b.snaps >= 1 and len(b.states) >= 2
+    _holds_and_balances(cup, b)
+    D, scale = work_balance(cup, b)
+    D0, scale0 = work_balance(*frictionless)
+    print(f"sticking: D = {D:.4g} J of {scale:.4g} J, {b.snaps} slips; solver {b.stats.dissipated_J:.4g} J")
+    assert D > 2 * abs(D0) / scale0 * scale
+    assert b.stats.dissipated_J > 0.0
+
+
+def _holds_and_balances(cup, b) -> None:
+    """Every state pulls F1 and balances plate, contact pressure and suction; N rises."""
     N = b.column("N")
-    assert np.all(np.diff(N) > 0) and N[-1] > 1.5 * N[0]
+    assert np.all(np.diff(N) > 0)
     for s in b.states:
         scale = cup.p_a_Pa * math.pi * s.seal_r_m**2
         assert abs(s.F1_N - F1) <= cup.options.rtol * scale
         contact = float(np.sum(s.profile.p_gauss_Pa * s.profile.w_m2))
         assert abs(s.F1_N + contact - s.dp_Pa * math.pi * s.cut_r_m**2) <= 1e-7 * scale
-
-
-def test_frictionless_work_balance_closes(frictionless):
-    """No dissipation on a frictionless path: the balance closes to the trapezoid's error."""
-    D, scale = work_balance(*frictionless)
-    print(f"frictionless: D = {D:.4g} J of {scale:.4g} J")
-    assert abs(D) <= 2e-3 * scale
-
-
-def test_sticking_dissipates(sticking, frictionless):
-    """The sticking branch slips (its pull jumps, `Branch.snaps`) and every slip dissipates:
-    the branch's work balance leaves D >= 0, beyond the frictionless branch's quadrature error,
-    and so does every load step the solver took (`SolverStats.dissipated_J`)."""
-    cup, b = sticking
-    D, scale = work_balance(cup, b)
-    D0, scale0 = work_balance(*frictionless)
-    print(f"sticking: D = {D:.4g} J of {scale:.4g} J, {b.snaps} slips; solver {b.stats.dissipated_J:.4g} J")
-    assert b.snaps >= 1
-    assert D >= -2e-3 * scale
-    assert b.stats.dissipated_J >= 0.0
-
-
-def test_sticking_lifetime_comes_out_of_the_branch(model):
-    life = reduced.solve_lifetime(model, F1, route="fem", cup=FemCup("A", "coarse", contact=ContactLaw("sticking")),
-                                  du_m=DU)
-    assert life.reason in ("fold", "reached_r1") and 0.0 < life.lifetime_s < math.inf
-    assert life.details["snaps"] >= 1
-    assert np.all(np.diff(life.trajectory["t_s"]) > 0)
 
 
 def test_tangent_rows_carry_the_gas_rank_one_term():
