@@ -61,7 +61,7 @@ from .solver import SolverStats, StepResult
 from .cup import _joined
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
-__all__ = ["Branch", "equilibrium_branch", "pull_sensitivities"]
+__all__ = ["Branch", "equilibrium_branch", "pull_sensitivities", "state_between"]
 
 SNAP_DN = 1e-6      # relative rise of N at the held plate that tests for a snap
 SNAP_DROP = 1e-3    # ... and the relative fall of F1 that makes it one
@@ -233,6 +233,23 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
         slopes.append(walk.slope(s))
         tangent = t
     raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
+
+
+def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float) -> GasState | None:
+    """A state holding F1_N between two consecutive states a and b of a branch, reached from a
+    (its history): N the unknown at the plate midway, or where that fails, the plate at N
+    midway. None where neither is found between them (a jump of the pull between a and b)."""
+    walk = _Walk(cup, float(F1_N))
+    prev = _Trial(a.u_m, a.N, a.F1_N, a.state)
+    u, N = 0.5 * (a.u_m + b.u_m), 0.5 * (a.N + b.N)
+    for find in (walk.hold, walk.hold_u):
+        try:
+            s = find(prev, u, N)
+        except RuntimeError:
+            continue
+        if min(a.N, b.N) < s.N < max(a.N, b.N) and not _open(cup, s):
+            return walk.result(None, "between", [s]).states[0]
+    return None
 
 
 def _open(cup: CupWithGas, s: "_Trial") -> bool:

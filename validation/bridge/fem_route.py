@@ -17,8 +17,10 @@ FEM's less the interface gas's rise over p_b across the zone [r_k, r_cut] (the m
 `interface`), averaged over the u_c table's patch length, its rings' gaps u_c(p / E) in series
 (`reduced.profile_leak`). The lifetime is t = int_{N0}^{N_max} dN / Q by the trapezoid in N over
 the branch states: N rises monotonically along the branch whereas u turns where the branch does
-(the walk switches to N as its parameter there), and 1/Q is smooth in N; the change when the
-plate step is halved measures the quadrature and branch error (benchmarks/bench_fem_route.py).
+(the walk switches to N as its parameter there), and 1/Q is smooth in N except where the
+seal's contact narrows to its last ring and Q falls several times within a plate step: there
+states are added midway (`refine_branch`). The change when the plate step is halved measures the
+quadrature and branch error (benchmarks/bench_fem_route.py, docs/lifetime.md).
 
 The largest holdable force is the largest pull along the plate raised at fixed N0 from the sealed
 state (the branch at a larger F1 does not start: the cup lets go at once).
@@ -219,12 +221,13 @@ class FemRoute:
         if branch.detachment is None:
             raise FemRouteError(f"F1 = {force_N:g} N: the branch ended without a detachment "
                                 f"({branch.reason}) after {len(branch.states)} states")
-        states = list(branch.states)
-        q = np.array([state_leak_rate(s, model, sealed.E_Pa, options["radial"]) for s in states])
+        leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, options["radial"])  # noqa: E731
+        states, q, added = refine_branch(sealed.cup, list(branch.states), [leak(s) for s in branch.states],
+                                         float(force_N), leak)
         N = np.array([s.N for s in states])
         columns = _columns(states, q)
         stats = branch.stats
-        details = {**base, "N_max": branch.N_max, "states": len(states), "snaps": branch.snaps,
+        details = {**base, "N_max": branch.N_max, "states": len(states), "refined": added, "snaps": branch.snaps,
                    "newton_iterations": stats.newton_iterations, "wall_time_s": stats.wall_time_s,
                    "seal_r_final_mm": 1e3 * states[-1].seal_r_m, "p_b_final_Pa": states[-1].p_b_Pa,
                    "u_final_mm": 1e3 * states[-1].u_m}
@@ -251,6 +254,44 @@ class FemRoute:
             run.progress(1.0, f"F1 = {force_N:g} N: {reason}")
         return Lifetime(reason=reason, lifetime_s=float(t[-1]), trajectory=columns, details=details,
                         message=f"detached at t = {t[-1]:.4g} s: {where}", **common)
+
+
+#: the leak may change by at most this factor between neighbouring states where their interval
+#: carries more than REFINE_SHARE of the lifetime (`refine_branch`)
+REFINE_RATIO, REFINE_SHARE, REFINE_DEPTH = 2.0, 0.01, 3
+
+
+def refine_branch(cup: CupWithGas, states: list, q: list, force_N: float,
+                  leak: Callable[[Any], float]) -> tuple[list, np.ndarray, int]:
+    """The branch's states with states added where the trapezoid of 1/Q in N is not resolved:
+    between neighbours whose leak differs by more than REFINE_RATIO and whose interval carries
+    more than REFINE_SHARE of the lifetime (where the seal's last contact ring narrows, Q falls
+    several times within one plate step), a state midway (`fem.gas_branch.state_between`, from
+    the earlier state), up to REFINE_DEPTH halvings. (states, Q [1/s], states added)."""
+    from fem.gas_branch import state_between
+
+    states, q = list(states), list(q)
+    added = 0
+    for _ in range(REFINE_DEPTH):
+        N, Q = np.array([s.N for s in states]), np.array(q)
+        inv = np.where(np.isinf(Q), 0.0, 1.0 / np.where(Q > 0, Q, np.inf))
+        if np.any(Q <= 0) or len(states) < 2:
+            break
+        share = np.maximum(inv[1:], inv[:-1]) * np.diff(N)
+        total = float(lifetime_integral(N, Q)[-1])
+        finite = np.isfinite(Q[1:]) & np.isfinite(Q[:-1])
+        ratio = np.zeros(len(Q) - 1)
+        ratio[finite] = np.abs(np.log(Q[1:][finite] / Q[:-1][finite]))
+        todo = np.flatnonzero((ratio > math.log(REFINE_RATIO)) & (share > REFINE_SHARE * total))
+        if len(todo) == 0:
+            break
+        for k in todo[::-1]:                      # from the end: the indices before stay valid
+            mid = state_between(cup, states[k], states[k + 1], force_N)
+            if mid is not None:
+                states.insert(k + 1, mid)
+                q.insert(k + 1, leak(mid))
+                added += 1
+    return states, np.array(q), added
 
 
 def _branch_progress(report: Callable[[float, str], None] | None, force_N: float, sealed: Sealed):
