@@ -8,13 +8,15 @@ r_start = 12 mm, sealed, held at F1 along its FEM branch, per mesh level and con
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --summarize study.jsonl
 
 For each (level, law, plate step): the largest holdable force (max pull at fixed N0), then per
-force the lifetime (its wall and CPU time: the CPU time is the cost on a busy machine), its reason, the branch's states and Newton iterations, the seal radius at the
-start of the branch and at its end, and where the time goes (pressing + sealing, the branch's FEM
+force the lifetime (its wall and CPU time: the CPU time is the cost on a busy machine), its
+reason, the branch's states and Newton iterations, the seal radius at the start of the branch
+and at its end, and where the time goes (pressing + sealing, the branch's FEM
 solves, the rest: sensitivities, measurement and the leak through every state's profile). With
 --jsonl every lifetime is also appended as one JSON line, with what explains it: N_max / N0, the
-leak rate at the branch's start and end, the mean of 1/Q over N, the seal's contact force and its
-width (cut radius less inner contact radius). --summarize turns such a file into the convergence
-table: each lifetime beside the finest plate step's and the finer mesh's, in percent.
+leak rate at the branch's start and end, the mean of 1/Q over N (lifetime = (N_max - N0) times
+it), p_b, u, the seal radius and the contact band's width (cut radius less inner contact radius)
+at the start and end. --summarize turns such a file into the convergence table: each lifetime
+beside the one at half its plate step and the next finer mesh's at the same step, in percent.
 """
 
 from __future__ import annotations

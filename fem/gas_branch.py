@@ -142,8 +142,9 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     a sealed state) to detachment (module docstring). du_m: the plate step along the branch
     (halved, down to du_m / 16, where a state cannot be found); u_min_m: the lowest plate
     position (default -h1: the plate above the touching height, the suction holding the wall on
-    the plane); progress(k, u_m, N): called with every state k of the branch as it is found. Raises ValueError for bad input; where no state is found even with the smallest
-    step, the branch ends there with reason "stopped: <why>" and no detachment."""
+    the plane); progress(k, u_m, N): called with every state k of the branch as it is found.
+    Raises ValueError for bad input; where no state is found even with the smallest step, the
+    branch ends there with reason "stopped: <why>" and no detachment."""
     if not (isinstance(F1_N, (int, float)) and math.isfinite(F1_N)):
         raise ValueError(f"F1_N: must be a finite number, got {F1_N!r}")
     if not (math.isfinite(du_m) and 0.0 < du_m <= 0.1 * cup.h1_m):

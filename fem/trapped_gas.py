@@ -339,8 +339,8 @@ def _body_solver(pattern: sp.csr_matrix, coordinates: np.ndarray, mesh):
         return make_solver(pattern, coordinates, mesh)
     kept = _SOLVERS.get(id(mesh))
     if kept is not None and kept[0]() is mesh and kept[1].shape == pattern.shape \
-            and np.array_equal(kept[1].indptr, pattern.indptr) and np.array_equal(kept[1].indices, pattern.indices) \
-            and np.array_equal(kept[2], coordinates):
+            and np.array_equal(kept[1].indptr, pattern.indptr) \
+            and np.array_equal(kept[1].indices, pattern.indices) and np.array_equal(kept[2], coordinates):
         return kept[3]
     solver = make_solver(pattern, coordinates, mesh)
     for key in [k for k, v in _SOLVERS.items() if v[0]() is None]:
