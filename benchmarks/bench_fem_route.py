@@ -6,6 +6,7 @@ r_start = 12 mm, sealed, held at F1 along its FEM branch, per mesh level and con
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --levels coarse --laws frictionless \
         --forces 5 10 20 40 --du-factors 1 0.5 0.25 --jsonl study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --summarize study.jsonl
+    OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --why 5 20
 
 For each (level, law, plate step): the largest holdable force (max pull at fixed N0), then per
 force the lifetime (its wall and CPU time: the CPU time is the cost on a busy machine), its
@@ -63,11 +64,17 @@ def main() -> None:
     ap.add_argument("--no-largest", action="store_true", help="skip the largest holdable force")
     ap.add_argument("--jsonl", default=None, help="append every lifetime as a JSON line to this file")
     ap.add_argument("--summarize", default=None, help="print the convergence table of a --jsonl file")
+    ap.add_argument("--why", nargs=2, type=float, default=None, metavar=("F_LOW", "F_HIGH"),
+                    help="the leak of the two forces' frictionless branch states at equal N / N0, each "
+                         "also at the other's p_b (the profile's share against the pressure's)")
     a = ap.parse_args()
     if a.summarize:
         summarize(a.summarize)
         return
     model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
+    if a.why:
+        why(model, *a.why, level=a.levels[0])
+        return
     du0 = DEFAULT_DU_M if a.du_mm is None else 1e-3 * a.du_mm
     print("| level | law | du [mm] | F1 [N] | lifetime [s] | reason | states | Newton it. | seal r start/end [mm] "
           "| u end [mm] | wall [s]: total / press / branch FEM / rest | largest force [N] |")
@@ -124,6 +131,33 @@ def _one(model, cup, level, law, du, F, t_press, largest, jsonl) -> None:
     if jsonl:
         with open(jsonl, "a") as f:
             f.write(json.dumps(row) + "\n")
+
+
+def why(model, low: float, high: float, level: str = "coarse") -> None:
+    """Why the lifetime changes with the force: at N = 1, 2, 4, 8 N0 on both frictionless branches,
+    the state's p_b, seal, contact force, peak contact pressure and leak Q, and the leak of each
+    state's profile at the other state's p_b (`state_leak_rate` with p_b and dp swapped)."""
+    from dataclasses import replace
+
+    from fem.gas_branch import equilibrium_branch
+    from validation.bridge.fem_route import state_leak_rate
+
+    route = register()
+    sealed = route.seal(model, {**route.options, "cup": FemCup("A", level)})
+    N0 = sealed.state.N
+    branches = [equilibrium_branch(sealed.cup, sealed.state, F, du_m=DEFAULT_DU_M) for F in (low, high)]
+    print(f"| N/N0 | p_b [kPa] | r_k [mm] | contact force [N] | peak p [kPa] | Q [1/s] | Q at the other's p_b "
+          f"[1/s] |  ({low:g} N / {high:g} N)")
+    print("|---|---|---|---|---|---|---|")
+    for ratio in (1.0, 2.0, 4.0, 8.0):
+        a, b = (br.states[int(np.argmin(np.abs(br.column("N") / N0 - ratio)))] for br in branches)
+        q = [state_leak_rate(s, model, sealed.E_Pa) for s in (a, b)]
+        swapped = [state_leak_rate(replace(s, p_b_Pa=o.p_b_Pa, dp_Pa=o.dp_Pa), model, sealed.E_Pa)
+                   for s, o in ((a, b), (b, a))]
+        print(f"| {a.N / N0:.2f} / {b.N / N0:.2f} | {a.p_b_Pa / 1e3:.1f} / {b.p_b_Pa / 1e3:.1f} | "
+              f"{1e3 * a.seal_r_m:.2f} / {1e3 * b.seal_r_m:.2f} | {a.contact_force_N:.2f} / {b.contact_force_N:.2f} | "
+              f"{a.profile.p_Pa.max() / 1e3:.1f} / {b.profile.p_Pa.max() / 1e3:.1f} | {q[0]:.3g} / {q[1]:.3g} | "
+              f"{swapped[0]:.3g} / {swapped[1]:.3g} |", flush=True)
 
 
 def summarize(path: str) -> None:

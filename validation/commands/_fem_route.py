@@ -12,7 +12,7 @@ from typing import Any
 
 from validation.commands._reduced_options import build_uc, check_run_options, refuse_other_options
 
-#: mesh level of the fem route when --fidelity is not given (one lifetime ~15 s on one core)
+#: mesh level of the fem route when --fidelity is not given (one lifetime 4-6 s of CPU coarse, ~20 s medium)
 DEFAULT_FIDELITY = "coarse"
 
 #: lifetime options the fem route replaces or does not model: (option, attribute, default)
