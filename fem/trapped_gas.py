@@ -33,7 +33,8 @@ contact state, with its sticking anchors and Coulomb slips, is carried from stat
 Only the geometric volume takes part (no wetted fraction: the gas law needs the volume the gas
 fills, and the load must be its derivative). For Coulomb friction the condensed contact problem
 (`fem.friction`) reads rows of the sparse part only, so its Newton step misses the rank-one term
-on the contact rows (an inexact tangent there; the energy and the residual stay exact).
+on the contact rows (an inexact tangent there; the energy and the residual stay exact);
+`tangent_rows` (`GasTangent.rows`) gives those rows with the term, K_s[rows] + c g[rows] g^T.
 """
 
 from __future__ import annotations
