@@ -148,7 +148,8 @@ class FemRoute:
 
     def __init__(self) -> None:
         self._sealed: dict[tuple, Sealed] = {}
-        self._largest: dict[int, tuple[Sealed, float]] = {}     # id(Sealed) -> it, its largest pull [N]
+        # id(Sealed) -> it, its largest pull [N], the solver's message if that is a lower bound
+        self._largest: dict[int, tuple[Sealed, float, str | None]] = {}
 
     def check(self, model: LeakageModel, options: Mapping[str, Any]) -> None:
         from fem.interface import ContactLaw
@@ -188,11 +189,14 @@ class FemRoute:
 
     def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
         """The largest pull the sealed cup holds (`largest_pull`), once per sealed cup."""
+        return self._largest_checked(model, options)[0]
+
+    def _largest_checked(self, model: LeakageModel, options: Mapping[str, Any]) -> tuple[float, str | None]:
         sealed = self.seal(model, options)
         kept = self._largest.get(id(sealed))
         if kept is None or kept[0] is not sealed:
-            kept = self._largest[id(sealed)] = (sealed, largest_pull(sealed.cup, sealed.state))
-        return kept[1]
+            kept = self._largest[id(sealed)] = (sealed, *largest_pull_checked(sealed.cup, sealed.state))
+        return kept[1], kept[2]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
         from fem.gas_branch import equilibrium_branch
@@ -205,7 +209,7 @@ class FemRoute:
         sealed = self.seal(model, options, run.progress)
         branch = equilibrium_branch(sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
                                     progress=_branch_progress(run.progress, force_N, sealed))
-        largest = self.largest_force(model, options)
+        largest, partial = self._largest_checked(model, options)
         s0 = sealed.state
         provenance = {"route": self.name, "options": {**options, "cup": options["cup"].describe(),
                                                        "press": options["press"] and vars(options["press"])},
@@ -214,6 +218,8 @@ class FemRoute:
                       provenance=provenance)
         base = {"N0": s0.N, "u_sealed_mm": 1e3 * s0.u_m, "r_start_mm": 1e3 * s0.r_c_m,
                 "seal_r_sealed_mm": 1e3 * s0.seal_r_m, "branch_reason": branch.reason}
+        if partial is not None:       # the pull was still rising where the solver stopped
+            base["largest_force_lower_bound"] = partial
         if branch.reason == "not held":
             return Lifetime(reason="over_force", lifetime_s=0.0, message=f"F1 = {force_N:g} N exceeds "
                             f"what the sealed cup holds: it detaches at once", trajectory={},
@@ -332,6 +338,12 @@ def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float
     `sealed` (module docstring): the path is followed up to -h1 until F1 has fallen by `drop` of
     its maximum or the solver stops (the seal opening), and the maximum refined by the parabola
     through the three states around it."""
+    return largest_pull_checked(cup, sealed, drop)[0]
+
+
+def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> tuple[float, str | None]:
+    """`largest_pull` and, where the solver stopped while the pull was still rising (the maximum
+    not reached: a lower bound only), the solver's message; else None."""
     from fem.solver import ConvergenceError
     from fem.trapped_gas import GasMechanics, TrappedGas, follow_gas_path
 
@@ -349,18 +361,22 @@ def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float
         if best > 0 and F1 < (1.0 - drop) * best:
             raise _Past
     options = replace(cup.options, max_step=min(cup.options.max_step, 0.01))
+    stopped = None
     try:
         follow_gas_path(mech, plate, span, plane=cup.cup.plane, start=sealed.state, options=options,
                         on_step=on_step)
-    except (_Past, ConvergenceError):
+    except _Past:
         pass
+    except ConvergenceError as err:
+        stopped = str(err)
     u, F = np.array(seen).T
     k = int(np.argmax(F))
+    partial = stopped if stopped is not None and k == F.size - 1 else None
     if 0 < k < F.size - 1:
         a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
         if a < 0:
-            return float(max(F[k], c - b * b / (4 * a)))
-    return float(F[k])
+            return float(max(F[k], c - b * b / (4 * a))), partial
+    return float(F[k]), partial
 
 
 def register() -> FemRoute:
