@@ -19,11 +19,21 @@ to dN at the held plate, solved with the rank-one gas tangent (`fem.trapped_gas`
 contact dofs fixed and Coulomb's sliding nodes sliding (`pull_sensitivities`). Every trial N is
 reached from the previous state of the branch (not from the last trial: with friction a trial's
 back-and-forth would enter the history); a secant step takes over when the tangent's step does
-not halve the mismatch (the contact set changed in between). A snap, F1 falling by a finite
-amount as N rises at the held plate, is crossed at that N by raising the plate until the pull is
-F1 again (`Branch.snaps`). A bordered Newton (N an unknown of the solver's Newton iteration beside u) would need the
-solver's Newton step and line search (`fem.newton`) to carry a constraint that is not an energy;
-the scalar root keeps the solver an energy minimization at given (u, N).
+not reduce the mismatch tenfold (the contact set changed in between), and regula falsi on the
+bracket of the trials where neither converges. A bordered Newton (N an unknown of the solver's
+Newton iteration beside u) would need the solver's Newton step and line search (`fem.newton`)
+to carry a constraint that is not an energy; the scalar root keeps the solver an energy
+minimization at given (u, N).
+
+Slips and snaps: the pull can jump as N rises at the held plate (or as the plate moves at fixed
+N): a sticking node whose normal reaction reaches zero while it carries a tangential one is
+released and slips (mu -> infinity has no continuous transition), or the wall snaps. Where the
+bracket of the root closes to 1e-3 of the trial's move with the pull still on both sides of F1,
+the pull jumps across F1 there; the cup crosses the jump at that N and is then restored to F1
+by the physical response of a held pull: the plate rises at fixed N where the pull fell, gas
+enters at the held plate where it rose (`Branch.snaps` counts them; the slip's dissipation is
+in the branch's stats). The sticking law's slips land where the load step puts them, so its
+moves between states are taken in STICKING_STEPS load steps.
 
 Detachment (the criterion): with the pull F1 held, the leak raises N, and the cup follows the
 branch while N can still rise along it. Where N(u) has its maximum, dN/du = 0 (the fold of the
@@ -33,13 +43,13 @@ state, dN/du = -(dF1/du)/(dF1/dN), and the fold located by a secant on it). The 
 where the seal opens, no node of the cavity chain being on the plane any more: the detachment is
 then the last state with the seal closed, bisected to 1/64 of a step ("seal opened"). It ends
 without a detachment where the plate reaches u_min_m ("u_min"), or where no state holds F1 even
-with 1/16 of a step ("stopped: why"; e.g. the sticking law's slips, whose landing depends on the
-load step, make F1(N) at the held plate discontinuous and not monotone).
+with 1/16 of a step ("stopped: why").
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -51,10 +61,11 @@ from .solver import SolverStats, StepResult
 from .cup import _joined
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
-__all__ = ["Branch", "equilibrium_branch", "pull_sensitivities"]
+__all__ = ["Branch", "equilibrium_branch", "pull_sensitivities", "state_between"]
 
 SNAP_DN = 1e-6      # relative rise of N at the held plate that tests for a snap
 SNAP_DROP = 1e-3    # ... and the relative fall of F1 that makes it one
+STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
 
 
 @dataclass(frozen=True, eq=False)
@@ -125,13 +136,15 @@ def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float,
 
 
 def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: float = 0.1e-3,
-                       u_min_m: float | None = None, max_states: int = 400) -> Branch:
+                       u_min_m: float | None = None, max_states: int = 400,
+                       progress: Callable[[int, float, float], None] | None = None) -> Branch:
     """The states holding the pull F1_N from `sealed` (a "pressed" state, sealed there at p_a, or
     a sealed state) to detachment (module docstring). du_m: the plate step along the branch
     (halved, down to du_m / 16, where a state cannot be found); u_min_m: the lowest plate
     position (default -h1: the plate above the touching height, the suction holding the wall on
-    the plane). Raises ValueError for bad input; where no state is found even with the smallest
-    step, the branch ends there with reason "stopped: <why>" and no detachment."""
+    the plane); progress(k, u_m, N): called with every state k of the branch as it is found.
+    Raises ValueError for bad input; where no state is found even with the smallest step, the
+    branch ends there with reason "stopped: <why>" and no detachment."""
     if not (isinstance(F1_N, (int, float)) and math.isfinite(F1_N)):
         raise ValueError(f"F1_N: must be a finite number, got {F1_N!r}")
     if not (math.isfinite(du_m) and 0.0 < du_m <= 0.1 * cup.h1_m):
@@ -149,6 +162,8 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     if first is None:
         return walk.result(None, "not held")
     trials, slopes = [first], [walk.slope(first)]
+    if progress:
+        progress(0, first.u_m, first.N)
     N_ref = abs(slopes[0]) * du_m if math.isfinite(slopes[0]) and slopes[0] else 1e-3 * first.N
     tangent = walk.tangent(first, du_m, N_ref, None)
     h = 1.0
@@ -162,6 +177,25 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
                 s = walk.hold(prev, u_pred, N_pred)
             else:                                        # N leads (near a turn of u): u is
                 s = walk.hold_u(prev, u_pred, N_pred)
+        except _Jump as jump:
+            # the pull jumps across F1 (a slip): the cup crosses it at the jump's N, then the
+            # plate rises (the pull fell) or gas enters (it rose) until the pull is F1 again
+            try:
+                restored = walk.restore(jump.after, du_m, u_min)
+            except RuntimeError as err:
+                return walk.result(None, f"stopped: {jump}; then {err}", trials, slopes)
+            if restored is None:
+                return walk.result(None, "u_min", trials, slopes)
+            if _open(cup, restored):
+                return walk.result(prev, "seal opened", trials, slopes)
+            trials.append(restored)
+            if progress:
+                progress(len(trials) - 1, restored.u_m, restored.N)
+            slopes.append(walk.slope(restored))
+            tangent = walk.tangent(restored, du_m, N_ref, None)
+            walk.snaps += 1
+            h = 1.0
+            continue
         except RuntimeError as err:
             if h > 1.0 / 16.0 * (1 + 1e-9):
                 h *= 0.5
@@ -177,6 +211,8 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             if not restored:
                 return walk.result(None, f"stopped: {err}", trials, slopes)
             trials.append(restored)
+            if progress:
+                progress(len(trials) - 1, restored.u_m, restored.N)
             slopes.append(walk.slope(restored))
             tangent = walk.tangent(restored, du_m, N_ref, None)
             walk.snaps += 1
@@ -193,15 +229,42 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             fold = walk.fold(prev, slopes[-1], s, walk.slope(s))
             return walk.result(fold, "fold", trials + [fold], slopes + [walk.slope(fold)])
         trials.append(s)
+        if progress:
+            progress(len(trials) - 1, s.u_m, s.N)
         slopes.append(walk.slope(s))
         tangent = t
     raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
+
+
+def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float) -> GasState | None:
+    """A state holding F1_N between two consecutive states a and b of a branch, reached from a
+    (its history): N the unknown at the plate midway, or where that fails, the plate at N
+    midway. None where neither is found between them (a jump of the pull between a and b)."""
+    walk = _Walk(cup, float(F1_N))
+    prev = _Trial(a.u_m, a.N, a.F1_N, a.state)
+    u, N = 0.5 * (a.u_m + b.u_m), 0.5 * (a.N + b.N)
+    for find in (walk.hold, walk.hold_u):
+        try:
+            s = find(prev, u, N)
+        except RuntimeError:
+            continue
+        if min(a.N, b.N) < s.N < max(a.N, b.N) and not _open(cup, s):
+            return walk.result(None, "between", [s]).states[0]
+    return None
 
 
 def _open(cup: CupWithGas, s: "_Trial") -> bool:
     """Whether no node of the cavity chain is on the plane (the cavity is open to the outside)."""
     x = cup.mesh.doflocs + np.stack([s.step.u[0::2], s.step.u[1::2]])
     return not np.any(x[1, cup.cavity.nodes] <= cup.cavity.tolerance_m)
+
+
+class _Jump(RuntimeError):
+    """The pull jumps across F1 between two states close together in N or u (module docstring)."""
+
+    def __init__(self, before: "_Trial", after: "_Trial", message: str):
+        super().__init__(message)
+        self.before, self.after = before, after
 
 
 @dataclass(frozen=True, eq=False)
@@ -220,6 +283,16 @@ class _Walk:
     def __init__(self, cup: CupWithGas, F1_N: float):
         self.cup, self.F1 = cup, F1_N
         self.options = replace(cup.options, initial_step=1.0, max_step=1.0)
+        # a trial of the F1 root: cut at most 4 times, a trial that does not converge in 1/16
+        # of its move is given up (the walk shortens its step) rather than ground through
+        self.trial_options = replace(self.options, min_step=max(cup.options.min_step, 1.0 / 16.0),
+                                     max_iterations=min(cup.options.max_iterations, 40))
+        if cup.cup.plane.law.name == "sticking":
+            # its slips land where the load step puts them: every move in STICKING_STEPS steps
+            self.options = replace(self.options, initial_step=1.0 / STICKING_STEPS,
+                                   max_step=1.0 / STICKING_STEPS)
+            self.trial_options = replace(self.trial_options, initial_step=1.0 / STICKING_STEPS,
+                                         max_step=1.0 / STICKING_STEPS, min_step=1.0 / (16 * STICKING_STEPS))
         self.stats: SolverStats | None = None
         self.snaps = 0
         self.slopes: dict[_Trial, tuple[float, float]] = {}     # by identity
@@ -247,26 +320,7 @@ class _Walk:
             t = -t
         return float(t[0]), float(t[1])
 
-    def hold_u(self, prev: _Trial, u_guess: float, N: float) -> _Trial:
-        """The state at N whose pull is F1 (the plate position by Newton on F1(u), the secant
-        where it is slow), reached from prev."""
-        s = self.solve(prev, u_guess, N)
-        tried: list[tuple[float, float]] = [(s.u_m, s.F1_N - self.F1)]
-        for _ in range(12):
-            miss = s.F1_N - self.F1
-            if abs(miss) <= self.tolerance:
-                return s
-            u_new = s.u_m - miss / self.derivatives(s)[1]
-            if len(tried) >= 2 and abs(miss) > 0.5 * abs(tried[-2][1]):
-                (ua, fa), (ub, fb) = tried[-2:]
-                if fb != fa:
-                    u_new = ub - fb * (ub - ua) / (fb - fa)
-            s = self.solve(prev, u_new, N)
-            tried.append((s.u_m, s.F1_N - self.F1))
-        raise RuntimeError(f"F1_N = {self.F1:g} N: the plate position not found at N = {N:.6g} "
-                           f"(pull off by {s.F1_N - self.F1:.3g} N after {len(tried) - 1} corrections)")
-
-    def solve(self, start: _Trial, u_m: float, N: float) -> _Trial:
+    def solve(self, start: _Trial, u_m: float, N: float, options=None) -> _Trial:
         """The state at (u_m, N), reached from `start` with the plate and N on a line."""
         u0, N0 = start.u_m, start.N
         mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
@@ -278,31 +332,95 @@ class _Walk:
             return dofs, np.concatenate([zeros, np.full(top.size, -(u0 + t * (u_m - u0)))])
         last = []
         stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
-                                options=self.options, on_step=last.append)
+                                options=options or self.options, on_step=last.append)
         self.stats = stats if self.stats is None else _joined(self.stats, stats)
         end = last[-1]
         return _Trial(float(u_m), float(N), float(np.sum(end.r_int[2 * top + 1])), end)
 
     def hold(self, prev: _Trial, u_m: float, N_guess: float) -> _Trial:
         """The state at plate position u_m whose pull is F1 (N by Newton on F1(N), module
-        docstring), reached from prev."""
-        s = self.solve(prev, u_m, N_guess)
-        tried: list[tuple[float, float]] = [(s.N, s.F1_N - self.F1)]
+        docstring), reached from prev. Raises `_Jump` where F1(N) jumps across F1."""
+        return self._root(prev, u_m, N_guess, 0)
+
+    def hold_u(self, prev: _Trial, u_guess: float, N: float) -> _Trial:
+        """The state at N whose pull is F1 (the plate position by Newton on F1(u)), reached
+        from prev. Raises `_Jump` where F1(u) jumps across F1."""
+        return self._root(prev, u_guess, N, 1)
+
+    def _root(self, prev: _Trial, u_m: float, N: float, k: int) -> _Trial:
+        """F1(x) = F1 for x = N at the plate u_m (k = 0) or x = u at N (k = 1), every trial
+        reached from prev: Newton with the exact dF1/dx, the secant where it does not halve the
+        mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`)."""
+        if k == 0:
+            def at(x): return self.solve(prev, u_m, x, self.trial_options)
+            x0, x_prev, name = N, prev.N, "N"
+        else:
+            def at(x): return self.solve(prev, x, N, self.trial_options)
+            x0, x_prev, name = u_m, prev.u_m, "the plate position"
+        s = at(x0)
+        tried: list[tuple[float, float, _Trial]] = [(x0, s.F1_N - self.F1, s)]
         for _ in range(12):
             miss = s.F1_N - self.F1
             if abs(miss) <= self.tolerance:
                 return s
-            N_new = s.N - miss / self.derivatives(s)[0]
-            if len(tried) >= 2 and abs(miss) > 0.5 * abs(tried[-2][1]):   # slow: secant
-                (Na, fa), (Nb, fb) = tried[-2:]
+            x_new = tried[-1][0] - miss / self.derivatives(s)[k]
+            if len(tried) >= 2 and abs(miss) > 0.1 * abs(tried[-2][1]):   # slow: secant
+                (xa, fa, _), (xb, fb, _) = tried[-2:]
                 if fb != fa:
-                    N_new = Nb - fb * (Nb - Na) / (fb - fa)
-            if not N_new > 0.0:
+                    x_new = xb - fb * (xb - xa) / (fb - fa)
+            if k == 0 and not x_new > 0.0:
                 break
-            s = self.solve(prev, u_m, N_new)
-            tried.append((s.N, s.F1_N - self.F1))
-        raise RuntimeError(f"F1_N = {self.F1:g} N: N not found at u = {u_m * 1e3:.4g} mm "
-                           f"(pull off by {s.F1_N - self.F1:.3g} N after {len(tried) - 1} corrections)")
+            s = at(x_new)
+            tried.append((x_new, s.F1_N - self.F1, s))
+        return self._bracket(at, tried, x0 - x_prev, name)
+
+    def _bracket(self, at, tried, travel: float, name: str) -> _Trial:
+        """The root of F1(x) = F1 on the closest bracket among the trials (Illinois regula
+        falsi, every third trial a bisection). Where the bracket closes to 1e-3 of the trial's
+        move from the previous state without a root, F1 jumps across F1 there (a slip of the
+        sticking law, a snap): `_Jump` with the states on both sides. RuntimeError where the
+        trials found no bracket."""
+        pos = [t for t in tried if t[1] > 0.0]
+        neg = [t for t in tried if t[1] < 0.0]
+        x, f, s = tried[-1]
+        if not (pos and neg):
+            raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (pull off by "
+                               f"{f:.3g} N after {len(tried) - 1} corrections)")
+        a, b = min(((p, n) for p in pos for n in neg), key=lambda pn: abs(pn[0][0] - pn[1][0]))
+        xtol = 1e-3 * abs(travel) + 1e-12 * abs(x)
+        side = 0
+        for i in range(60):
+            (xa, fa, sa), (xb, fb, sb) = a, b
+            if abs(xa - xb) <= xtol:
+                before, after = (a, b) if (xb - xa) * travel > 0.0 else (b, a)
+                raise _Jump(before[2], after[2], f"F1_N = {self.F1:g} N: the pull jumps from "
+                            f"{before[2].F1_N:.4g} to {after[2].F1_N:.4g} N at {name} {xa:.6g}")
+            x = 0.5 * (xa + xb) if i % 3 == 2 else xb - fb * (xb - xa) / (fb - fa)
+            s = at(x)
+            f = s.F1_N - self.F1
+            if abs(f) <= self.tolerance:
+                return s
+            if f > 0.0:
+                a = (x, f, s)
+                b = (xb, 0.5 * fb if side == 1 else fb, sb)
+                side = 1
+            else:
+                b = (x, f, s)
+                a = (xa, 0.5 * fa if side == -1 else fa, sa)
+                side = -1
+        raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (bracket not closed)")
+
+    def restore(self, after: _Trial, du_m: float, u_min: float) -> _Trial | None:
+        """The state holding F1 again after a jump of the pull (`_Jump`): the plate raised at
+        fixed N where the pull fell, gas let in at the held plate where it rose. None if the
+        plate reaches u_min first."""
+        if after.F1_N < self.F1:
+            return self.pull_to_force(after, du_m, u_min)
+        dF1_dN = self.derivatives(after)[0]
+        if not dF1_dN < 0.0:
+            raise RuntimeError(f"F1_N = {self.F1:g} N: the pull jumped to {after.F1_N:.4g} N and "
+                               f"more gas does not lower it")
+        return self.hold(after, after.u_m, after.N - (after.F1_N - self.F1) / dF1_dN)
 
     def pull_to_force(self, sealed: _Trial, du_m: float, u_min: float) -> _Trial | None:
         """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m
@@ -362,9 +480,13 @@ class _Walk:
 
     def fold(self, a: _Trial, ka: float, b: _Trial, kb: float) -> _Trial:
         """The state between a and b where dN/du = 0 on the branch (secant on dN/du)."""
+        s = b
         for _ in range(8):
             u = b.u_m + (a.u_m - b.u_m) * kb / (kb - ka)
-            s = self.hold(a, u, a.N + ka * (u - a.u_m))
+            try:
+                s = self.hold(a, u, a.N + ka * (u - a.u_m))
+            except RuntimeError:        # no state there (a jump): the last one found
+                return s
             k = self.slope(s)
             if abs(k) <= 1e-3 * max(abs(ka), abs(kb)) or abs(u - a.u_m) < 1e-9 * self.cup.h1_m:
                 return s

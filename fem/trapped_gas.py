@@ -33,12 +33,14 @@ contact state, with its sticking anchors and Coulomb slips, is carried from stat
 Only the geometric volume takes part (no wetted fraction: the gas law needs the volume the gas
 fills, and the load must be its derivative). For Coulomb friction the condensed contact problem
 (`fem.friction`) reads rows of the sparse part only, so its Newton step misses the rank-one term
-on the contact rows (an inexact tangent there; the energy and the residual stay exact).
+on the contact rows (an inexact tangent there; the energy and the residual stay exact);
+`tangent_rows` (`GasTangent.rows`) gives those rows with the term, K_s[rows] + c g[rows] g^T.
 """
 
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -54,7 +56,7 @@ from .linsolve import NotPositiveDefinite
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
 __all__ = ["K_B", "TrappedGas", "GasMechanics", "GasTangent", "RankOneSolver", "RankOneFactor",
-           "SymmetricLU", "follow_gas_path"]
+           "SymmetricLU", "follow_gas_path", "tangent_rows"]
 
 K_B = 1.380649e-23          # J/K (exact, SI 2019)
 
@@ -111,6 +113,12 @@ class GasTangent(sp.csr_matrix):
         """The sparse part K_s as a plain CSR matrix (the pattern the solver factors)."""
         return sp.csr_matrix((self.data, self.indices, self.indptr), shape=self.shape)
 
+    def rows(self, dofs: np.ndarray) -> sp.csr_matrix:
+        """The rows `dofs` of the whole tangent, K_s[dofs] + c g[dofs] g^T, as a sparse matrix
+        (g is nonzero on the cavity chain's dofs only): what a condensation onto a few rows
+        (`fem.friction`'s contact rows) needs; plain slicing gives the sparse part only."""
+        return tangent_rows(self, dofs)
+
     def __matmul__(self, other):
         out = super().__matmul__(other)
         if self.rank_one is None or not isinstance(other, np.ndarray):
@@ -120,6 +128,20 @@ class GasTangent(sp.csr_matrix):
 
     def dot(self, other):
         return self @ other
+
+
+def tangent_rows(K: sp.csr_matrix, dofs: np.ndarray) -> sp.csr_matrix:
+    """Rows `dofs` of a tangent with its rank-one term if it has one (`GasTangent`), else K[dofs]."""
+    rank_one = getattr(K, "rank_one", None)
+    Ks = _sparse_part(K)[dofs]
+    if rank_one is None:
+        return Ks
+    c, g = rank_one
+    support = np.flatnonzero(g)
+    block = c * np.outer(g[dofs], g[support])                  # [len(dofs), len(support)]
+    rows = np.repeat(np.arange(block.shape[0]), len(support))
+    return (Ks + sp.csr_matrix((block.ravel(), (rows, np.tile(support, block.shape[0]))),
+                               shape=Ks.shape)).tocsr()
 
 
 def _sparse_part(K):
@@ -253,8 +275,10 @@ class GasMechanics:
 
     def make_solver(self, pattern, coordinates: np.ndarray, mesh=None) -> "RankOneSolver":
         """The linear solver `follow_path` uses for this mechanics: the body's sparse factor with the
-        gas's rank-one term by Sherman-Morrison (module docstring)."""
-        return RankOneSolver(make_solver(_sparse_part(pattern), coordinates, mesh))
+        gas's rank-one term by Sherman-Morrison (module docstring). The body's solver depends on
+        the mesh and the tangent's pattern only, so it is built once per mesh (`_body_solver`):
+        a branch runs hundreds of short paths on one cup."""
+        return RankOneSolver(_body_solver(_sparse_part(pattern), coordinates, mesh))
 
     def at(self, t: float) -> "GasMechanics":
         if self.schedule is None:
@@ -303,6 +327,29 @@ class GasMechanics:
         g = np.bincount(dofs, grad, minlength=r.size)
         data = K.data + dp * np.bincount(self._load._positions(K, pairs), hess, minlength=K.nnz)
         return W + Pi_gas, r + dp * g, GasTangent.of(K, data, self.gas.NkT_J / V**2, g)
+
+
+_SOLVERS: dict[int, tuple] = {}      # id(mesh) -> (weakref to the mesh, pattern, coordinates, solver)
+
+
+def _body_solver(pattern: sp.csr_matrix, coordinates: np.ndarray, mesh):
+    """`fem.condensation.make_solver` of the pattern, reused while the mesh, its node coordinates
+    and the pattern are the same (the solver holds the ordering and condensation maps only; each
+    factorization is a new object)."""
+    if mesh is None:
+        return make_solver(pattern, coordinates, mesh)
+    kept = _SOLVERS.get(id(mesh))
+    if kept is not None and kept[0]() is mesh and kept[1].shape == pattern.shape \
+            and np.array_equal(kept[1].indptr, pattern.indptr) \
+            and np.array_equal(kept[1].indices, pattern.indices) and np.array_equal(kept[2], coordinates):
+        return kept[3]
+    solver = make_solver(pattern, coordinates, mesh)
+    for key in [k for k, v in _SOLVERS.items() if v[0]() is None]:
+        del _SOLVERS[key]
+    _SOLVERS[id(mesh)] = (weakref.ref(mesh), sp.csr_matrix((np.zeros(pattern.nnz), pattern.indices.copy(),
+                                                             pattern.indptr.copy()), shape=pattern.shape),
+                          np.array(coordinates, copy=True), solver)
+    return solver
 
 
 def follow_gas_path(mech: GasMechanics, dirichlet: Callable[[float], tuple[np.ndarray, np.ndarray]],

@@ -17,8 +17,10 @@ FEM's less the interface gas's rise over p_b across the zone [r_k, r_cut] (the m
 `interface`), averaged over the u_c table's patch length, its rings' gaps u_c(p / E) in series
 (`reduced.profile_leak`). The lifetime is t = int_{N0}^{N_max} dN / Q by the trapezoid in N over
 the branch states: N rises monotonically along the branch whereas u turns where the branch does
-(the walk switches to N as its parameter there), and 1/Q is smooth in N; the change when the
-plate step is halved measures the quadrature and branch error (benchmarks/bench_fem_route.py).
+(the walk switches to N as its parameter there), and 1/Q is smooth in N except where the
+seal's contact narrows to its last ring and Q falls several times within a plate step: there
+states are added midway (`refine_branch`). The change when the plate step is halved measures the
+quadrature and branch error (benchmarks/bench_fem_route.py, docs/lifetime.md).
 
 The largest holdable force is the largest pull along the plate raised at fixed N0 from the sealed
 state (the branch at a larger F1 does not start: the cup lets go at once).
@@ -146,6 +148,8 @@ class FemRoute:
 
     def __init__(self) -> None:
         self._sealed: dict[tuple, Sealed] = {}
+        # id(Sealed) -> it, its largest pull [N], the solver's message if that is a lower bound
+        self._largest: dict[int, tuple[Sealed, float, str | None]] = {}
 
     def check(self, model: LeakageModel, options: Mapping[str, Any]) -> None:
         from fem.interface import ContactLaw
@@ -184,8 +188,15 @@ class FemRoute:
         return self._sealed[key]
 
     def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
+        """The largest pull the sealed cup holds (`largest_pull`), once per sealed cup."""
+        return self._largest_checked(model, options)[0]
+
+    def _largest_checked(self, model: LeakageModel, options: Mapping[str, Any]) -> tuple[float, str | None]:
         sealed = self.seal(model, options)
-        return largest_pull(sealed.cup, sealed.state)
+        kept = self._largest.get(id(sealed))
+        if kept is None or kept[0] is not sealed:
+            kept = self._largest[id(sealed)] = (sealed, *largest_pull_checked(sealed.cup, sealed.state))
+        return kept[1], kept[2]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
         from fem.gas_branch import equilibrium_branch
@@ -196,10 +207,9 @@ class FemRoute:
         if run.refine != 1:
             raise ValueError(f"refine: the fem route has no dense output, got {run.refine}")
         sealed = self.seal(model, options, run.progress)
-        if run.progress:
-            run.progress(0.1, f"F1 = {force_N:g} N: following the branch")
-        branch = equilibrium_branch(sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]))
-        largest = self.largest_force(model, options)
+        branch = equilibrium_branch(sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
+                                    progress=_branch_progress(run.progress, force_N, sealed))
+        largest, partial = self._largest_checked(model, options)
         s0 = sealed.state
         provenance = {"route": self.name, "options": {**options, "cup": options["cup"].describe(),
                                                        "press": options["press"] and vars(options["press"])},
@@ -208,6 +218,8 @@ class FemRoute:
                       provenance=provenance)
         base = {"N0": s0.N, "u_sealed_mm": 1e3 * s0.u_m, "r_start_mm": 1e3 * s0.r_c_m,
                 "seal_r_sealed_mm": 1e3 * s0.seal_r_m, "branch_reason": branch.reason}
+        if partial is not None:       # the pull was still rising where the solver stopped
+            base["largest_force_lower_bound"] = partial
         if branch.reason == "not held":
             return Lifetime(reason="over_force", lifetime_s=0.0, message=f"F1 = {force_N:g} N exceeds "
                             f"what the sealed cup holds: it detaches at once", trajectory={},
@@ -215,12 +227,13 @@ class FemRoute:
         if branch.detachment is None:
             raise FemRouteError(f"F1 = {force_N:g} N: the branch ended without a detachment "
                                 f"({branch.reason}) after {len(branch.states)} states")
-        states = list(branch.states)
-        q = np.array([state_leak_rate(s, model, sealed.E_Pa, options["radial"]) for s in states])
+        leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, options["radial"])  # noqa: E731
+        states, q, added = refine_branch(sealed.cup, list(branch.states), [leak(s) for s in branch.states],
+                                         float(force_N), leak)
         N = np.array([s.N for s in states])
         columns = _columns(states, q)
         stats = branch.stats
-        details = {**base, "N_max": branch.N_max, "states": len(states), "snaps": branch.snaps,
+        details = {**base, "N_max": branch.N_max, "states": len(states), "refined": added, "snaps": branch.snaps,
                    "newton_iterations": stats.newton_iterations, "wall_time_s": stats.wall_time_s,
                    "seal_r_final_mm": 1e3 * states[-1].seal_r_m, "p_b_final_Pa": states[-1].p_b_Pa,
                    "u_final_mm": 1e3 * states[-1].u_m}
@@ -249,6 +262,58 @@ class FemRoute:
                         message=f"detached at t = {t[-1]:.4g} s: {where}", **common)
 
 
+#: the leak may change by at most this factor between neighbouring states where their interval
+#: carries more than REFINE_SHARE of the lifetime (`refine_branch`)
+REFINE_RATIO, REFINE_SHARE, REFINE_DEPTH = 2.0, 0.01, 3
+
+
+def refine_branch(cup: CupWithGas, states: list, q: list, force_N: float,
+                  leak: Callable[[Any], float]) -> tuple[list, np.ndarray, int]:
+    """The branch's states with states added where the trapezoid of 1/Q in N is not resolved:
+    between neighbours whose leak differs by more than REFINE_RATIO and whose interval carries
+    more than REFINE_SHARE of the lifetime (where the seal's last contact ring narrows, Q falls
+    several times within one plate step), a state midway (`fem.gas_branch.state_between`, from
+    the earlier state), up to REFINE_DEPTH halvings. (states, Q [1/s], states added)."""
+    from fem.gas_branch import state_between
+
+    states, q = list(states), list(q)
+    added = 0
+    for _ in range(REFINE_DEPTH):
+        N, Q = np.array([s.N for s in states]), np.array(q)
+        inv = np.where(np.isinf(Q), 0.0, 1.0 / np.where(Q > 0, Q, np.inf))
+        if np.any(Q <= 0) or len(states) < 2:
+            break
+        share = np.maximum(inv[1:], inv[:-1]) * np.diff(N)
+        total = float(lifetime_integral(N, Q)[-1])
+        finite = np.isfinite(Q[1:]) & np.isfinite(Q[:-1])
+        ratio = np.zeros(len(Q) - 1)
+        ratio[finite] = np.abs(np.log(Q[1:][finite] / Q[:-1][finite]))
+        todo = np.flatnonzero((ratio > math.log(REFINE_RATIO)) & (share > REFINE_SHARE * total))
+        if len(todo) == 0:
+            break
+        for k in todo[::-1]:                      # from the end: the indices before stay valid
+            mid = state_between(cup, states[k], states[k + 1], force_N)
+            if mid is not None:
+                states.insert(k + 1, mid)
+                q.insert(k + 1, leak(mid))
+                added += 1
+    return states, np.array(q), added
+
+
+def _branch_progress(report: Callable[[float, str], None] | None, force_N: float, sealed: Sealed):
+    """One progress line per branch state: the fraction is the plate's travel from the sealed
+    position towards -h1 (the branch's end is not known before it is reached)."""
+    if report is None:
+        return None
+    u0, N0, h1 = sealed.state.u_m, sealed.state.N, sealed.cup.h1_m
+    report(0.1, f"F1 = {force_N:g} N: following the branch")
+
+    def on_state(k: int, u_m: float, N: float) -> None:
+        report(0.1 + 0.85 * min(max((u0 - u_m) / (u0 + h1), 0.0), 1.0),
+               f"F1 = {force_N:g} N: branch state {k}, u = {1e3 * u_m:.3f} mm, N = {N / N0:.4g} N0")
+    return on_state
+
+
 def lifetime_integral(N: np.ndarray, q: np.ndarray) -> np.ndarray:
     """t(N) = int_{N_0}^{N} dN' / Q(N') [s] at every sample, by the trapezoid (1/Q = 0 where the
     seal is held open, Q = inf)."""
@@ -273,6 +338,12 @@ def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float
     `sealed` (module docstring): the path is followed up to -h1 until F1 has fallen by `drop` of
     its maximum or the solver stops (the seal opening), and the maximum refined by the parabola
     through the three states around it."""
+    return largest_pull_checked(cup, sealed, drop)[0]
+
+
+def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> tuple[float, str | None]:
+    """`largest_pull` and, where the solver stopped while the pull was still rising (the maximum
+    not reached: a lower bound only), the solver's message; else None."""
     from fem.solver import ConvergenceError
     from fem.trapped_gas import GasMechanics, TrappedGas, follow_gas_path
 
@@ -290,18 +361,22 @@ def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float
         if best > 0 and F1 < (1.0 - drop) * best:
             raise _Past
     options = replace(cup.options, max_step=min(cup.options.max_step, 0.01))
+    stopped = None
     try:
         follow_gas_path(mech, plate, span, plane=cup.cup.plane, start=sealed.state, options=options,
                         on_step=on_step)
-    except (_Past, ConvergenceError):
+    except _Past:
         pass
+    except ConvergenceError as err:
+        stopped = str(err)
     u, F = np.array(seen).T
     k = int(np.argmax(F))
+    partial = stopped if stopped is not None and k == F.size - 1 else None
     if 0 < k < F.size - 1:
         a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
         if a < 0:
-            return float(max(F[k], c - b * b / (4 * a)))
-    return float(F[k])
+            return float(max(F[k], c - b * b / (4 * a))), partial
+    return float(F[k]), partial
 
 
 def register() -> FemRoute:
