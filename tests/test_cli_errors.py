@@ -43,7 +43,7 @@ def no_solve(monkeypatch):
                                            "invalid choice: 'exact' (choose from 'emt', 'critical-junction')"),
     (["lifetime", "--force", "ten"], "cupcheck lifetime: error: argument --force: invalid float value: 'ten'"),
     (["nonsense"], "cupcheck: error: argument COMMAND: invalid choice: 'nonsense' (choose from "
-                   "'example', 'lifetime', 'render', 'run', 'stiffness', 'suction', 'sweep', 'uc', 'validate')"),
+                   "'example', 'lifetime', 'paper', 'render', 'run', 'stiffness', 'suction', 'sweep', 'uc', 'validate')"),
 ])
 def test_parser_errors_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys, no_solve, argv, message):
     monkeypatch.chdir(tmp_path)                 # anything written by mistake would land here
