@@ -28,8 +28,8 @@ class LogLogPchip:
         lx, ly = np.log(np.asarray(x, float)), np.log(np.asarray(y, float))
         self.n = len(lx)
         self._cubic = ScalarPchip(lx, ly, "log-log table")
-        self._lo = (float(lx[0]), float(ly[0]), float(self._cubic.pp(lx[0], 1)))
-        self._hi = (float(lx[-1]), float(ly[-1]), float(self._cubic.pp(lx[-1], 1)))
+        self._lo = (float(lx[0]), float(ly[0]), float(self._cubic.values_and_slopes(lx[:1])[1][0]))
+        self._hi = (float(lx[-1]), float(ly[-1]), float(self._cubic.values_and_slopes(lx[-1:])[1][0]))
 
     def value_and_slope(self, x: float) -> tuple[float, float]:
         """(y(x), d ln y / d ln x) for x > 0."""

@@ -31,7 +31,6 @@ from dataclasses import dataclass
 from importlib import resources
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .persson import critical_gap_table
 from .spectrum import PowerSpectrum, self_affine
@@ -93,6 +92,8 @@ def calibrate(name: str, method: str = "emt") -> Preset:
     def miss(ln_x: float) -> float:
         u_c = _uc_at_calibration(dict(base, **{free: float(np.exp(ln_x))}), method)
         return np.log(max(u_c, 1e-15) / target)
+
+    from scipy.optimize import brentq     # here: calibration only
 
     lo, hi = np.log(BRACKETS[free])
     params = dict(base, **{free: float(np.exp(brentq(miss, lo, hi, xtol=1e-6)))})
