@@ -5,8 +5,8 @@ spends no time in Persson theory (~0.1 s of CPU a table) and imports no scipy.sp
 A stored table is found by the hash of everything it is computed from: the spectrum's q, C and
 provenance, nu, method, gamma, a_c, the p/E grid, whether it carries its patch length, and the
 sources of this package (the theory's code). Any edit of those sources makes every stored table
-stale: it is then computed as before, until ``python -m reduced.roughness.stored`` writes them
-anew (tests/test_uc_stored.py fails meanwhile, and checks each stored table against a fresh
+stale: it is then computed as before, until ``python -m reduced.roughness.surfaces --tables``
+writes them anew (tests/test_uc_stored.py fails meanwhile, and checks each stored table against a fresh
 computation bit for bit). The floats are stored as their shortest repr, which reads back exactly.
 """
 
@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import sys
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -25,12 +24,13 @@ from reduced.critical_gap import UcTable
 
 from .spectrum import PowerSpectrum
 
-__all__ = ["request_key", "stored_table", "STORED_NU"]
+__all__ = ["request_key", "stored_table", "STORED_NU", "REPRODUCE"]
 
 #: the Poisson ratio of the stored tables: the paper's rubber, `cupcheck lifetime`'s and the
 #: scenes' default (`validation.bridge.pipeline.surface_uc_table`)
 STORED_NU = 0.5
 _FILE = "data/uc_tables.json"
+REPRODUCE = "python -m reduced.roughness.surfaces --tables"
 
 
 @lru_cache(maxsize=1)
@@ -74,29 +74,17 @@ def stored_table(key: str, p_over_E: np.ndarray) -> UcTable | None:
                    theory=entry["theory"])
 
 
-def _entry(name: str, table: UcTable) -> dict:
+def entry(name: str, table: UcTable) -> dict:
+    """What the store keeps of preset `name`'s table (its grid is the request's)."""
     return {"preset": name, "provenance": table.provenance, "patch_length_m": table.patch_length_m,
             "theory": dict(table.theory), "u_c_m": table.u_c_m.tolist(), "u_mean_m": table.u_mean_m.tolist(),
             "contact_area_ratio": table.contact_area_ratio.tolist(), "sealed": table.sealed.tolist()}
 
 
-def main() -> int:
-    """Compute every preset's table at the defaults of `uc_table` (nu = `STORED_NU`) and store them."""
-    from .persson import UC_TABLE_P_OVER_E, uc_table
-    from .surfaces import load_presets
-
-    tables = {}
-    for name, p in load_presets().items():
-        spectrum = p.spectrum()
-        key = request_key(spectrum, STORED_NU, "emt", 0.45, 0.42, UC_TABLE_P_OVER_E, True)
-        tables[key] = _entry(name, uc_table(spectrum, STORED_NU, stored=False))
-        print(f"{name:10s} {key}", file=sys.stderr)
+def write(tables: dict[str, dict]) -> Path:
+    """Replace the store by `tables` (key -> `entry`), one table a line."""
     path = Path(__file__).parent / _FILE
     rows = ",\n".join(f"{json.dumps(k)}: {json.dumps(v, separators=(',', ':'))}" for k, v in tables.items())
-    path.write_text(f'{{"reproduce": "python -m reduced.roughness.stored", "tables": {{\n{rows}\n}}}}\n')
-    print(path, file=sys.stderr)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    path.write_text(f'{{"reproduce": "{REPRODUCE}", "tables": {{\n{rows}\n}}}}\n')
+    _stored.cache_clear()
+    return path
