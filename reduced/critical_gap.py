@@ -137,16 +137,15 @@ class UcTable:
         object.__setattr__(self, "_open", LogLogPchip(ps[:open_rows], us[:open_rows]))
 
     def _vectorised(self) -> tuple:
-        """The interpolant for arrays (`values`): ln u_c PCHIP in ln p/E, power laws beyond; built
-        on first use (scipy.interpolate costs ~0.4 s to import, and scalar callers never need it)."""
+        """The interpolant for arrays (`values`): ln u_c PCHIP in ln p/E (the scalar path's, evaluated
+        on arrays as scipy's PchipInterpolator does, `reduced.fast_curve`), power laws beyond."""
         if self._vec is None:
-            from scipy.interpolate import PchipInterpolator
             n = self._open.n
             lx, ly = np.log(self._rows[0][:n]), np.log(self._rows[1][:n])
-            cubic = PchipInterpolator(lx, ly, extrapolate=False)
-            slopes = cubic([lx[0], lx[-1]], 1)
-            object.__setattr__(self, "_vec", (cubic, lx[0], ly[0], float(slopes[0]), lx[-1], ly[-1],
-                                              float(slopes[1])))
+            pchip = self._open.cubic
+            slopes = pchip.values_and_slopes(np.array([lx[0], lx[-1]]))[1]
+            object.__setattr__(self, "_vec", (lambda t: pchip.values_and_slopes(t)[0], lx[0], ly[0],
+                                              float(slopes[0]), lx[-1], ly[-1], float(slopes[1])))
         return self._vec
 
     def _interpolable(self) -> None:

@@ -60,3 +60,22 @@ def test_a_monotone_sample_stays_monotone_and_outside_is_refused():
 def test_bad_knots_are_refused_naming_the_field(x, y, field):
     with pytest.raises(ValueError, match=f"^{field}:"):
         pchip_coefficients(x, y)
+
+
+def test_the_uc_tables_array_path_is_scipys_pchip_in_log_log_bit_for_bit():
+    """`UcTable.values` runs on the same coefficients: inside the table scipy's PchipInterpolator of
+    ln u_c over ln p/E, beyond it the power laws with scipy's end slopes, to the last bit."""
+    from reduced.critical_gap import UcTable
+
+    p = np.geomspace(1e-5, 0.2, 30)
+    u = 1e-6 * (p / 0.025) ** -0.8 * (1.0 + 0.3 * np.sin(7.0 * np.log(p)))
+    table = UcTable(p, u)
+    lx, ly = np.log(p), np.log(u)
+    cubic = PchipInterpolator(lx, ly, extrapolate=False)
+    s0, s1 = cubic([lx[0], lx[-1]], 1)
+    x = np.geomspace(1e-8, 2.0, 2001)
+    t = np.log(x)
+    expected = np.exp(np.where(t < lx[0], ly[0] + s0 * (t - lx[0]),
+                               np.where(t > lx[-1], ly[-1] + s1 * (t - lx[-1]),
+                                        cubic(np.clip(t, lx[0], lx[-1])))))
+    assert np.array_equal(table.values(x), expected)
