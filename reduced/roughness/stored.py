@@ -4,8 +4,8 @@ spends no time in Persson theory (~0.1 s of CPU a table) and imports no scipy.sp
 
 A stored table is found by the hash of everything it is computed from: the spectrum's q, C and
 provenance, nu, method, gamma, a_c, the p/E grid, whether it carries its patch length, and the
-sources of this package (the theory's code). Any edit of those sources makes every stored table
-stale: it is then computed as before, until ``python -m reduced.roughness.surfaces --tables``
+sources of the theory (`THEORY`: the modules that compute a table from a spectrum). Any edit of
+those makes every stored table stale: it is then computed as before, until ``python -m reduced.roughness.surfaces --tables``
 writes them anew (tests/test_uc_stored.py fails meanwhile, and checks each stored table against a fresh
 computation bit for bit). The floats are stored as their shortest repr, which reads back exactly.
 """
@@ -30,16 +30,18 @@ __all__ = ["request_key", "stored_table", "STORED_NU", "REPRODUCE"]
 #: scenes' default (`validation.bridge.pipeline.surface_uc_table`)
 STORED_NU = 0.5
 _FILE = "data/uc_tables.json"
+#: the modules of this package whose code computes a u_c table from a spectrum
+THEORY = ("persson.py", "separation.py", "effective_medium.py", "spectrum.py")
 REPRODUCE = "python -m reduced.roughness.surfaces --tables"
 
 
 @lru_cache(maxsize=1)
 def _source_hash() -> str:
-    """A hash of this package's sources (the code that computes a u_c table)."""
+    """A hash of the sources that compute a u_c table (`THEORY`)."""
     h = hashlib.sha256()
-    for path in sorted(Path(__file__).parent.glob("*.py")):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
+    for name in THEORY:
+        h.update(name.encode())
+        h.update((Path(__file__).parent / name).read_bytes())
     return h.hexdigest()
 
 
