@@ -25,8 +25,8 @@ from typing import Any, Protocol
 from reduced.lifetime.result import Lifetime, _PaperRecord
 from reduced.model import LeakageModel
 
-# each route imports its machinery when it first runs (a paper-route lifetime loads no coupled
-# cavity, and the force balance's interpolants only when a strip or profile route is asked for)
+# each route imports its machinery when it first runs: a paper-route lifetime loads no coupled
+# cavity, a coupled one no force balance
 
 __all__ = ["Route", "Run", "ROUTES", "register_route", "solve_lifetime", "largest_holdable_force"]
 
