@@ -1,6 +1,7 @@
 """Where users wait: whole-process times of the commands users run, and their ratio to a baseline.
 
     OMP_NUM_THREADS=1 python benchmarks/bench_speed.py [--repeat 5] [--with-suction] [--against ../pristine]
+    OMP_NUM_THREADS=1 python benchmarks/bench_speed.py --only help lifetime_paper curve_coarse
     python benchmarks/bench_speed.py --tree ../old-checkout --write-baseline    # record a baseline
 
 Every figure is a whole `cupcheck` process (start-up included), the median of --repeat runs:
@@ -12,7 +13,11 @@ Each is printed beside benchmarks/speed_baseline.json (the same figures on an ea
 ratio, new / baseline, so a change's speed-up or slow-down is one number, and beside its target.
 The CPU time (user + system) of each process is printed too: on a machine shared with other work
 it moves much less than the wall time. --against times another checkout in the same run, each of
-its runs next to this tree's, so that the ratio to it holds on a loaded machine too.
+its runs next to this tree's, so that the ratio to it holds on a loaded machine too. --only
+times the named figures alone (what they need, e.g. the medium curve of the profile route, is still
+made, untimed). --pyc lets the processes cache their compiled bytecode (in a temporary
+PYTHONPYCACHEPREFIX, as an installed package does) where the environment sets
+PYTHONDONTWRITEBYTECODE: else every run compiles the project's sources anew (~0.05 s of a command).
 """
 
 from __future__ import annotations
@@ -41,9 +46,12 @@ TARGETS = {"help": 0.15, "curve_coarse": 0.35, "curve_medium": 0.7, "main_cold":
 class Runner:
     """Runs `cupcheck ARGS` as a whole process in one checkout (its sources first on the path)."""
 
-    def __init__(self, tree: Path, work: Path):
+    def __init__(self, tree: Path, work: Path, pyc: bool = False):
         self.tree, self.work = tree, work
         self.env = {**os.environ, "PYTHONPATH": str(tree), "MPLBACKEND": "Agg"}
+        if pyc:
+            self.env.pop("PYTHONDONTWRITEBYTECODE", None)
+            self.env["PYTHONPYCACHEPREFIX"] = str(work / "pyc")
 
     def __call__(self, *args: str) -> tuple[float, float]:
         """(wall time, CPU time: user + system) of one run [s]."""
@@ -67,26 +75,44 @@ def median(run: Callable[[], tuple[float, float]], repeat: int,
     return statistics.median(t[0] for t in times), statistics.median(t[1] for t in times)
 
 
-def figures(cli: Runner, repeat: int, with_suction: bool) -> Iterator[tuple[str, tuple[float, float]]]:
-    """(name, (wall, CPU) [s]) of each figure, in turn."""
+#: the figures in the order they are timed
+NAMES = ("help", "curve_coarse", "curve_medium", "main_cold", "main_warm", "lifetime_paper",
+         "lifetime_profile", "profile_per_force", "suction_coarse", "lifetime_coupled")
+
+
+def figures(cli: Runner, repeat: int, with_suction: bool,
+            only: frozenset[str] = frozenset(NAMES)) -> Iterator[tuple[str, tuple[float, float]]]:
+    """(name, (wall, CPU) [s]) of each figure in `only`, in turn."""
     w = cli.work
-    yield "help", median(lambda: cli("--help"), repeat)
-    yield "curve_coarse", median(lambda: cli("stiffness", "--cup", "A", "--fidelity", "coarse",
-                                             "--out", str(w / "coarse.csv")), repeat)
-    yield "curve_medium", median(lambda: cli("stiffness", "--cup", "A", "--fidelity", "medium",
-                                             "--out", str(w / "medium.csv")), repeat)
+    if "help" in only:
+        yield "help", median(lambda: cli("--help"), repeat)
+    if "curve_coarse" in only:
+        yield "curve_coarse", median(lambda: cli("stiffness", "--cup", "A", "--fidelity", "coarse",
+                                                 "--out", str(w / "coarse.csv")), repeat)
+    medium = lambda: cli("stiffness", "--cup", "A", "--fidelity", "medium", "--out", str(w / "medium.csv"))  # noqa: E731
+    if "curve_medium" in only:
+        yield "curve_medium", median(medium, repeat)
     main = ["run", "scenes/main.toml", "--quiet", "--out"]
-    yield "main_cold", median(lambda: cli(*main, str(w / "main_cold"), "--no-cache"), repeat)
-    cli(*main, str(w / "main_warm"), "--cache-dir", str(w / "cache"))          # fill the cache
-    yield "main_warm", median(lambda: cli(*main, str(w / "main_warm"), "--cache-dir", str(w / "cache")), repeat)
+    if "main_cold" in only:
+        yield "main_cold", median(lambda: cli(*main, str(w / "main_cold"), "--no-cache"), repeat)
+    if "main_warm" in only:
+        cli(*main, str(w / "main_warm"), "--cache-dir", str(w / "cache"))          # fill the cache
+        yield "main_warm", median(lambda: cli(*main, str(w / "main_warm"), "--cache-dir", str(w / "cache")),
+                                  repeat)
     paper = ["lifetime", "--cup", "A", "--surface", "pmma-1.89", "--force"]
-    yield "lifetime_paper", median(lambda: cli(*paper, "10"), repeat)
+    if "lifetime_paper" in only:
+        yield "lifetime_paper", median(lambda: cli(*paper, "10"), repeat)
     profile = ["lifetime", "--stiffness", str(w / "medium.csv"), "--route", "profile", "--surface",
                "pmma-1.89", "--force"]
-    one = median(lambda: cli(*profile, "10"), repeat)
-    many = median(lambda: cli(*profile, *FORCES), repeat)
-    yield "lifetime_profile", one
-    yield "profile_per_force", tuple((m - o) / (len(FORCES) - 1) for m, o in zip(many, one))
+    if only & {"lifetime_profile", "profile_per_force"}:
+        if "curve_medium" not in only:
+            medium()                                                                # its input, untimed
+        one = median(lambda: cli(*profile, "10"), repeat)
+        if "lifetime_profile" in only:
+            yield "lifetime_profile", one
+        if "profile_per_force" in only:
+            many = median(lambda: cli(*profile, *FORCES), repeat)
+            yield "profile_per_force", tuple((m - o) / (len(FORCES) - 1) for m, o in zip(many, one))
     if with_suction:
         table = str(w / "suction.json")
         yield "suction_coarse", median(lambda: cli("suction", "--cup", "A", "--fidelity", "coarse",
@@ -106,8 +132,15 @@ def main() -> None:
     ap.add_argument("--against", type=Path, default=None,
                     help="another checkout timed in the same run, figure by figure (its ratio: tree / against)")
     ap.add_argument("--with-suction", action="store_true", help="also the coarse suction table (minutes)")
+    ap.add_argument("--pyc", action="store_true",
+                    help="cache compiled bytecode between runs (a temporary PYTHONPYCACHEPREFIX)")
+    ap.add_argument("--only", nargs="+", choices=NAMES, default=None, metavar="FIGURE",
+                    help=f"time only these figures ({', '.join(NAMES)})")
     ap.add_argument("--write-baseline", action="store_true", help=f"store the figures as {BASELINE.name}")
     args = ap.parse_args()
+    if args.only is not None and args.write_baseline:
+        ap.error("--write-baseline: records every figure; drop --only")
+    only = frozenset(args.only or NAMES)
     tree = args.tree.resolve()
     base = json.loads(BASELINE.read_text())["seconds"] if BASELINE.is_file() else {}
     got: dict[str, float] = {}
@@ -116,9 +149,9 @@ def main() -> None:
         head += f" {'against':>8s} {'cpu':>7s} {'ratio':>6s} {'cpu':>6s}"
     print(head + f" {'target':>7s}", flush=True)
     with tempfile.TemporaryDirectory() as d, tempfile.TemporaryDirectory() as e:
-        other = figures(Runner(args.against.resolve(), Path(e)), args.repeat, args.with_suction) \
+        other = figures(Runner(args.against.resolve(), Path(e), args.pyc), args.repeat, args.with_suction, only) \
             if args.against is not None else None
-        for name, (t, cpu) in figures(Runner(tree, Path(d)), args.repeat, args.with_suction):
+        for name, (t, cpu) in figures(Runner(tree, Path(d), args.pyc), args.repeat, args.with_suction, only):
             got[name] = t
             b = base.get(name)
             line = (f"{name:18s} {t:9.3f} {cpu:8.3f} {_cell(b, 9)} "

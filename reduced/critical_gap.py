@@ -35,7 +35,6 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from reduced.loglog import LogLogPchip, elementwise, read_two_columns
 
@@ -89,7 +88,7 @@ class UcTable:
     _rows: tuple = field(init=False, repr=False, compare=False)
     _open: LogLogPchip | None = field(init=False, repr=False, compare=False)
     _seal: float = field(init=False, repr=False, compare=False)
-    _vec: tuple = field(init=False, repr=False, compare=False)
+    _vec: tuple | None = field(init=False, repr=False, compare=False)
 
     def __reduce__(self):
         """Pickle by the constructor's fields, the read-only mappings as plain dicts (a
@@ -131,16 +130,23 @@ class UcTable:
             raise ValueError("u_c_m: a sealed (0) row may only be followed by sealed rows")
         object.__setattr__(self, "_rows", (ps, us))
         object.__setattr__(self, "_seal", float(ps[open_rows]) if open_rows < ps.size else math.inf)
+        object.__setattr__(self, "_vec", None)         # built by the first `values` call
         if open_rows < 2:
             object.__setattr__(self, "_open", None)
-            object.__setattr__(self, "_vec", ())
             return
         object.__setattr__(self, "_open", LogLogPchip(ps[:open_rows], us[:open_rows]))
-        # the same interpolant for arrays (`values`): ln u_c PCHIP in ln p/E, power laws beyond
-        lx, ly = np.log(ps[:open_rows]), np.log(us[:open_rows])
-        cubic = PchipInterpolator(lx, ly, extrapolate=False)
-        slopes = cubic([lx[0], lx[-1]], 1)
-        object.__setattr__(self, "_vec", (cubic, lx[0], ly[0], float(slopes[0]), lx[-1], ly[-1], float(slopes[1])))
+
+    def _vectorised(self) -> tuple:
+        """The interpolant for arrays (`values`): ln u_c PCHIP in ln p/E (the scalar path's, evaluated
+        on arrays as scipy's PchipInterpolator does, `reduced.fast_curve`), power laws beyond."""
+        if self._vec is None:
+            n = self._open.n
+            lx, ly = np.log(self._rows[0][:n]), np.log(self._rows[1][:n])
+            pchip = self._open.cubic
+            slopes = pchip.values_and_slopes(np.array([lx[0], lx[-1]]))[1]
+            object.__setattr__(self, "_vec", (lambda t: pchip.values_and_slopes(t)[0], lx[0], ly[0],
+                                              float(slopes[0]), lx[-1], ly[-1], float(slopes[1])))
+        return self._vec
 
     def _interpolable(self) -> None:
         if self._open is None:
@@ -176,7 +182,7 @@ class UcTable:
         if x.size and not np.all(x > 0):
             raise ValueError(f"p_over_E: contact pressure over modulus must be > 0, got {x[~(x > 0)][0]}")
         self._interpolable()
-        cubic, t_lo, y_lo, s_lo, t_hi, y_hi, s_hi = self._vec
+        cubic, t_lo, y_lo, s_lo, t_hi, y_hi, s_hi = self._vectorised()
         t = np.log(x)
         inside = np.clip(t, t_lo, t_hi)
         ln_u = np.where(t < t_lo, y_lo + s_lo * (t - t_lo), np.where(t > t_hi, y_hi + s_hi * (t - t_hi), cubic(inside)))

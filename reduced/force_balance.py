@@ -28,11 +28,11 @@ import weakref
 from functools import cached_property
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from reduced.fast_curve import CurveRangeError, ScalarPchip
 from reduced.geometry import geometry_source
 from reduced.model import LeakageModel
+from reduced.roots import brentq
 from reduced.seal import SEALS, ProfileSeal, StripSeal
 from reduced.viscoelastic import measurement_contact_time
 
@@ -256,6 +256,7 @@ class ForceBalance:
         cap = self.liquid_capacity(hh)
         j = int(np.argmax(cap))
         if 0 < j < len(hh) - 1:       # an interior maximum: refine it between its neighbours
+            from scipy.optimize import minimize_scalar     # here: a cavitating liquid only
             res = minimize_scalar(lambda x: -float(self.liquid_capacity(np.array([x]))[0]),
                                   bounds=(float(hh[j - 1]), float(hh[j + 1])), method="bounded",
                                   options={"xatol": 1e-12 * self.h1})

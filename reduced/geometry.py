@@ -15,10 +15,10 @@ displacement u = h_ref_m - h is measured from `h_ref_m`, the source's undeformed
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 from reduced.cup import CupParameters
 from reduced.fast_curve import CurveRangeError, ScalarPchip
+from reduced.roots import brentq
 from reduced.stiffness_curve import StiffnessCurve
 
 __all__ = ["ConeGeometry", "CurveGeometry", "geometry_source"]

@@ -27,15 +27,15 @@ class LogLogPchip:
     def __init__(self, x: np.ndarray, y: np.ndarray):
         lx, ly = np.log(np.asarray(x, float)), np.log(np.asarray(y, float))
         self.n = len(lx)
-        self._cubic = ScalarPchip(lx, ly, "log-log table")
-        self._lo = (float(lx[0]), float(ly[0]), float(self._cubic.pp(lx[0], 1)))
-        self._hi = (float(lx[-1]), float(ly[-1]), float(self._cubic.pp(lx[-1], 1)))
+        self.cubic = ScalarPchip(lx, ly, "log-log table")
+        self._lo = (float(lx[0]), float(ly[0]), float(self.cubic.values_and_slopes(lx[:1])[1][0]))
+        self._hi = (float(lx[-1]), float(ly[-1]), float(self.cubic.values_and_slopes(lx[-1:])[1][0]))
 
     def value_and_slope(self, x: float) -> tuple[float, float]:
         """(y(x), d ln y / d ln x) for x > 0."""
         t = math.log(x)
         if self._lo[0] <= t <= self._hi[0]:
-            ly, slope = self._cubic.value_and_slope(t)
+            ly, slope = self.cubic.value_and_slope(t)
             return math.exp(ly), slope
         t_end, ly_end, slope = self._lo if t < self._lo[0] else self._hi
         return math.exp(ly_end + slope * (t - t_end)), slope

@@ -11,14 +11,15 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-from reduced.appendix_a import appendix_a_curve
 from reduced.cup import CupParameters
 from reduced.gas import AIR, WATER_VISCOSITY_PA_S, Gas
-from reduced.stiffness_curve import StiffnessCurve
-from reduced.suction_table import SuctionTable
-from reduced.table_surface import INTERFACES
-from reduced.viscoelastic import RelaxationModulus
+
+if TYPE_CHECKING:                 # the model only holds these: building one imports no interpolant
+    from reduced.stiffness_curve import StiffnessCurve
+    from reduced.suction_table import SuctionTable
+    from reduced.viscoelastic import RelaxationModulus
 
 __all__ = ["LeakageModel", "reference_model", "FLUIDS"]
 
@@ -69,6 +70,7 @@ class LeakageModel:
             raise ValueError(f"kappa: stiffness factor must be > 0, got {self.kappa}")
         if self.phi0_s is not None and not self.phi0_s > 0:
             raise ValueError(f"phi0_s: measurement contact time must be > 0 s, got {self.phi0_s}")
+        from reduced.table_surface import INTERFACES
         if self.interface not in INTERFACES:
             raise ValueError(f"interface: expected one of {', '.join(INTERFACES)}, got {self.interface!r}")
         if self.fluid not in FLUIDS:
@@ -95,6 +97,7 @@ def reference_model(cup: CupParameters, u_c: Callable[[float], float]) -> Leakag
     """The paper's reference conventions (`reduced.lifetime.paper`) for `cup` and `u_c`: Appendix A
     stiffness (d0 = 2 mm, E = 4 MPa), no relaxation, air at 293.15 K, p_a = 1e5 Pa (the paper's rigid
     cone is the paper route's default cup_laws)."""
+    from reduced.appendix_a import appendix_a_curve
     return LeakageModel(cup=cup, stiffness=appendix_a_curve(cup, E_Pa=4e6, d0_m=2e-3), u_c=u_c,
                         gas=Gas(T_K=293.15, molecular_mass_u=28.97, viscosity_Pa_s=1.81e-5),
                         p_a_Pa=1e5, E_Pa=4e6, relaxation=None, label="reference")

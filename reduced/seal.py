@@ -43,7 +43,6 @@ import math
 from bisect import bisect_right
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from reduced.gas import Gas, ballistic_share, interpolated_leak_rate, liquid_volume_rate
 from reduced.profile_leak import (ContactProfile, patch_average, patch_contact, profile_leak_rate,
@@ -324,6 +323,7 @@ class PbTable:
     TAU = np.unique(np.concatenate([np.arange(-14.0, -5.0, 0.1), np.linspace(-5.0, math.log(0.999), 251)]))
 
     def __init__(self, tau: np.ndarray, log_ratio: np.ndarray, p_a: float):
+        from scipy.interpolate import CubicSpline     # here: scipy.interpolate costs ~0.4 s to import
         spline = CubicSpline(tau, log_ratio)
         self.x = [float(v) for v in spline.x]
         self.c3, self.c2, self.c1, self.c0 = ([float(v) for v in row] for row in spline.c)

@@ -35,7 +35,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from reduced.curve_files import (CSV_COLUMNS, OPTIONAL_COLUMNS, profiles_from_lists, read_curve_csv,
                                   read_profiles_csv, write_curve_csv)
@@ -167,7 +166,7 @@ class StiffnessCurve:
                 f"range [{1e3 * (self.h1_m - hi):.6g}, {1e3 * (self.h1_m - lo):.6g}] mm")
         return np.clip(u, lo, hi)
 
-    def _interpolant(self, name: str) -> PchipInterpolator:
+    def _interpolant(self, name: str) -> Any:
         interps = self._interpolants
         if name not in interps:
             raise ValueError(f"{name}: this stiffness curve has no such column "
@@ -175,8 +174,9 @@ class StiffnessCurve:
         return interps[name]
 
     @cached_property
-    def _interpolants(self) -> dict[str, PchipInterpolator]:
+    def _interpolants(self) -> dict[str, Any]:
         names = ("F0_N",) + tuple(n for n in OPTIONAL_COLUMNS if self.has(n))
+        from scipy.interpolate import PchipInterpolator     # here: scipy.interpolate costs ~0.4 s to import
         return {n: PchipInterpolator(self.u_m, getattr(self, n), extrapolate=False) for n in names}
 
     # --------------------------------------------------------------------- IO

@@ -14,7 +14,6 @@ import bisect
 from functools import cached_property
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from reduced.profile_leak import ContactProfile, patch_average
 from reduced.suction_table import SuctionTable
@@ -34,6 +33,7 @@ class TableSurface:
 
     def __init__(self, u: np.ndarray, dp: np.ndarray, z: np.ndarray, along_u: str):
         self.u, self.dp, self.z = u, dp, np.asarray(z, dtype=float)
+        from scipy.interpolate import PchipInterpolator     # here: scipy.interpolate costs ~0.4 s to import
         self.slope = (PchipInterpolator(u, self.z, axis=0).derivative()(u) if along_u == "pchip"
                       else None)
 

@@ -1,7 +1,10 @@
 """A command imports only what it uses: `cupcheck --help` and bare `cupcheck` import no command
 module (nor numpy); a reduced-model-only command (`lifetime --route paper`, `uc`) imports no FEM
-machinery, no plotting, no dask, no pyvista, no scipy.signal. Each case is a fresh process (the
-modules a test session has already loaded say nothing), its `sys.modules` read after the command ran.
+machinery, no plotting, no dask, no pyvista, no scipy.signal; the paper route's lifetime on a preset
+surface imports no scipy at all (its u_c table is stored, its interpolants and roots are the
+project's own: scipy.interpolate and scipy.optimize cost ~0.5 s to import, more than the command);
+a stiffness curve without a mesh file imports no meshio. Each case is a fresh process (the modules
+a test session has already loaded say nothing), its `sys.modules` read after the command ran.
 """
 
 from __future__ import annotations
@@ -69,11 +72,25 @@ def test_a_reduced_model_command_imports_no_fem_and_no_plotting(argv, tmp_path):
     assert "reduced.lifetime" in modules or "reduced.roughness" in modules
 
 
+@pytest.mark.parametrize("argv", [
+    ["lifetime", "--cup", "A", "--force", "10", "--route", "paper"],
+    ["lifetime", "--reference-mode", "--force", "5", "80"],
+    ["lifetime", "--cup", "B", "--force", "10", "40", "--surface", "table", "--relaxation", "default"],
+], ids=["paper", "reference-mode", "relaxed"])
+def test_the_paper_route_imports_no_scipy(argv, tmp_path):
+    modules = _modules_after(argv, tmp_path)
+    assert "scipy" not in _top(modules), sorted(m for m in modules if m.startswith("scipy"))[:10]
+    # the test can fail: the lifetime was computed, on the force balance and a u_c table
+    assert {"reduced.force_balance", "reduced.critical_gap", "reduced.roughness.stored"} <= modules
+
+
 def test_a_fem_command_does_import_the_fem(tmp_path):
-    """The check above sees imports: a command that runs the FEM shows skfem."""
+    """The checks above see imports: a command that runs the FEM shows skfem (and scipy); without
+    a mesh file it reads none (no meshio)."""
     modules = _modules_after(["stiffness", "--cup", "A", "--fidelity", "coarse", "--out",
                               str(tmp_path / "c.csv")], tmp_path)
-    assert "skfem" in _top(modules)
+    assert {"skfem", "scipy"} <= _top(modules)
+    assert "meshio" not in _top(modules)
 
 
 @pytest.mark.parametrize("name", COMMANDS)

@@ -5,13 +5,37 @@
 - `paper`: the integrator of the paper and profile routes (eqs 3-10 in time), private to them.
 - `quadrature`: the same lifetime without relaxation as a quadrature, a second method.
 
-The model (`LeakageModel`) lives in `reduced.model`.
+The model (`LeakageModel`) lives in `reduced.model`. The names are loaded on first use (PEP 562)
+and a route loads its own modules when it first runs, so a paper-route lifetime imports nothing
+of the coupled route.
 """
 
-from reduced.lifetime.quadrature import lifetime_by_quadrature
-from reduced.lifetime.result import REASONS, Lifetime
-from reduced.lifetime.routes import ROUTES, Route, Run, largest_holdable_force, register_route, solve_lifetime
-from reduced.model import LeakageModel, reference_model
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+#: public name -> the module that defines it
+_WHERE = {
+    "lifetime_by_quadrature": "reduced.lifetime.quadrature",
+    "REASONS": "reduced.lifetime.result", "Lifetime": "reduced.lifetime.result",
+    **{name: "reduced.lifetime.routes" for name in ("ROUTES", "Route", "Run", "largest_holdable_force",
+                                                     "register_route", "solve_lifetime")},
+    "LeakageModel": "reduced.model", "reference_model": "reduced.model",
+}
 
 __all__ = ["LeakageModel", "reference_model", "solve_lifetime", "largest_holdable_force", "Lifetime",
            "REASONS", "ROUTES", "Route", "Run", "register_route", "lifetime_by_quadrature"]
+
+
+def __getattr__(name: str) -> Any:
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'reduced.lifetime' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + __all__)

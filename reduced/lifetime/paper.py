@@ -48,12 +48,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 import numpy as np
-from scipy.optimize import brentq
 
 from reduced.fast_curve import CurveRangeError
 from reduced.force_balance import ForceBalance
 from reduced.lifetime.result import _PaperRecord
 from reduced.ode import dopri5
+from reduced.roots import brentq
 
 __all__ = ["integrate", "start_height", "sealed_on_branch", "check_run"]
 _DYNAMIC_FOLD = 1e-4  # |D| / |D(0)| at which the relaxed dynamics is declared singular

@@ -22,12 +22,11 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from reduced.coupled import CoupledCavity
-from reduced.force_balance import force_balance
-from reduced.lifetime.paper import check_run, integrate
 from reduced.lifetime.result import Lifetime, _PaperRecord
 from reduced.model import LeakageModel
-from reduced.viscoelastic import measurement_contact_time
+
+# each route imports its machinery when it first runs: a paper-route lifetime loads no coupled
+# cavity, a coupled one no force balance
 
 __all__ = ["Route", "Run", "ROUTES", "register_route", "solve_lifetime", "largest_holdable_force"]
 
@@ -83,9 +82,11 @@ class _StripOrProfile:
         _needs(model, "u_c", "a critical gap u_c(p/E) (e.g. a UcTable)", self.name)
 
     def core(self, model: LeakageModel, options: Mapping[str, Any]):
+        from reduced.force_balance import force_balance
         return force_balance(model, self.laws(model, options), self.seal, exact=options.get("exact", False))
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
+        from reduced.lifetime.paper import integrate
         record = integrate(self.core(model, options), force_N, t_max_s=run.t_max_s,
                            rtol=run.rtol, refine=run.refine, progress=run.progress)
         return self.result(record, model, run, {**options, "cup_laws": self.laws(model, options)})
@@ -158,8 +159,11 @@ class CoupledRoute:
         if u_start is not None and not math.isfinite(u_start):
             raise ValueError(f"u_start_m: must be finite, got {u_start}")
 
-    def cavity(self, model: LeakageModel, options: Mapping[str, Any]) -> tuple[CoupledCavity, float, dict]:
-        """(the cavity, u_start [m], cache) for `model` and `options`, built once per pair."""
+    def cavity(self, model: LeakageModel, options: Mapping[str, Any]) -> tuple[Any, float, dict]:
+        """(the `reduced.coupled.CoupledCavity`, u_start [m], cache) for `model` and `options`,
+        built once per pair."""
+        from reduced.coupled import CoupledCavity
+        from reduced.viscoelastic import measurement_contact_time
         key = tuple(sorted(options.items()))
         per_model = self._cavities.setdefault(model, {})
         if key not in per_model:
@@ -186,6 +190,7 @@ class CoupledRoute:
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
         if run.refine != 1:
             raise ValueError(f"refine: the coupled route has no dense output, got {run.refine}")
+        from reduced.lifetime.paper import check_run
         check_run(force_N, run.t_max_s, run.rtol, run.refine)
         cc, u_start, _ = self.cavity(model, options)
         record = cc._lifetime(force_N, u_start, t_max_s=run.t_max_s, rtol=run.rtol)

@@ -7,7 +7,7 @@ Public entry points::
 
 Modules: `spectrum` (convention, parametric spectra, 1D <-> 2D), `line_scan`, `separation` (moments,
 contact area, mean separation), `persson` (critical junction, the u_c table), `effective_medium` (Bruggeman leak rate), `surfaces`
-(calibrated presets), `bem` (a periodic boundary-element check).
+(calibrated presets), `stored` (the presets' u_c tables, shipped), `bem` (a periodic boundary-element check).
 """
 
 from .line_scan import read_line_scan, spectrum_from_line_scan

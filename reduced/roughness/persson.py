@@ -24,7 +24,6 @@ from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
-from scipy.special import erfinv
 
 from reduced.critical_gap import UcTable
 
@@ -40,6 +39,7 @@ from .spectrum import PowerSpectrum
 
 def critical_magnification(mom: Moments, pstar: np.ndarray, a_c: float) -> tuple[np.ndarray, np.ndarray]:
     """(ln q_c, sealed): A(q_c)/A0 = a_c in closed form; sealed where A/A0 >= a_c at q1."""
+    from scipy.special import erfinv     # here: scipy.special costs ~0.3 s to import
     m_c = (np.asarray(pstar, float) / erfinv(a_c)) ** 2 / np.pi
     sealed = m_c >= mom.m[-1]
     return mom.lnq_at_m(np.minimum(m_c, mom.m[-1])), sealed
@@ -154,7 +154,8 @@ UC_TABLE_P_OVER_E = np.geomspace(1e-6, 1.0, 241)
 
 
 def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: float = 0.45,
-             a_c: float = 0.42, p_over_E: np.ndarray | None = None, with_patch_length: bool = True):
+             a_c: float = 0.42, p_over_E: np.ndarray | None = None, with_patch_length: bool = True,
+             stored: bool = True):
     """u_c(p/E) of `spectrum` as the reduced model's `UcTable` (log-log interpolated).
 
     Without adhesion the theory is linear elastic: u_c depends on p and E only through p/E*, so
@@ -166,8 +167,16 @@ def uc_table(spectrum: PowerSpectrum, nu: float, *, method: str = "emt", gamma: 
     pressure over it (`reduced.profile_leak`, `reduced.seal`; it makes that route converge under mesh
     refinement; eq (10)'s strip is then at least one patch wide, `reduced.seal.ProfileSeal.width`).
     On by default; False: the raw FEM profile (mesh-dependent where the rim corner alone touches).
+
+    With `stored`, a request the package stores the answer to (a calibrated preset at the defaults,
+    `reduced.roughness.stored`) is read, not computed: the same table, bit for bit.
     """
     grid = UC_TABLE_P_OVER_E if p_over_E is None else np.asarray(p_over_E, float)
+    if stored:
+        from .stored import request_key, stored_table
+        table = stored_table(request_key(spectrum, nu, method, gamma, a_c, grid, with_patch_length), grid)
+        if table is not None:
+            return table
     table = critical_gap_table(spectrum, 1e6, nu, grid, method=method, gamma=gamma, a_c=a_c)
     note = (f"Persson theory ({method}, gamma {gamma:g}, a_c {a_c:g}, nu {nu:g}) of "
             f"{spectrum.provenance}")

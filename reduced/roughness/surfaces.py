@@ -20,7 +20,8 @@ the hump's share of <h^2> (with the hump carrying most of the rms, u_c comes out
 above 0.85 um, for every roll-off: the bump is a feature on top of long-wavelength roughness).
 
 The calibration (parameters, target, achieved value, conditions) is stored in
-``data/presets.json``; ``python -m reduced.roughness.surfaces`` recomputes and rewrites it.
+``data/presets.json``; ``python -m reduced.roughness.surfaces`` recomputes and rewrites it, and the
+presets' u_c tables (`reduced.roughness.stored`; ``--tables``: only these).
 """
 
 from __future__ import annotations
@@ -31,9 +32,9 @@ from dataclasses import dataclass
 from importlib import resources
 
 import numpy as np
-from scipy.optimize import brentq
 
-from .persson import critical_gap_table
+from . import stored
+from .persson import UC_TABLE_P_OVER_E, critical_gap_table, uc_table
 from .spectrum import PowerSpectrum, self_affine
 
 ATM_PA = 101325.0
@@ -94,6 +95,8 @@ def calibrate(name: str, method: str = "emt") -> Preset:
         u_c = _uc_at_calibration(dict(base, **{free: float(np.exp(ln_x))}), method)
         return np.log(max(u_c, 1e-15) / target)
 
+    from scipy.optimize import brentq     # here: calibration only
+
     lo, hi = np.log(BRACKETS[free])
     params = dict(base, **{free: float(np.exp(brentq(miss, lo, hi, xtol=1e-6)))})
     achieved = _uc_at_calibration(params, method)
@@ -117,8 +120,24 @@ def preset(name: str) -> Preset:
     return presets[name]
 
 
-def main() -> int:
-    """Recalibrate every preset and rewrite data/presets.json."""
+def store_tables() -> None:
+    """Compute every preset's u_c table at `uc_table`'s defaults (nu = `stored.STORED_NU`) and
+    store them (data/uc_tables.json)."""
+    tables = {}
+    for name, p in load_presets().items():
+        spectrum = p.spectrum()
+        key = stored.request_key(spectrum, stored.STORED_NU, "emt", 0.45, 0.42, UC_TABLE_P_OVER_E, True)
+        tables[key] = stored.entry(name, uc_table(spectrum, stored.STORED_NU, stored=False))
+        print(f"{name:10s} u_c table {key}", file=sys.stderr)
+    print(stored.write(tables), file=sys.stderr)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Recalibrate every preset and rewrite data/presets.json and the stored u_c tables
+    (``--tables``: the tables only)."""
+    if "--tables" in (sys.argv[1:] if argv is None else argv):
+        store_tables()
+        return 0
     out = []
     for name in TARGETS:
         p = calibrate(name)
@@ -132,6 +151,7 @@ def main() -> int:
     with open(path, "w") as f:
         json.dump(out, f, indent=1)
         f.write("\n")
+    store_tables()
     return 0
 
 

@@ -137,7 +137,6 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     """Validate every input and build the mesh and material (cheap); raise ValueError."""
     from fem.cup import cup_height
     from fem.mesh import DEFAULT_FIDELITY, cup_mesh
-    from fem.mesh_files import read_mesh
     from validation.bridge.pipeline import mesh_record, neo_hookean
 
     out = Path(args.out)
@@ -164,6 +163,7 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
         if given:
             raise ValueError(f"mesh: a mesh file fixes the geometry and the mesh; drop {', '.join(given)}")
         contact = contact_choice(args)
+        from fem.mesh_files import read_mesh        # meshio: only for a mesh file
         mesh = read_mesh(args.mesh, unit=args.mesh_unit)
         geometry = {"name": f"mesh file {Path(args.mesh).name}"}
         mesh_info = mesh_record(mesh, None, {"file": str(args.mesh), "unit": args.mesh_unit,
