@@ -20,6 +20,8 @@ after each, which ends on the undamped equilibrium.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from .contact_step import ContactStep
@@ -31,19 +33,21 @@ __all__ = ["newton_step", "relax_step", "balanced", "largest_move", "largest_sli
 _STALLED = 12           # Newton iterations in a row whose linearized frictional problem found no set
 
 
-def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy):
+def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy,
+                stall: int = _STALLED):
     """Newton iterations of one step with a contact step per iteration (module docstring), to the
     tolerances of `opts` (a `fem.solver.SolverOptions`); returns (u, r_int, contact state,
     iterations, whether the tangent was indefinite on the way)."""
     flags = {"indefinite": False}
     try:
-        return _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags)
+        return _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags,
+                        stall)
     except StepFailure as fail:
         fail.indefinite = flags["indefinite"]
         raise
 
 
-def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags):
+def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags, stall):
     n = mech.kin.ndofs
     fixed_dofs, fixed_vals = dirichlet(t)
     fext0 = fext = f_ext(t)
@@ -77,7 +81,7 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         shift = step.solve(solver, K, shift, history, policy)
         indefinite |= shift > 0.0
         stalled = 0 if getattr(step, "solvable", True) else stalled + 1
-        if stalled >= _STALLED:
+        if stalled >= stall:
             raise StepFailure(f"Coulomb's linearized contact problem found no stick/slide set in {stalled} "
                               "iterations in a row; likely cause: a friction bound falling with the slip "
                               "faster than the elastic drive grows (no quasi-static solution)", history)
@@ -174,29 +178,31 @@ class _Damped:
         return self.mech.energy(u) + 0.5 * d @ (self.weight * d)
 
 
+_SUB_ITERATIONS, _SUB_STALL = 40, 4    # a sub-step is short: it fails early (and c rises) instead
 _RELAX_ATTEMPTS = 400               # damped sub-steps (accepted or redone) of one relaxed load step
-_C_START, _C_MAX = 1.0, 1e8
+_C_START, _C_SETTLED, _C_MAX = 1.0, 1e-3, 1e8
 SLIP = 0.25                         # the largest slip of a held node in a (sub-)step / the bound
 _SETTLED = 1e-3                     # a damped sub-step moving less than this of the bound: try undamped
 
 
 def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, bound):
-    """The load step to t as the damped motion that leaves an unstable state, friction integrated
-    along it: for an incremental (Coulomb) law, where the quasi-static step either has no solution
-    or snaps, its end state depends on how the slip is divided into increments.
+    """The load step to t as the damped motion that leaves an unstable state, with the friction
+    integrated along it: for an incremental (Coulomb) law, where the quasi-static step has no
+    solution or snaps, its end state depends on how the slip is divided into increments.
 
-    Each sub-step minimizes the energy plus the viscous term of `_Damped` with C = c diag(K(u_start))
-    (the damping metric, fixed for the step) from the last sub-step's state, whose positions are
+    Each sub-step minimizes the energy plus the viscous term of `_Damped`, C = c diag(K(u_start))
+    (the damping metric, fixed for the step), from the last sub-step's state, whose positions are
     the friction's anchors (committed after every sub-step): backward Euler on the damped motion,
-    a quasi-static sequence whose incremental frictional problems have a solution for c large
-    enough (the damping adds to the stiffness that Klarbring's condition compares mu with). c is
-    raised fourfold while a sub-step fails, moves a node more than `bound` [m] beyond the
-    prescribed increment or slips a held node by more than SLIP bound, and lowered fourfold after a sub-step that moves less than bound / 4;
-    once a sub-step moves less than _SETTLED bound, the undamped load step from its state ends
-    the motion if it moves no node more than bound. As bound -> 0 the sequence tends to the
-    damped motion, independent of the load step. Returns (u, r_int, contact state, Newton
-    iterations); raises StepFailure."""
+    whose incremental frictional problems have a solution for c large enough (the damping adds to
+    the stiffness that Klarbring's condition compares mu with). c rises fourfold while a sub-step
+    fails, moves a node more than `bound` [m] beyond the prescribed increment or slips a held node
+    by more than SLIP bound, and falls fourfold after a sub-step that moves less than bound / 4.
+    Once a sub-step with c <= _C_SETTLED moves less than _SETTLED bound, the undamped step from
+    its state ends the motion, if it moves no node more than bound. As bound -> 0 the sequence
+    tends to the damped motion, independent of the load step. Returns (u, r_int, contact state,
+    Newton iterations); raises StepFailure (with the `iterations` spent)."""
     metric = np.abs(mech.evaluate(u_start)[2].diagonal())
+    sub_opts = replace(opts, max_iterations=min(opts.max_iterations, _SUB_ITERATIONS))
     dofs, values = dirichlet(t)
     u, s, c, its, history = u_start, state, _C_START, 0, []
     settled, settle = False, _SETTLED * bound
@@ -204,7 +210,8 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
         body = mech if settled else _Damped(mech, u, c * metric)
         allowed = bound + np.max(np.abs(values - u[dofs]), initial=0.0)
         try:
-            u1, r1, s1, n, _ = newton_step(body, dirichlet, f_ext, plane, s, u, t, opts, solver, policy)
+            u1, r1, s1, n, _ = newton_step(body, dirichlet, f_ext, plane, s, u, t, sub_opts, solver,
+                                           policy, _SUB_STALL)
             its += n
             if largest_move(u1, u) > allowed or largest_slip(plane, s1, u1, u) > SLIP * bound:
                 raise StepFailure("a node moved or slipped too far", [])
@@ -221,7 +228,7 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
             return u1, r1, s1, its
         move = largest_move(u1, u)
         s, u = plane.law.commit(plane, s1, u1), u1
-        settled = move < settle
+        settled = move < settle and c <= _C_SETTLED
         if move < 0.25 * bound:
             c *= 0.25
     fail = StepFailure(f"the damped motion across the instability did not settle ({its} Newton "
