@@ -180,6 +180,7 @@ class _Damped:
 
 _SUB_ITERATIONS, _SUB_STALL = 40, 4    # a sub-step is short: it fails early (and c rises) instead
 _RELAX_ATTEMPTS = 400               # damped sub-steps (accepted or redone) of one relaxed load step
+#                                     at the default largest step (0.05 of the range); more below
 _C_START, _C_SETTLED, _C_MAX = 1.0, 1e-3, 1e8
 SLIP = 0.25                         # the largest slip of a held node in a (sub-)step / the bound
 _SETTLED = 1e-3                     # a damped sub-step moving less than this of the bound: try undamped
@@ -206,7 +207,7 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
     dofs, values = dirichlet(t)
     u, s, c, its, history = u_start, state, _C_START, 0, []
     settled, settle = False, _SETTLED * bound
-    for _ in range(_RELAX_ATTEMPTS):
+    for _ in range(int(_RELAX_ATTEMPTS * max(1.0, 0.05 / opts.max_step))):   # sub-steps ~ 1 / bound
         body = mech if settled else _Damped(mech, u, c * metric)
         allowed = bound + np.max(np.abs(values - u[dofs]), initial=0.0)
         try:

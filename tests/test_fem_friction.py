@@ -85,6 +85,7 @@ def test_large_mu_is_sticking_over_the_whole_curve():
     assert _largest_deviation(st, co) < 0.03
     assert np.max(co.cone_excess) < 1e-6
     np.testing.assert_allclose(co.F0_contact_N, co.F0_N, rtol=1e-5, atol=1e-6 * np.max(co.F0_N))
+    assert co.stats.dissipated_J > 0.0          # the slips dissipate
 
 
 def test_stiffness_rises_with_mu(mesh):
@@ -226,8 +227,8 @@ def test_path_through_the_snap_converges_under_step_refinement(mesh):
     """Coarse cup A (nu 0.49), mu = 2, to 0.9 h1: the wall lands (u ~ 4.6 mm) by a slip of
     ~1.6 mm that no quasi-static step resolves; with the damped motion across it the path
     converges as the largest step goes from the default 0.05 of the range to 1/2, 1/4, 1/8 of
-    it: past the landing the change of F0 falls with each halving (benchmarks/bench_friction.py
-    --refine --fidelity coarse)."""
+    it: past the landing the change of F0 (at 5, 6, 7, 8 mm) falls with each halving
+    (benchmarks/bench_friction.py --refine --fidelity coarse)."""
     steps = (0.05, 0.025, 0.0125, 0.00625)
     u = np.array([5.0, 6.0, 7.0, 8.0]) * 1e-3
     F = []
@@ -237,4 +238,4 @@ def test_path_through_the_snap_converges_under_step_refinement(mesh):
         F.append(np.interp(u, r.u_m, r.F0_N))
     change = [np.max(np.abs(F[i + 1] / F[i] - 1.0)) for i in range(len(steps) - 1)]
     assert change[2] < change[1] < change[0]
-    assert change[2] < REFINED_CHANGE
+    assert change[2] < 0.01          # measured 3.3 %, 1.9 %, 0.57 %
