@@ -1,11 +1,15 @@
 """Coulomb friction on cup A: F0(u) for several mu, the cost against the sticking law, and the mu
-whose small-u stiffness F0(1 mm) / 1 mm matches the paper's dry 2.5 N/mm (Appendix A's value).
+whose small-u stiffness F0(1 mm) / 1 mm matches the paper's dry 2.5 N/mm (Appendix A's value);
+with --refine, the step refinement of a frictional path through the wall's snap.
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_friction.py [--fidelity medium] [--repeat 1]
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_friction.py --refine [--mu 2] [--fidelity medium]
 
 Prints per law: wall time (min of --repeat), Newton iterations, F0 at 1, 3, 5, 7 mm, the small-u
 stiffness, the largest cone excess; the ratio of each Coulomb time to the sticking one; then the
-matching mu by bisection on runs to u = 1 mm (to 1 %).
+matching mu by bisection on runs to u = 1 mm (to 1 %). --refine: the path at the default largest
+step (0.05 of the range) and at 1/2, 1/4, 1/8 of it (also the sticking law's), F0 at 4.5, 5, 6,
+7 and 8 mm for each, and each one's largest difference from the next finer one.
 """
 
 from __future__ import annotations
@@ -39,13 +43,44 @@ def small_u_stiffness(mesh, mu) -> float:
     return float(r.F0_N[-1] / 1.0)
 
 
+REFINE_U_MM = (4.5, 5.0, 6.0, 7.0, 8.0)
+REFINE_STEPS = (0.05, 0.025, 0.0125, 0.00625)     # the default largest step, 1/2, 1/4, 1/8
+
+
+def refinement(mesh, contact: str, mu: float, steps=REFINE_STEPS) -> list[tuple[float, np.ndarray, object]]:
+    """(largest step, F0 at REFINE_U_MM [N], solver stats) of the path at each step in `steps`."""
+    out = []
+    for step in steps:
+        r = compress_cup(mesh, MAT, contact=contact, friction=mu, max_step=step)
+        out.append((step, np.interp(np.array(REFINE_U_MM) * 1e-3, r.u_m, r.F0_N), r.stats))
+    return out
+
+
+def print_refinement(mesh, mu: float) -> None:
+    for contact, m in (("coulomb", mu), ("sticking", 0.0)):
+        rows = refinement(mesh, contact, m)
+        print(f"{contact} mu = {m:g}: F0 [N] at u = " + ", ".join(f"{u:g}" for u in REFINE_U_MM) + " mm")
+        for i, (step, F, stats) in enumerate(rows):
+            diff = ""
+            if i + 1 < len(rows):
+                diff = f"  largest |F0 - finer| / finer: {np.max(np.abs(F / rows[i + 1][1] - 1.0)):.2%}"
+            print(f"  step {step:7.5f}: " + " ".join(f"{f:7.3f}" for f in F)
+                  + f"  ({stats.newton_iterations} Newton iterations, {stats.wall_time_s:.1f} s){diff}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--fidelity", default="medium")
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--mus", default="0,0.1,0.3,0.5,1,2")
+    ap.add_argument("--refine", action="store_true", help="the step refinement study (module docstring)")
+    ap.add_argument("--mu", type=float, default=2.0, help="Coulomb's mu of the refinement study")
     args = ap.parse_args()
     mesh = cup_mesh(cup_geometry("A"), args.fidelity)
+    if args.refine:
+        print(f"cup A, {args.fidelity}, E = 4 MPa, nu = 0.49, to 0.9 h1: step refinement")
+        print_refinement(mesh, args.mu)
+        return
     laws = [("frictionless", 0.0), ("sticking", 0.0)] + [("coulomb", float(m)) for m in args.mus.split(",")]
     times = {}
     print(f"cup A, {args.fidelity}, E = 4 MPa, nu = 0.49, to 0.9 h1")

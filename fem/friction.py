@@ -63,7 +63,7 @@ class FrictionStep:
         self.plane, self.old, self.u, self.free, self.tol = plane, state, u, free, tol
         self.res0 = res + friction           # r - f_ext without the friction forces
         self.du_fixed, self.factor, self.friction = du_fixed, factor, friction
-        self.state, self.settled = state, False
+        self.state, self.settled, self.solvable = state, False, True
 
     def solve(self, solver, K, shift, history, policy, lower=True) -> float:
         """Factor the base block (`factor`: `fem.factorization.factor_shifted`, shifted if not positive
@@ -106,6 +106,7 @@ class FrictionStep:
         slip[sub.held] = np.where(sub.An[:nh], sub.slip, 0)
         keep = old.active & ~self.release
         self.state = ContactState(keep, old.u_r_stick_m, np.where(keep, slip, 0).astype(np.int8))
+        self.solvable = sub.converged
         self.settled = sub.converged and not self.release.any() and not self.pressed.any() \
             and np.array_equal(self.state.slip, old.slip)
 

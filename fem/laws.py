@@ -34,6 +34,7 @@ class Frictionless:
     name: ClassVar[str] = "frictionless"
     conservative: ClassVar[bool] = True     # the total energy is the path's potential
     anchored: ClassVar[bool] = False        # held nodes keep their radial anchor
+    relaxes: ClassVar[bool] = False         # instabilities crossed by damped motion (`fem.newton.relax_step`)
     mu: ClassVar[float] = 0.0
 
     @property
@@ -77,6 +78,7 @@ class Coulomb:
     name: ClassVar[str] = "coulomb"
     conservative: ClassVar[bool] = False
     anchored: ClassVar[bool] = True
+    relaxes: ClassVar[bool] = True          # its slip across an instability is integrated in increments
 
     def __post_init__(self) -> None:
         ContactLaw(self.name, self.mu)          # the one check of mu

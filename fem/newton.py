@@ -12,9 +12,15 @@ Converged: the prescribed values hold, no held node pulls on the plane beyond th
 ||r_f|| <= rtol * max(||reactions||, f_floor) (or at the round-off floor, `balanced`), the energy
 norm of the next correction |du . r| <= etol * f_ref * max|u| (the work scale), and Coulomb's
 condensed problem keeps its sets. Anything else raises `fem.failure.StepFailure` with its cause.
+
+`relax_step` is the load step of an incremental friction law across an instability (or where its
+quasi-static step has no solution): a sequence of damped sub-steps, the friction's anchors moved
+after each, which ends on the undamped equilibrium.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -22,22 +28,26 @@ from .contact_step import ContactStep
 from .failure import StepFailure
 from .linesearch import line_search, total_potential
 
-__all__ = ["newton_step", "balanced"]
+__all__ = ["newton_step", "relax_step", "balanced", "largest_move", "largest_slip", "SLIP"]
+
+_STALLED = 12           # Newton iterations in a row whose linearized frictional problem found no set
 
 
-def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy):
+def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy,
+                stall: int = _STALLED):
     """Newton iterations of one step with a contact step per iteration (module docstring), to the
     tolerances of `opts` (a `fem.solver.SolverOptions`); returns (u, r_int, contact state,
     iterations, whether the tangent was indefinite on the way)."""
     flags = {"indefinite": False}
     try:
-        return _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags)
+        return _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags,
+                        stall)
     except StepFailure as fail:
         fail.indefinite = flags["indefinite"]
         raise
 
 
-def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags):
+def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags, stall):
     n = mech.kin.ndofs
     fixed_dofs, fixed_vals = dirichlet(t)
     fext0 = fext = f_ext(t)
@@ -48,7 +58,7 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
     except FloatingPointError as err:
         raise StepFailure(f"{err} at the predictor; likely cause: the step is too large for "
                           "the deformation, or the mesh is too coarse", history) from None
-    it, shift, indefinite = 0, 0.0, False
+    it, shift, indefinite, stalled = 0, 0.0, False, 0
     released = np.zeros(len(plane.nodes), bool) if plane is not None else None
     while True:
         res = r - fext0
@@ -70,6 +80,11 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
             step = ContactStep(None, state, u, res, free, du_fixed, opts.rtol * f_ref)
         shift = step.solve(solver, K, shift, history, policy)
         indefinite |= shift > 0.0
+        stalled = 0 if getattr(step, "solvable", True) else stalled + 1
+        if stalled >= stall:
+            raise StepFailure(f"Coulomb's linearized contact problem found no stick/slide set in {stalled} "
+                              "iterations in a row; likely cause: a friction bound falling with the slip "
+                              "faster than the elastic drive grows (no quasi-static solution)", history)
         flags["indefinite"] = indefinite
         energy = abs(step.du @ res)
         e_ref = f_ref * max(np.max(np.abs(u)), np.max(np.abs(step.du)), 1e-9 * _size(mech))
@@ -130,3 +145,95 @@ def _size(mech) -> float:
 def _force_floor(mech) -> float:
     """A force scale below which residuals are round-off: 1e-6 mu L^2 with L the body's size."""
     return 1e-6 * mech.material.mu * _size(mech) ** 2
+
+
+def largest_move(u1: np.ndarray, u0: np.ndarray) -> float:
+    """The largest displacement of a node between two states [m]."""
+    return float(np.max(np.hypot(*(u1 - u0).reshape(-1, 2).T)))
+
+
+def largest_slip(plane, state, u1: np.ndarray, u0: np.ndarray) -> float:
+    """The largest radial move between two states of a node that `state` holds on the plane [m]."""
+    rd = 2 * plane.nodes[state.active]
+    return float(np.max(np.abs(u1[rd] - u0[rd]), initial=0.0))
+
+
+class _Damped:
+    """The body with a viscous term of one pseudo-time step: Pi(u) + (u - u_k) . C (u - u_k) / 2,
+    C = diag(weight). Its minimizer is backward Euler's step of the damped motion C du/ds =
+    -grad Pi from u_k; the tangent gains C on its diagonal (the pattern is K's)."""
+
+    def __init__(self, mech, u_k: np.ndarray, weight: np.ndarray):
+        self.mech, self.kin, self.material, self.u_k, self.weight = mech, mech.kin, mech.material, u_k, weight
+
+    def evaluate(self, u):
+        W, r, K = self.mech.evaluate(u)
+        d = u - self.u_k
+        K = K.copy()
+        K.setdiag(K.diagonal() + self.weight)
+        return W + 0.5 * d @ (self.weight * d), r + self.weight * d, K
+
+    def energy(self, u):
+        d = u - self.u_k
+        return self.mech.energy(u) + 0.5 * d @ (self.weight * d)
+
+
+_SUB_ITERATIONS, _SUB_STALL = 40, 4    # a sub-step is short: it fails early (and c rises) instead
+_RELAX_ATTEMPTS = 400               # damped sub-steps (accepted or redone) of one relaxed load step
+#                                     at the default largest step (0.05 of the range); more below
+_C_START, _C_SETTLED, _C_MAX = 1.0, 1e-3, 1e8
+SLIP = 0.25                         # the largest slip of a held node in a (sub-)step / the bound
+_SETTLED = 1e-3                     # a damped sub-step moving less than this of the bound: try undamped
+
+
+def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, bound):
+    """The load step to t as the damped motion that leaves an unstable state, with the friction
+    integrated along it: for an incremental (Coulomb) law, where the quasi-static step has no
+    solution or snaps, its end state depends on how the slip is divided into increments.
+
+    Each sub-step minimizes the energy plus the viscous term of `_Damped`, C = c diag(K(u_start))
+    (the damping metric, fixed for the step), from the last sub-step's state, whose positions are
+    the friction's anchors (committed after every sub-step): backward Euler on the damped motion,
+    whose incremental frictional problems have a solution for c large enough (the damping adds to
+    the stiffness that Klarbring's condition compares mu with). c rises fourfold while a sub-step
+    fails, moves a node more than `bound` [m] beyond the prescribed increment or slips a held node
+    by more than SLIP bound, and falls fourfold after a sub-step that moves less than bound / 4.
+    Once a sub-step with c <= _C_SETTLED moves less than _SETTLED bound, the undamped step from
+    its state ends the motion, if it moves no node more than bound. As bound -> 0 the sequence
+    tends to the damped motion, independent of the load step. Returns (u, r_int, contact state,
+    Newton iterations); raises StepFailure (with the `iterations` spent)."""
+    metric = np.abs(mech.evaluate(u_start)[2].diagonal())
+    sub_opts = replace(opts, max_iterations=min(opts.max_iterations, _SUB_ITERATIONS))
+    dofs, values = dirichlet(t)
+    u, s, c, its, history = u_start, state, _C_START, 0, []
+    settled, settle = False, _SETTLED * bound
+    for _ in range(int(_RELAX_ATTEMPTS * max(1.0, 0.05 / opts.max_step))):   # sub-steps ~ 1 / bound
+        body = mech if settled else _Damped(mech, u, c * metric)
+        allowed = bound + np.max(np.abs(values - u[dofs]), initial=0.0)
+        try:
+            u1, r1, s1, n, _ = newton_step(body, dirichlet, f_ext, plane, s, u, t, sub_opts, solver,
+                                           policy, _SUB_STALL)
+            its += n
+            if largest_move(u1, u) > allowed or largest_slip(plane, s1, u1, u) > SLIP * bound:
+                raise StepFailure("a node moved or slipped too far", [])
+        except StepFailure as fail:
+            its, history = its + len(fail.history), fail.history or history
+            if settled:         # the undamped step fails: damped again, and settle closer first
+                settled, settle = False, 0.1 * settle
+            elif c >= _C_MAX:
+                break
+            else:
+                c *= 4.0
+            continue
+        if body is mech:
+            return u1, r1, s1, its
+        move = largest_move(u1, u)
+        s, u = plane.law.commit(plane, s1, u1), u1
+        settled = move < settle and c <= _C_SETTLED
+        if move < 0.25 * bound:
+            c *= 0.25
+    fail = StepFailure(f"the damped motion across the instability did not settle ({its} Newton "
+                       "iterations); likely cause: a friction bound falling with the slip faster "
+                       "than the damping can hold", history, indefinite=True)
+    fail.iterations = its
+    raise fail

@@ -13,8 +13,13 @@ energy lost in a step, W0 + work - W1, is summed as `SolverStats.dissipated_J`; 
 conservative path (no contact or frictionless contact) an unstable step that loses more than
 jump_tol of W is redone with half the step down to jump_min_step: a large step's descent may land
 on another branch than the load path reaches, while a real snap keeps its loss as the step
-shrinks and is accepted, localized to one small step. docs/fem.md ("Solver notes") records what
-was measured for these choices.
+shrinks and is accepted, localized to one small step. An incremental friction law (Coulomb)
+does not jump: a step that fails or crosses an instability is halved down to a quarter of the
+largest step; there, if it still fails or a held node slips more than that, it is redone as
+damped motion at its load (`fem.newton.relax_step`),
+so that the slip is integrated in increments no longer than the largest step and the path
+converges as the step shrinks. docs/fem.md ("Solver notes") records what was measured for these
+choices.
 """
 
 from __future__ import annotations
@@ -33,7 +38,7 @@ from .factorization import ShiftPolicy
 from .failure import StepFailure
 from .forms import Mechanics
 from .linesearch import conservative
-from .newton import newton_step
+from .newton import SLIP, largest_slip, newton_step, relax_step
 
 __all__ = ["SolverOptions", "SolverStats", "ConvergenceError", "follow_path", "StepResult"]
 
@@ -147,19 +152,38 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         on_step(StepResult(0.0, u0, r0, W0, state, 0))
     dt = dt_ok = options.initial_step * t_max
     steps = iterations = cutbacks = unstable = jumps = 0
+    # damped motion needs the tangent as a sparse matrix (not a mech's own solver, `fem.trapped_gas`)
+    relaxes = plane is not None and getattr(plane.law, "relaxes", False) and build is make_solver
+    bound = options.max_step * t_max     # the largest move of a node in a relaxed sub-step
+    short = SLIP * bound * (1 + 1e-9)     # the longest step across an instability, the largest slip
     dissipated = 0.0
     while t < t_max * (1 - 1e-12):
         t1 = min(t + dt, t_max)
         if t_max - t1 < 0.2 * dt:          # don't leave a sliver at the end
             t1 = t_max
         m1 = at(t1)
+        fail = None
         try:
             u1, r1, state1, its, indefinite = newton_step(m1, dirichlet, f_ext, plane, state, u0,
                                                            t1, options, solver, policy)
-        except StepFailure as fail:
-            cutbacks += 1
+            if relaxes and indefinite and (t1 - t > short or largest_slip(plane, state1, u1, u0) > short):
+                raise StepFailure("the step crossed an instability", [math.nan] * its, indefinite=True)
+        except StepFailure as err:
+            fail = err
+        if fail is not None and relaxes and t1 - t <= short:
+            # an incremental friction law: the motion across the instability, in damped increments
+            # (a longer step is halved first: where a quasi-static path exists, it follows it)
             iterations += len(fail.history)
-            if fail.indefinite and jumps < _JUMPS:
+            try:
+                u1, r1, state1, its = relax_step(m1, dirichlet, f_ext, plane, state, u0, t1,
+                                                 options, solver, policy, bound)
+                fail, indefinite = None, True
+            except StepFailure as again:
+                fail = again
+        if fail is not None:
+            cutbacks += 1
+            iterations += getattr(fail, "iterations", len(fail.history))
+            if fail.indefinite and jumps < _JUMPS and not relaxes:
                 # a structural instability: smaller steps only creep up to the limit point, so
                 # first try to step across it (the path jumps; the energy it loses is reported)
                 jumps += 1

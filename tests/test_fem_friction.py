@@ -1,7 +1,10 @@
 """Coulomb friction at the plane (`fem.contact`, `fem.friction`): its limits, its law, its energy.
 
 Independent checks: mu = 0 is the frictionless law and a large mu the sticking law (two other
-solvers' paths); a ring pressed and then sheared over the plane slides as a whole once the shear
+solvers' paths), through the wall's landing and snap to 0.9 h1; Coulomb's F0 lies between the
+frictionless and the sticking one on a monotone press; every converged state, also those reached
+by damped motion across an instability (`fem.newton.relax_step`), is in global equilibrium (plate
+force = sum of the contact reactions); a ring pressed and then sheared over the plane slides as a whole once the shear
 reaches mu times the normal load, by global equilibrium (sum of the nodal friction forces =
 -mu sum of the normal reactions, whatever the stress field); the work done equals the stored
 energy plus what the slips dissipate, sum of mu lambda |Delta| per step, to the trapezoid's error,
@@ -55,6 +58,34 @@ def test_large_mu_is_sticking(mesh):
     u = np.linspace(0.05, 1.0, 20) * u_max
     F_st, F_co = np.interp(u, st.u_m, st.F0_N), np.interp(u, co.u_m, co.F0_N)
     assert np.max(np.abs(F_co / F_st - 1.0)) < 5e-3
+
+
+def _vertical_A(level):
+    return cup_mesh(cup_geometry("A", thickness_convention="vertical"), level)
+
+
+def _press(mesh, contact, mu=0.0, **opts):
+    return compress_cup(mesh, NeoHookean(E_Pa=4e6, nu=0.45), contact=contact, friction=mu, **opts)
+
+
+def _largest_deviation(ref, other):
+    """max |F_other / F_ref - 1| at ref's steps (u > 0), F_other interpolated."""
+    u = ref.u_m[1:]
+    return float(np.max(np.abs(np.interp(u, other.u_m, other.F0_N) / ref.F0_N[1:] - 1.0)))
+
+
+def test_large_mu_is_sticking_over_the_whole_curve():
+    """Cup A (nu 0.45, vertical thickness, coarse, default steps) to 0.9 h1: Coulomb at mu = 10
+    follows the sticking law within 3 % through the wall's landing (u ~ 4.3 mm) and the late
+    instability (~7.6 mm), where a long step let the contact slide off the sticking path (-64 %
+    at the end before the steps across instabilities were shortened); every state in equilibrium."""
+    mesh = _vertical_A("coarse")
+    st, co = _press(mesh, "sticking"), _press(mesh, "coulomb", 10.0)
+    assert not co.partial and co.u_m[-1] == pytest.approx(st.u_m[-1])
+    assert _largest_deviation(st, co) < 0.03
+    assert np.max(co.cone_excess) < 1e-6
+    np.testing.assert_allclose(co.F0_contact_N, co.F0_N, rtol=1e-5, atol=1e-6 * np.max(co.F0_N))
+    assert co.stats.dissipated_J > 0.0          # the slips dissipate
 
 
 def test_stiffness_rises_with_mu(mesh):
@@ -165,3 +196,46 @@ def test_converged_states_hold_coulombs_law_node_by_node(mesh):
         assert np.all(slip[sliding & was] * moved[sliding & was] > 0.0)
         kinds |= {int(k) for k in slip[a]}
     assert kinds >= {0, 1}
+
+
+LANDING_MM = (3.95, 4.5)      # where the wall lands on the plane and F0 rises tenfold
+
+
+@pytest.mark.slow
+def test_large_mu_is_sticking_over_the_whole_curve_medium():
+    """The same on the medium mesh, both laws at 1/4 of the default step (at the default step the
+    sticking path itself jumps at u ~ 7.3 mm and lies 14 % below its refined curve). Within 3 %
+    (measured 0.7 %) but for the landing, where F0 rises tenfold within 0.5 mm and a shift of
+    the touchdown by a fraction of a step moves it by 4.7 %. The issue's command (u_max 4.2 mm,
+    default steps), which stopped at 2.29 mm after 400 iterations (the linearized problem had no
+    stick/slide set at the rim's edge node), runs, within 3 % of sticking before the landing."""
+    mesh = _vertical_A("medium")
+    st, co = (_press(mesh, law, mu, max_step=0.0125) for law, mu in (("sticking", 0.0), ("coulomb", 10.0)))
+    assert not co.partial and co.u_m[-1] == pytest.approx(st.u_m[-1])
+    u = co.u_m[1:]
+    away = (u < LANDING_MM[0] * 1e-3) | (u > LANDING_MM[1] * 1e-3)
+    assert np.max(np.abs(co.F0_N[1:][away] / np.interp(u[away], st.u_m, st.F0_N) - 1.0)) < 0.03
+    short = _press(mesh, "coulomb", 10.0, u_max_m=4.2e-3)
+    assert not short.partial and short.u_m[-1] == pytest.approx(4.2e-3)
+    before = short.u_m[1:] < LANDING_MM[0] * 1e-3
+    F_st = np.interp(short.u_m[1:][before], st.u_m, st.F0_N)
+    assert np.max(np.abs(short.F0_N[1:][before] / F_st - 1.0)) < 0.03
+
+
+@pytest.mark.slow
+def test_path_through_the_snap_converges_under_step_refinement(mesh):
+    """Coarse cup A (nu 0.49), mu = 2, to 0.9 h1: the wall lands (u ~ 4.6 mm) by a slip of
+    ~1.6 mm that no quasi-static step resolves; with the damped motion across it the path
+    converges as the largest step goes from the default 0.05 of the range to 1/2, 1/4, 1/8 of
+    it: past the landing the change of F0 (at 5, 6, 7, 8 mm) falls with each halving
+    (benchmarks/bench_friction.py --refine --fidelity coarse)."""
+    steps = (0.05, 0.025, 0.0125, 0.00625)
+    u = np.array([5.0, 6.0, 7.0, 8.0]) * 1e-3
+    F = []
+    for step in steps:
+        r = compress_cup(mesh, MAT, contact="coulomb", friction=2.0, max_step=step)
+        assert not r.partial
+        F.append(np.interp(u, r.u_m, r.F0_N))
+    change = [np.max(np.abs(F[i + 1] / F[i] - 1.0)) for i in range(len(steps) - 1)]
+    assert change[2] < change[1] < change[0]
+    assert change[2] < 0.01          # measured 3.3 %, 1.9 %, 0.57 %
