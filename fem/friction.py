@@ -151,7 +151,7 @@ class _Condensed:
         self.slip = old.slip[held].astype(np.int8)
         self.g_all = plane.gap(u)
         self.d0 = u[rd[held]] - old.u_r_stick_m[held]
-        self._Kc = K[self.rows]
+        self._Kc = _rows(K, self.rows)
         self.converged, self.y = False, np.zeros(0)
         # a held node off the plane or off its anchor (pressed or landed in the last iteration)
         self._columns(np.flatnonzero(np.concatenate([self.g_all[held] != 0.0, self.d0 != 0.0])))
@@ -166,7 +166,7 @@ class _Condensed:
         force = self.force[rows]
         E = np.zeros((n, len(rows)))
         E[dofs[force], k[force]] = 1.0
-        E[:, ~force] = -self.K[dofs[~force]].toarray().T      # K symmetric: its columns
+        E[:, ~force] = -_rows(self.K, dofs[~force]).toarray().T      # K symmetric: its columns
         Z = self.fac.solve(E)
         Z[dofs[~force], k[~force]] = 1.0
         self.Z = np.hstack([self.Z, Z])
@@ -181,7 +181,7 @@ class _Condensed:
         self.has = np.concatenate([self.has, np.zeros(len(new), bool)])
         self.nodes = np.concatenate([self.nodes, new])
         self.An = np.concatenate([self.An, np.ones(len(new), bool)])
-        self._Kc = self.K[self.rows]
+        self._Kc = _rows(self.K, self.rows)
         self._columns(np.arange(start, len(self.rows)))
 
     def du(self) -> np.ndarray:
@@ -241,3 +241,9 @@ class _Condensed:
         slip_new = np.where(np.abs(zeta) <= bound, 0, -np.sign(zeta)).astype(np.int8)
         slip_new[(slip != 0) & (slip_new == -slip)] = 0
         return An_new, np.where(An_new[:nh], slip_new, 0).astype(np.int8)
+
+
+def _rows(K, dofs: np.ndarray):
+    """Rows `dofs` of the tangent, its rank-one gas term included where it has one
+    (`fem.trapped_gas.GasTangent.rows`); plain slicing gives the sparse part only."""
+    return K.rows(dofs) if getattr(K, "rank_one", None) is not None else K[dofs]
