@@ -110,6 +110,23 @@ def test_a_fields_file_without_provenance_renders_captioned_unknown(run, tmp_pat
     assert titles[0]["clipped"] == []
 
 
+@pytest.mark.parametrize("suffix", [".vtu", ".vtk"])
+def test_a_single_step_file_records_the_coulomb_law_and_vtk_reads_the_record(tmp_path, titles, suffix):
+    """Cup B, coarse, Coulomb mu = 0.5, the last step as .vtu/.vtk: VTK's own reader (pyvista) finds
+    the provenance in the file's field data, and the cut-away is captioned with mu, unclipped."""
+    _gl()
+    import pyvista as pv
+
+    fields = tmp_path / f"f{suffix}"
+    assert main(["stiffness", "--cup", "B", "--fidelity", "coarse", "--contact", "coulomb", "--friction", "0.5",
+                 "--u-max-mm", "0.4", "--fields-out", str(fields), "--out", str(tmp_path / "c.csv")]) == 0
+    codes = np.asarray(pv.read(fields).field_data["cupcheck_provenance"]).astype(np.uint8)
+    record = json.loads(codes.tobytes().decode())
+    assert (record["design"], record["contact"], record["mesh"]) == ("cup B", "coulomb mu = 0.5", "coarse")
+    assert main(["render", str(fields), "--field", "min_stretch", "--out", str(tmp_path / "c.png")]) == 0
+    assert titles == [{"texts": ["cup B, coulomb mu = 0.5, coarse mesh, u = 0.4 mm"], "clipped": []}]
+
+
 @pytest.mark.parametrize("argv,message", [
     (["--view", "squeeze", "--out", "x.png"], "out: the squeeze view writes a .gif file"),
     (["--frames", "1", "--view", "squeeze", "--out", "x.gif"], "frames: must be in [2, 60], got 1"),
