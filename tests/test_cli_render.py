@@ -110,6 +110,20 @@ def test_a_fields_file_without_provenance_renders_captioned_unknown(run, tmp_pat
     assert titles[0]["clipped"] == []
 
 
+@pytest.mark.parametrize("view,out", [("cutaway", "x.png"), ("squeeze", "x.gif")])
+def test_an_unreadable_provenance_record_is_refused(run, tmp_path, capsys, view, out):
+    from xml.etree import ElementTree as ET
+
+    tree = ET.parse(run / "f.xdmf")
+    tree.getroot().find("Domain/Information").set("Value", "{not json")
+    bad = tmp_path / "bad.xdmf"
+    tree.write(bad)
+    assert main(["render", str(bad), "--view", view, "--out", str(tmp_path / out)]) == 2
+    err = capsys.readouterr().err
+    assert "fields: cannot read the provenance of 'bad.xdmf'" in err and err.count("\n") == 1
+    assert [p.name for p in tmp_path.iterdir()] == ["bad.xdmf"]
+
+
 @pytest.mark.parametrize("suffix", [".vtu", ".vtk"])
 def test_a_single_step_file_records_the_coulomb_law_and_vtk_reads_the_record(tmp_path, titles, suffix):
     """Cup B, coarse, Coulomb mu = 0.5, the last step as .vtu/.vtk: VTK's own reader (pyvista) finds

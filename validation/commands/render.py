@@ -65,9 +65,9 @@ def run(args: argparse.Namespace) -> int:
         if len(steps) < 2:
             raise ValueError(f"fields: the squeeze needs an .xdmf series of several steps; '{args.fields.name}' "
                              "holds one (write it with --fields-out NAME.xdmf)")
+        caption = _caption(args.fields)
         targets = [steps[0] + (steps[-1] - steps[0]) * k / (args.frames - 1) for k in range(args.frames)]
         frames = [frame_from_fields_file(args.fields, u_mm=1e3 * t, fields=(args.field,)) for t in targets]
-        caption = _caption(args.fields)
         with atomic_file(args.out) as tmp, tempfile.TemporaryDirectory() as d:
             seq = views.squeeze(frames, args.field, Path(d) / "frame", title=caption)
             Path(tmp).write_bytes(seq.gif.read_bytes())
