@@ -26,7 +26,15 @@ HEAD = {
                "Unknown keys, wrong types, implausible values (`validation.guards`: a modulus in Pa, radii "
                "in um, ...) and contradictions are refused with one line naming the key path, before any "
                "work. Paths are relative to the scene file. Examples: `scenes/*.toml`, the gallery "
-               "`scenes/README.md`."),
+               "`scenes/README.md`.\n\n"
+               "**A warm rerun keeps intact outputs.** `DIR/manifest.json` records for every output the key "
+               "of what it was made from (its keys, the part of the study it depends on with each input file "
+               "by its sha256, the sources of fem, reduced and validation) and the sha256 of each file. "
+               "Rerun into the same `--out DIR`, an output whose key and files match is kept (its files "
+               "linked into the new directory, mtimes unchanged); an edited input redraws only the outputs "
+               "made from it, an edited or deleted file only its own output, and a rerun that changes "
+               "nothing writes nothing (`cupcheck run` says the files are up to date). `--no-cache` draws "
+               "everything afresh."),
     "sweeps": ("# Sweep files: every key",
                "A sweep file (TOML) names a base design and the axes to vary; `cupcheck sweep SWEEP.toml "
                "--out DIR` evaluates every design on dask and keeps one committed result per design in DIR "

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 import fem.cup
+import fem.fields
 from validation.cli import main
 
 
@@ -124,10 +125,10 @@ def test_solver_failure_exits_1_and_leaves_no_files(tmp_path, monkeypatch, capsy
 def test_failure_while_writing_leaves_none_of_the_files(tmp_path, monkeypatch, capsys):
     # the curve and the sidecar are written first, the fields last: a failure there must take
     # the other two with it
-    def broken(self, path, step=-1):
+    def broken(resp, path, step=-1, provenance=None):
         Path(path).write_text("half a file")
         raise RuntimeError("fields: disk full")
-    monkeypatch.setattr(fem.cup.CupResponse, "write_fields", broken)
+    monkeypatch.setattr(fem.fields, "write_fields", broken)
     assert main(["stiffness", "--fidelity", "coarse", "--u-max-mm", "0.3",
                  "--out", str(tmp_path / "curve.csv"), "--fields-out", str(tmp_path / "f.vtu")]) == 1
     assert capsys.readouterr().err.splitlines()[-1] == "cupcheck stiffness: failed: fields: disk full"

@@ -36,6 +36,16 @@ FAULTS = """
   with the column and the stage that produced it; inf is written only where it means something
   (an infinite lifetime, an unbounded line-contact pressure).
 
+## A partial FEM curve: exit status 3 (tests/test_partial_curve.py)
+
+A `stiffness` path that fails after some converged steps (cup A, sticking, coarse, pressed to h1:
+the wall folds into the plate at u = 8.921 mm) writes its converged part (the curve, the sidecar,
+`--fields-out`), flagged `"partial": true` in the sidecar's provenance with `"failed_at_u_mm"`,
+`"failure_reason"` and `"u_max_mm_that_runs"`; one line says where and why it stopped and which
+`--u-max-mm` runs, the record goes to `<out>.failure.json`, and the exit status is 3 (1: nothing
+converged, no curve; 2: refused input). `lifetime` uses such a curve within its range and refuses
+(exit 2, one line) one that stops short of the state it needs.
+
 ## Outputs never destroy, and own their folder (tests/test_output_paths.py)
 
 One function, `validation.output.check_outputs`, runs in every command before any work (and again

@@ -9,6 +9,8 @@ Views (pyvista off-screen, the child-process GL probe first):
 Fields: contact_pressure (recovered smoothly from the nodal reactions), von_mises (L2 projection of
 the file's element-mean Cauchy stress), min_stretch (from the file's displacement). A .vtu/.vtk
 holds one step; from an .xdmf series --u-mm picks the step nearest u (default the last).
+Every image is captioned with the design, contact law and mesh level the fields file records
+(an older file without that record: captioned as unknown).
 
 Bad input (a missing or foreign file, a suffix that does not fit the view, --u-mm or --frames out
 of range) stops with one line naming the option and exit status 2, before anything is written.
@@ -63,10 +65,11 @@ def run(args: argparse.Namespace) -> int:
         if len(steps) < 2:
             raise ValueError(f"fields: the squeeze needs an .xdmf series of several steps; '{args.fields.name}' "
                              "holds one (write it with --fields-out NAME.xdmf)")
+        caption = _caption(args.fields)
         targets = [steps[0] + (steps[-1] - steps[0]) * k / (args.frames - 1) for k in range(args.frames)]
         frames = [frame_from_fields_file(args.fields, u_mm=1e3 * t, fields=(args.field,)) for t in targets]
         with atomic_file(args.out) as tmp, tempfile.TemporaryDirectory() as d:
-            seq = views.squeeze(frames, args.field, Path(d) / "frame")
+            seq = views.squeeze(frames, args.field, Path(d) / "frame", title=caption)
             Path(tmp).write_bytes(seq.gif.read_bytes())
         print(f"cupcheck render: wrote {args.out} ({len(frames)} frames, u = {1e3 * seq.u_m[0]:.3g} .. "
               f"{1e3 * seq.u_m[-1]:.3g} mm)")
@@ -76,17 +79,31 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"u_mm: no contact at u = {1e3 * frame.u_m:.4g} mm in '{args.fields.name}'; choose a "
                          "later step")
     scale = args.out.with_suffix(".json")
+    caption = _caption(args.fields)
     with atomic_file(args.out) as tmp:
         if args.view == "cutaway":
-            views.cutaway(frame, args.field, tmp, title=f"u = {1e3 * frame.u_m:.3g} mm")
+            views.cutaway(frame, args.field, tmp, title=f"{caption}, u = {1e3 * frame.u_m:.3g} mm")
         else:
-            image = views.footprint(frame, tmp, title=f"from below, u = {1e3 * frame.u_m:.3g} mm")
+            image = views.footprint(frame, tmp, title=f"{caption}, from below, u = {1e3 * frame.u_m:.3g} mm")
             with atomic_file(scale) as tmp_scale:
                 tmp_scale.write_text(json.dumps({"m_per_px": image.m_per_px, "centre_px": image.centre_px,
                                                  "contact_zones_m": image.zones_m, "u_m": frame.u_m}) + "\n")
     extra = f" and {scale.name}" if args.view == "footprint" else ""
     print(f"cupcheck render: wrote {args.out}{extra} ({args.view}, u = {1e3 * frame.u_m:.3g} mm)")
     return 0
+
+
+def _caption(fields: Path) -> str:
+    """The caption of the fields file's provenance record (its parts unknown without one)."""
+    from xml.etree.ElementTree import ParseError
+
+    from fem.fields import read_provenance
+    from validation.render.caption import provenance_caption
+
+    try:
+        return provenance_caption(read_provenance(fields))
+    except (ValueError, ParseError, UnicodeError) as exc:
+        raise ValueError(f"fields: cannot read the provenance of '{fields.name}': {exc}".replace("\n", " ")) from None
 
 
 def _check(args: argparse.Namespace) -> None:

@@ -75,7 +75,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     r.add_argument("--fields-out", type=Path, metavar="FILE",
                    help="also write the fields (displacement, Cauchy stress, contact pressure): "
                         "the last step as .vtu (or .vtk), or every step as an .xdmf time series "
-                        "over u [m]; a missing directory is created")
+                        "over u [m], with the run's design, contact law, mesh level and material "
+                        "(cupcheck render captions with them); a missing directory is created")
     r.add_argument("--out", type=Path, required=True, metavar="CSV",
                    help="the stiffness curve (.csv); the sidecar goes to the same name with .json "
                         "(a missing directory is created)")
@@ -108,9 +109,11 @@ def run(args: argparse.Namespace) -> int:
         curve.to_csv(tmp_csv, sidecar=False)
         handoff.write_sidecar(handoff.sidecar(response, prov), tmp_json)
         if args.fields_out is not None:
+            from fem.fields import write_fields
             with atomic_file(args.fields_out) as tmp_fields:
                 every_step = tmp_fields.suffix.lower() == ".xdmf"
-                response.write_fields(tmp_fields, step=None if every_step else -1)
+                write_fields(response, tmp_fields, step=None if every_step else -1,
+                             provenance=_fields_provenance(job))
     if stop is not None:                     # after the writes, which removed an earlier record
         failure_record(stop.error, log)
     s = response.stats
@@ -191,6 +194,15 @@ def _prepare(args: argparse.Namespace) -> dict[str, Any]:
     return {"mesh": mesh, "material": material, "u_max_m": u_max, "geometry": geometry,
             "mesh_info": mesh_info, "fidelity": fidelity, "sidecar": out.with_suffix(".json"),
             "contact": contact}
+
+
+def _fields_provenance(job: dict[str, Any]) -> dict[str, str]:
+    """What the fields file records of its run (render captions with it): the design, the contact
+    law, the mesh level ("file" for a mesh file) and the material."""
+    m = job["material"]
+    return {"design": job["geometry"]["name"], "contact": job["contact"].contact.label(),
+            "mesh": job["fidelity"] or "file",
+            "material": f"neo-Hookean E = {1e-6 * m.E_Pa:g} MPa, nu = {m.nu:g} ({m.formulation})"}
 
 
 def _round_down(value: float, digits: int = 4) -> float:

@@ -46,8 +46,10 @@ def write_view(output: dict, products: Products, tmp: Path | None) -> list[dict[
 
 def view_caption(products: Products) -> str:
     """What a 3D view shows: the design, the FEM's contact law (with mu) and its mesh level."""
+    from validation.render.caption import view_caption_of
+
     s = products.study
-    return f"{s.design.label}, {s.contact.label()}, {s.fidelity} mesh"
+    return view_caption_of(s.design.label, s.contact.label(), s.fidelity)
 
 
 def _file(name: str, kind: str, path: Path) -> dict[str, str]:

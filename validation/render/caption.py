@@ -1,0 +1,23 @@
+"""The caption of a 3D view: which design, contact law and mesh level the drawn states are of.
+
+One wording for the scene views (`validation.scenes.views3d`) and for ``cupcheck render`` of a
+fields file (its provenance record, `fem.fields.read_provenance`); what a record lacks (an older
+fields file has none) is named as unknown rather than left out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+__all__ = ["view_caption_of", "provenance_caption"]
+
+
+def view_caption_of(design: str | None, contact: str | None, mesh_level: str | None) -> str:
+    """"cup A, coulomb mu = 0.5, coarse mesh"; a part given as None reads as unknown."""
+    return (f"{design or 'design unknown'}, {contact or 'contact law unknown'}, "
+            f"{mesh_level + ' mesh' if mesh_level else 'mesh level unknown'}")
+
+
+def provenance_caption(record: Mapping[str, str]) -> str:
+    """The caption of a fields file's provenance record (keys design, contact, mesh)."""
+    return view_caption_of(record.get("design"), record.get("contact"), record.get("mesh"))
