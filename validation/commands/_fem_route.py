@@ -11,6 +11,7 @@ import sys
 from typing import Any
 
 from validation.commands._reduced_options import build_uc, check_run_options, refuse_other_options
+from validation.study_schema import field_of
 
 #: mesh level of the fem route when --fidelity is not given (one lifetime 4-6 s of CPU coarse, ~20 s medium)
 DEFAULT_FIDELITY = "coarse"
@@ -22,13 +23,14 @@ _NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--suction-table", "su
              ("--l1-mm", "l1_mm", None), ("--kappa", "kappa", 1.0), ("--relaxation", "relaxation", "none"),
              ("--phi0-s", "phi0_s", None))
 
+#: the study's fields `lifetime` spells as the fem route's own flags (`validation.study_schema`), besides the contact
+FEM_KEYS = ("stiffness.fidelity", "loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm")
 #: options of the fem route only: (option, attribute, default)
-FEM_ONLY = (("--contact", "contact", None), ("--friction", "friction", None), ("--fidelity", "fidelity", None),
-            ("--press-u-mm", "press_u_mm", None), ("--press-force-N", "press_force_N", None),
-            ("--du-mm", "du_mm", 0.25))
+FEM_ONLY = tuple((f.flag, f.dest, f.default_in("cli"))
+                 for f in map(field_of, ("contact.law", "contact.friction", *FEM_KEYS)))
 
-#: how the cup is pressed before it is sealed: the study's field -> `validation.bridge.fem_route.Press`'s kind, scale
-_PRESSES = {"loads.r_start_mm": None, "loads.press_u_mm": ("u_m", 1e-3), "loads.press_force_N": ("force_N", 1.0)}
+#: the study's fields that say how the cup is pressed before it is sealed (one of them)
+_PRESSES = ("loads.r_start_mm", "loads.press_u_mm", "loads.press_force_N")
 
 
 def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, dict[str, Any]]:
@@ -38,9 +40,10 @@ def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, 
     from reduced.lifetime import LeakageModel
     from validation.bridge.design import resolve_cup
     from validation.bridge.fem_route import FemCup, Press, register
+    from validation.bridge.study import Loads
     from validation.commands._cup import contact_choice, load_cup_design
     from validation.guards import check_design, check_modulus
-    from validation.study_schema import check_route, field_of, parse, values_from_args
+    from validation.study_schema import check_route, parse, values_from_args
 
     refuse_other_options(args, "fem", _NOT_HERE, "computes the cup's mechanics, volume and contact profile "
                          "in the FEM (elastic wall, gas-filled cavity)")
@@ -53,8 +56,8 @@ def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, 
         if presses[key] is not None:
             parse(field_of(key), presses[key], "cli")
     check_route({**presses, "stiffness.route": "fem"}, [k for k, v in presses.items() if v is not None], "cli")
-    press = next((Press(_PRESSES[k][0], _PRESSES[k][1] * v) for k, v in presses.items()
-                  if v is not None and _PRESSES[k] is not None), None)
+    how = Loads(press_u_mm=presses["loads.press_u_mm"], press_force_N=presses["loads.press_force_N"]).press()
+    press = None if how is None else Press(*how)
     design = load_cup_design(args)
     contact = contact_choice(args, design)
     check_design(design.geometry.describe(), args.allow_unusual_design, source=design.geometry.name)

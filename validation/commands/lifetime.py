@@ -27,17 +27,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from validation.commands._cup import add_contact_arguments, add_cup_arguments, add_cup_law_arguments, cup_laws
 from validation.bridge.pipeline import DEFAULT_SURFACE
+from validation.commands._cup import add_contact_arguments, add_cup_arguments, add_cup_law_arguments, cup_laws
+from validation.commands._fem_route import FEM_KEYS, FEM_ONLY, run_fem_route
 from validation.commands._reduced_options import ILLUSTRATIVE, build_uc, check_run_options, relaxation_law
 from validation.commands._surface import add_surface_arguments
 from validation.study_schema import add_flags
 
 NAME = "lifetime"
 HELP = "lifetime of a suction cup under pull forces (reduced leakage model, eqs 3-24)"
-
-#: the study's fields of the fem route's group (`validation.study_schema`; contact: `add_contact_arguments`)
-FEM_KEYS = ("stiffness.fidelity", "loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -259,7 +257,6 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import check_file_names, check_outputs, command_inputs
     check_outputs(directories={"--out": args.out}, inputs=command_inputs(args))
     check_file_names({f"--force {f!r}": [f"trajectory_F1_{f:g}N.csv"] for f in args.force_N if args.out})
-    from validation.commands._fem_route import FEM_ONLY, run_fem_route
     if args.route == "fem":
         return run_fem_route(args)
     given = [option for option, name, default in FEM_ONLY if getattr(args, name) != default]
