@@ -5,7 +5,8 @@ a sweep file's base key (``base.E_MPa``) and a command-line flag (``--E-MPa``). 
 each field once: its key path as the scene writes it, the Study attribute it sets, its type, unit,
 default, choices, meaning, the shared plausibility guard (`validation.guards`), its sweep key and
 its flag, and where one spelling differs (a default, the routes it offers) that difference. The
-scene parser, the sweep parser's study part and `cupcheck example`'s options are derived from it
+scene parser, the sweep parser's study part and `cupcheck example`'s and `cupcheck lifetime`'s
+options (those that are study fields) are derived from it
 (`parse`, `add_flags`, `study_from_values`), and the rules that relate fields (`check_route`) are
 written once with the names of the spelling the user wrote (`Field.name`, `Field.setting`), so an
 error names the key path or the flag as given.

@@ -36,6 +36,11 @@ from validation.study_schema import add_flags
 
 NAME = "lifetime"
 HELP = "lifetime of a suction cup under pull forces (reduced leakage model, eqs 3-24)"
+#: the study's fields `lifetime` spells as flags (`validation.study_schema.add_flags`); its other options
+#: (--stiffness, --d0-mm, --nu of the surface's E*, the gas, the integration, --json, ...) are its own
+KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "stiffness.route", "loads.r_start_mm",
+        "cup.l0_mm", "cup.l1_mm", "contact.law", "contact.friction", *FEM_KEYS, "loads.F1_N", "material.E_MPa",
+        "loads.kappa", "surface.uc_table", "surface.preset", "material.relaxation", "fluid.kind")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
