@@ -57,6 +57,11 @@ def test_cli_lifetime_equals_the_python_call(capsys, tmp_path):
     (["--E-MPa", "-1"], "--E-MPa: "),
     (["--force", "-3"], "--force"),
     (["--r-start-mm", "30"], "r_start_mm: "),
+    (["--press-u-mm", "0"], "--press-u-mm: must be > 0, got 0$"),
+    (["--press-force-N", "-5"], "--press-force-N: must be > 0, got -5$"),
+    (["--r-start-mm", "12", "--press-u-mm", "6"], "--press-u-mm: the cup is pressed one way: give one of "
+                                                  "--r-start-mm, --press-u-mm$"),
+    (["--press-u-mm", "6", "--press-force-N", "5"], "--press-force-N: the cup is pressed one way"),
 ])
 def test_bad_input_is_refused_before_any_fem_work(capsys, tmp_path, extra, field):
     out = tmp_path / "never"
@@ -68,7 +73,42 @@ def test_bad_input_is_refused_before_any_fem_work(capsys, tmp_path, extra, field
 
 
 @pytest.mark.parametrize("option,value", [("--contact", "sticking"), ("--fidelity", "medium"),
-                                          ("--friction", "0.5"), ("--du-mm", "0.1")])
+                                          ("--friction", "0.5"), ("--du-mm", "0.1"),
+                                          ("--press-u-mm", "6"), ("--press-force-N", "5")])
 def test_fem_options_are_refused_on_other_routes(capsys, option, value):
     code, _, err = _run(capsys, "lifetime", "--reference-mode", option, value)
     assert code == 2 and f"{option}: applies to --route fem only" in err
+
+
+def test_pressing_to_the_u_that_r_start_reached_seals_the_same_cup(capsys):
+    """--press-u-mm at the plate displacement the default press (to r_start) ended at gives the same
+    sealed state and lifetime: two ways to press, one cup (to the FEM's Newton tolerance)."""
+    code, text, err = _run(capsys, "lifetime", "--route", "fem", "--force", "10", "--json")
+    assert code == 0, err
+    by_r, = json.loads(text)
+    code, text, err = _run(capsys, "lifetime", "--route", "fem", "--force", "10", "--json",
+                           "--press-u-mm", repr(by_r["u_sealed_mm"]))
+    assert code == 0, err
+    by_u, = json.loads(text)
+    assert by_u["cup"]["press"] == {"kind": "u_m", "value": pytest.approx(1e-3 * by_r["u_sealed_mm"], rel=1e-15)}
+    assert "press" not in by_r["cup"]
+    assert by_u["r_start_mm"] == pytest.approx(by_r["r_start_mm"], rel=1e-7)
+    for key in ("N0", "lifetime_s", "largest_force_N"):
+        assert by_u[key] == pytest.approx(by_r[key], rel=1e-8), key
+    assert by_u["reason"] == by_r["reason"]
+
+
+def test_press_force_reaches_the_route_as_a_press():
+    """--press-force-N is the fem route's `Press("force_N", F)`, --press-u-mm its `Press("u_m", u)`;
+    no flag keeps the route's own press to r_start (None). No FEM is solved."""
+    from validation.bridge.fem_route import Press
+    from validation.cli import build_parser
+    from validation.commands._fem_route import fem_route_case
+
+    def press(*extra):
+        args = build_parser().parse_args(["lifetime", "--route", "fem", *extra])
+        return fem_route_case(args)[1]["press"]
+
+    assert press("--press-force-N", "5") == Press("force_N", 5.0)
+    assert press("--press-u-mm", "6.5") == Press("u_m", 1e-3 * 6.5)
+    assert press() is None

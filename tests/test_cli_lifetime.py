@@ -140,3 +140,28 @@ def test_kappa_scales_the_stiffness_as_a_scaled_curve(capsys):
     assert json.loads(out)[0]["lifetime_s"] > solve_lifetime(base, 10.0, route="paper").lifetime_s
     code, _, err = _run(capsys, "lifetime", "--kappa", "0")
     assert code == 2 and "--kappa: stiffness factor must be > 0" in err
+
+
+def test_lifetimes_study_flags_are_the_fields():
+    """The options of `lifetime` that are study fields are the schema's flags: the same attribute,
+    choices and command-line default as `example` and the scenes (`validation.study_schema`)."""
+    import argparse
+
+    from validation.cli import build_parser
+    from validation.commands.lifetime import KEYS
+    from validation.study_schema import field_of
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    actions = {a.option_strings[-1]: a for a in sub.choices["lifetime"]._actions if a.option_strings}
+    for key in KEYS:
+        f = field_of(key)
+        action = actions[f.flag]
+        assert action.dest == f.dest, key
+        if key == "stiffness.route":                      # lifetime's own default route: paper
+            assert action.default == "paper" and tuple(action.choices) == f.choices_in("cli")
+            continue
+        assert action.default == f.default_in("cli"), key
+        if key == "material.relaxation":                  # a relaxation CSV besides the field's choices
+            assert action.choices is None
+        elif f.type == "choice" and action.choices is not None:
+            assert tuple(action.choices) == f.choices_in("cli"), key

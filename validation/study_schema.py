@@ -5,7 +5,8 @@ a sweep file's base key (``base.E_MPa``) and a command-line flag (``--E-MPa``). 
 each field once: its key path as the scene writes it, the Study attribute it sets, its type, unit,
 default, choices, meaning, the shared plausibility guard (`validation.guards`), its sweep key and
 its flag, and where one spelling differs (a default, the routes it offers) that difference. The
-scene parser, the sweep parser's study part and `cupcheck example`'s options are derived from it
+scene parser, the sweep parser's study part and `cupcheck example`'s and `cupcheck lifetime`'s
+options (those that are study fields) are derived from it
 (`parse`, `add_flags`, `study_from_values`), and the rules that relate fields (`check_route`) are
 written once with the names of the spelling the user wrote (`Field.name`, `Field.setting`), so an
 error names the key path or the flag as given.
@@ -40,7 +41,7 @@ class Field:
     "file"; positive: numbers must be > 0; guard: "modulus" or "forces" (`validation.guards`);
     sweep: the sweep file's base key (None: not in sweep files); flag: the command-line flag
     (None: not on the command line); scene: whether scene files have it; spelled: per spelling,
-    what differs ({"sweep": {"default": [10.0]}, "cli": {"choices": ROUTES}})."""
+    what differs ({"sweep": {"default": [10.0]}, "cli": {"choices": ROUTES, "dest": "force_N"}})."""
 
     key: str
     attr: str
@@ -75,7 +76,9 @@ class Field:
 
     @property
     def dest(self) -> str:
-        """The argparse attribute of the flag."""
+        """The argparse attribute of the flag (the command line's own, where it names one)."""
+        if "dest" in self.spelled.get("cli", {}):
+            return self.spelled["cli"]["dest"]
         return (self.flag or self.key).lstrip("-").replace("-", "_").split(".")[-1]
 
 
@@ -95,10 +98,10 @@ FIELDS: tuple[Field, ...] = (
     Field("cup.l1_mm", "design.l1_mm", "number", None, "eq (5)'s strip width at r1 [mm] (default: Table 1's for "
           "the base cup)", unit="mm", positive=True, sweep="l1_mm", flag="--l1-mm", scene=False),
     Field("material.E_MPa", "material.E_MPa", "number", 4.0, "Young's modulus [MPa] of the wall (and of p/E)",
-          unit="MPa", positive=True, guard="modulus", sweep="E_MPa"),
+          unit="MPa", positive=True, guard="modulus", sweep="E_MPa", flag="--E-MPa"),
     Field("material.nu", "material.nu", "number", 0.49, "Poisson's ratio, in [0, 0.5)", sweep="nu"),
     Field("material.relaxation", "loads.relaxation", "choice", "none", "none, or the default power-law relaxation "
-          "modulus (4.4 MPa at 1 s, 1.8 MPa at 3e4 s)", choices=("none", "default")),
+          "modulus (4.4 MPa at 1 s, 1.8 MPa at 3e4 s)", choices=("none", "default"), flag="--relaxation"),
     Field("contact.law", "contact.law", "choice", "frictionless", "the FEM's contact with the plane (default: "
           "the design file's [contact] law, else frictionless)", choices=_LAWS, sweep="contact", flag="--contact",
           spelled={"cli": {"default": None}}),
@@ -109,15 +112,15 @@ FIELDS: tuple[Field, ...] = (
     Field("surface.uc_table", "surface.uc_table", "file", None, "a u_c table CSV (columns p_over_E,u_c_m; u_c "
           "in m) instead of the preset", flag="--uc-table"),
     Field("fluid.kind", "loads.fluid", "choice", "air", "what fills the cavity and leaks in",
-          choices=("air", "water")),
+          choices=("air", "water"), flag="--fluid"),
     Field("loads.F1_N", "loads.forces_N", "numbers", [5.0, 10.0, 20.0, 40.0, 80.0], "pull forces F1 [N]: one "
           "lifetime (and trajectory) per force", unit="N", positive=True, guard="forces", sweep="F1_N",
-          spelled={"sweep": {"default": [10.0]}}),
+          flag="--force", spelled={"sweep": {"default": [10.0]}, "cli": {"default": [10.0], "dest": "force_N"}}),
     Field("loads.r_start_mm", "loads.r_start_mm", "number", None, "start radius of the contact [mm] (default: "
           "Table 1's 12 mm for A and B, mid-wall otherwise)", unit="mm", positive=True, sweep="r_start_mm",
           flag="--r-start-mm"),
     Field("loads.kappa", "loads.kappa", "number", 1.0, "stiffness factor: F0 replaced by kappa F0 (the paper's "
-          "Fig. 1stiffnessFactor)", positive=True),
+          "Fig. 1stiffnessFactor)", positive=True, flag="--kappa"),
     Field("loads.press_u_mm", "loads.press_u_mm", "number", None, "route fem: press the cup to this plate "
           "displacement [mm] instead of to r_start", unit="mm", positive=True, flag="--press-u-mm"),
     Field("loads.press_force_N", "loads.press_force_N", "number", None, "route fem: press the cup with this "
@@ -224,9 +227,11 @@ def add_flags(group: argparse._ActionsContainer, keys: Iterable[str], helps: Map
             continue
         if f.type == "choice" and "type" not in extra:
             extra["choices"] = f.choices_in("cli")
-        elif f.type == "number":
+        elif f.type in ("number", "numbers"):
             extra.setdefault("type", float)
             extra.setdefault("metavar", f.unit.upper() or "X")
+            if f.type == "numbers":
+                extra.setdefault("nargs", "+")
         elif f.type in ("name", "file"):
             extra.setdefault("metavar", "NAME" if f.type == "name" else "FILE")
         shown = "%(default)s" if default is not None else "none"

@@ -11,6 +11,7 @@ import sys
 from typing import Any
 
 from validation.commands._reduced_options import build_uc, check_run_options, refuse_other_options
+from validation.study_schema import field_of
 
 #: mesh level of the fem route when --fidelity is not given (one lifetime 4-6 s of CPU coarse, ~20 s medium)
 DEFAULT_FIDELITY = "coarse"
@@ -22,9 +23,14 @@ _NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--suction-table", "su
              ("--l1-mm", "l1_mm", None), ("--kappa", "kappa", 1.0), ("--relaxation", "relaxation", "none"),
              ("--phi0-s", "phi0_s", None))
 
+#: the study's fields `lifetime` spells as the fem route's own flags (`validation.study_schema`), besides the contact
+FEM_KEYS = ("stiffness.fidelity", "loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm")
 #: options of the fem route only: (option, attribute, default)
-FEM_ONLY = (("--contact", "contact", None), ("--friction", "friction", None), ("--fidelity", "fidelity", None),
-            ("--du-mm", "du_mm", 0.25))
+FEM_ONLY = tuple((f.flag, f.dest, f.default_in("cli"))
+                 for f in map(field_of, ("contact.law", "contact.friction", *FEM_KEYS)))
+
+#: the study's fields that say how the cup is pressed before it is sealed (one of them)
+_PRESSES = ("loads.r_start_mm", "loads.press_u_mm", "loads.press_force_N")
 
 
 def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, dict[str, Any]]:
@@ -33,9 +39,11 @@ def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, 
     from reduced.gas import Gas
     from reduced.lifetime import LeakageModel
     from validation.bridge.design import resolve_cup
-    from validation.bridge.fem_route import FemCup, register
+    from validation.bridge.fem_route import FemCup, Press, register
+    from validation.bridge.study import Loads
     from validation.commands._cup import contact_choice, load_cup_design
     from validation.guards import check_design, check_modulus
+    from validation.study_schema import check_route, parse, values_from_args
 
     refuse_other_options(args, "fem", _NOT_HERE, "computes the cup's mechanics, volume and contact profile "
                          "in the FEM (elastic wall, gas-filled cavity)")
@@ -43,6 +51,13 @@ def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, 
     E_MPa = check_modulus(args.E_MPa, "--E-MPa")
     if not (math.isfinite(args.du_mm) and args.du_mm > 0):
         raise ValueError(f"--du-mm: the plate step along the branch must be > 0 mm, got {args.du_mm:g}")
+    presses = values_from_args(args, _PRESSES)
+    for key in ("loads.press_u_mm", "loads.press_force_N"):
+        if presses[key] is not None:
+            parse(field_of(key), presses[key], "cli")
+    check_route({**presses, "stiffness.route": "fem"}, [k for k, v in presses.items() if v is not None], "cli")
+    how = Loads(press_u_mm=presses["loads.press_u_mm"], press_force_N=presses["loads.press_force_N"]).press()
+    press = None if how is None else Press(*how)
     design = load_cup_design(args)
     contact = contact_choice(args, design)
     check_design(design.geometry.describe(), args.allow_unusual_design, source=design.geometry.name)
@@ -54,10 +69,11 @@ def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, 
     model = LeakageModel(cup=choice.cup, u_c=build_uc(args), gas=Gas(T_K=args.T_K), p_a_Pa=args.p_a_Pa,
                          E_Pa=1e6 * E_MPa, interface=args.interface, label=choice.label)
     route = register()
-    options = {**route.options, "cup": fem_cup, "du_m": 1e-3 * args.du_mm}
+    options = {**route.options, "cup": fem_cup, "press": press, "du_m": 1e-3 * args.du_mm}
     route.check(model, options)
     cup = {**choice.describe(), "route": "fem", "fem_cup": fem_cup.describe(), "contact": contact.describe(),
-           "du_mm": args.du_mm, "interface": args.interface}
+           **({"press": {"kind": press.kind, "value": press.value}} if press else {}), "du_mm": args.du_mm,
+           "interface": args.interface}
     return model, options, choice, cup
 
 
@@ -101,7 +117,7 @@ def run_fem_route(args: argparse.Namespace) -> int:
         return 0
     fem = cup["fem_cup"]
     s0 = results[0].details
-    print(f"cup: {choice.label}; pressed to r_start {cup['r_start_mm']:.4g} mm and sealed (u = "
+    print(f"cup: {choice.label}; {_pressed(args, cup, s0)} and sealed (u = "
           f"{s0['u_sealed_mm']:.4g} mm, N0 = {s0['N0']:.4e}); route fem: {fem['fidelity']} mesh, E "
           f"{fem['E_Pa'] / 1e6:g} MPa, nu {fem['nu']:g}, contact {_law(cup['contact'])} "
           f"({cup['contact']['source']}), plate step {cup['du_mm']:g} mm; largest holdable force "
@@ -128,6 +144,14 @@ def _trajectory(r) -> dict[str, Any]:
 
 def _summaries(results, cup: dict[str, Any]) -> list[dict]:
     return [{**r.summary(), "largest_force_N": results.largest_force_N, "cup": cup} for r in results]
+
+
+def _pressed(args: argparse.Namespace, cup: dict[str, Any], sealed: dict[str, Any]) -> str:
+    """How the cup was pressed, as the command line asked (a press by u or force: the r_c it reached)."""
+    if args.press_u_mm is None and args.press_force_N is None:
+        return f"pressed to r_start {cup['r_start_mm']:.4g} mm"
+    how = f"to u = {args.press_u_mm:g} mm" if args.press_u_mm is not None else f"with {args.press_force_N:g} N"
+    return f"pressed {how} (r_c {sealed['r_start_mm']:.4g} mm)"
 
 
 def _law(contact: dict[str, Any]) -> str:

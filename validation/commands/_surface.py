@@ -11,13 +11,15 @@ import sys
 import warnings
 
 
-def add_surface_arguments(parser: argparse.ArgumentParser, group=None) -> None:
-    """--surface | --psd | --line-scan (mutually exclusive), --psd-convention, --tip-radius-um."""
+def add_surface_arguments(parser: argparse.ArgumentParser, group=None, preset: bool = True) -> None:
+    """--surface | --psd | --line-scan (mutually exclusive), --psd-convention, --tip-radius-um;
+    `preset` False: the caller adds --surface itself (`lifetime`, from the study's field)."""
     src = group if group is not None else parser.add_mutually_exclusive_group()
-    src.add_argument("--surface", metavar="NAME",
-                     help="calibrated preset (see `cupcheck uc --list-surfaces`); for `lifetime`, "
-                          "pmma-1.89 when no surface or table is given, and `illustrative` the "
-                          "power-law u_c table of reduced/data (not a rough-contact result)")
+    if preset:
+        src.add_argument("--surface", metavar="NAME",
+                         help="calibrated preset (see `cupcheck uc --list-surfaces`); for `lifetime`, "
+                              "pmma-1.89 when no surface or table is given, and `illustrative` the "
+                              "power-law u_c table of reduced/data (not a rough-contact result)")
     src.add_argument("--psd", metavar="FILE", help="isotropic C(q) CSV, columns q_per_m,C_m4 [1/m, m^4]")
     src.add_argument("--line-scan", metavar="FILE",
                      help="line scan CSV, header x_<unit>,z_<unit> (unit m, mm, um or nm)")

@@ -27,12 +27,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from validation.bridge.pipeline import DEFAULT_SURFACE
 from validation.commands._cup import add_contact_arguments, add_cup_arguments, add_cup_law_arguments, cup_laws
+from validation.commands._fem_route import FEM_KEYS, FEM_ONLY, run_fem_route
 from validation.commands._reduced_options import ILLUSTRATIVE, build_uc, check_run_options, relaxation_law
 from validation.commands._surface import add_surface_arguments
+from validation.study_schema import add_flags
 
 NAME = "lifetime"
 HELP = "lifetime of a suction cup under pull forces (reduced leakage model, eqs 3-24)"
+#: the study's fields `lifetime` spells as flags (`validation.study_schema.add_flags`); its other options
+#: (--stiffness, --d0-mm, --nu of the surface's E*, the gas, the integration, --json, ...) are its own
+KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "stiffness.route", "loads.r_start_mm",
+        "cup.l0_mm", "cup.l1_mm", "contact.law", "contact.friction", *FEM_KEYS, "loads.F1_N", "material.E_MPa",
+        "loads.kappa", "surface.uc_table", "surface.preset", "material.relaxation", "fluid.kind")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -41,15 +49,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_cup_law_arguments(p)
     fem = p.add_argument_group("fem route (--route fem)")
     add_contact_arguments(fem, "the paper's soap-cleaned PMMA is not frictionless, so give the law you mean")
-    fem.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default=None,
-                     help="for --route fem: mesh level of the cup (default coarse with --route fem: one "
-                          "lifetime in ~15 s on one core; medium is ~4x slower, see "
-                          "benchmarks/bench_fem_route.py)")
-    fem.add_argument("--du-mm", dest="du_mm", type=float, default=0.25,
-                     help="for --route fem: the plate step along the equilibrium branch in mm, > 0 "
-                          "(default: 0.25)")
-    p.add_argument("--force", dest="force_N", type=float, nargs="+", default=[10.0], metavar="F1_N",
-                   help="pull force(s) F1 in N, > 0 (default: 10)")
+    add_flags(fem, FEM_KEYS, helps={
+        "stiffness.fidelity": "for --route fem: mesh level of the cup (default coarse with --route fem: one "
+                              "lifetime in ~15 s on one core; medium is ~4x slower, see "
+                              "benchmarks/bench_fem_route.py)"})
+    add_flags(p, ("loads.F1_N",), helps={"loads.F1_N": "pull force(s) F1 in N, > 0 (default: 10)"},
+              **{"--force": {"metavar": "F1_N"}})
     p.add_argument("--stiffness", default="appendix-a", metavar="appendix-a|FILE.csv",
                    help="stiffness force F0: the Appendix A formula, or a StiffnessCurve CSV "
                         "(columns u_mm,F0_N[,h_mm,r_c_mm,l_mm,V_mm3]; its JSON sidecar, if any, "
@@ -59,18 +64,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--interface", default="linear", choices=("linear", "p_b", "p_a"),
                    help="for --route coupled: the gas pressure in the contact zone next to the seal, "
                         "rising linearly from p_b to p_a across it, or the bounds p_b, p_a (default: linear)")
-    p.add_argument("--E-MPa", dest="E_MPa", type=float, default=4.0,
-                   help="Young's modulus in MPa for Appendix A and for p/E without relaxation (default: 4)")
+    add_flags(p, ("material.E_MPa",), helps={
+        "material.E_MPa": "Young's modulus in MPa for Appendix A and for p/E without relaxation (default: 4)"})
     p.add_argument("--d0-mm", dest="d0_mm", type=float, default=2.0,
                    help="Appendix A wall thickness at r0 in mm (d1 = 0) (default: 2)")
-    p.add_argument("--kappa", type=float, default=1.0,
-                   help="stiffness factor: F0 replaced by kappa F0, > 0 (the paper's Fig. "
-                        "1stiffnessFactor) (default: 1)")
+    add_flags(p, ("loads.kappa",), **{"--kappa": {"metavar": "KAPPA"}})
     src = p.add_mutually_exclusive_group()
-    src.add_argument("--uc-table", default=None, metavar="FILE.csv",
-                     help="critical gap table, columns p_over_E,u_c_m (u_c in m; 0 = sealed) "
-                          "(default: the surface pmma-1.89)")
-    add_surface_arguments(p, src)
+    add_flags(src, ("surface.uc_table", "surface.preset"), helps={
+        "surface.uc_table": "critical gap table, columns p_over_E,u_c_m (u_c in m; 0 = sealed) "
+                            "(default: the surface pmma-1.89)",
+        "surface.preset": f"calibrated preset (see `cupcheck uc --list-surfaces`); {DEFAULT_SURFACE} when no "
+                          f"surface or table is given, and `{ILLUSTRATIVE}` the power-law u_c table of "
+                          "reduced/data (not a rough-contact result)"},
+        **{"--uc-table": {"metavar": "FILE.csv"}})
+    add_surface_arguments(p, src, preset=False)
     p.add_argument("--uc-method", default="emt", choices=("emt", "critical-junction"),
                    help="with a surface: u_c route of Persson theory (default: emt, as in the paper)")
     p.add_argument("--gamma", type=float, default=0.45,
@@ -81,15 +88,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="with a surface: Poisson ratio of the cup for E* = E/(1-nu^2) [-] (default: 0.5, "
                         "the paper's rubber; `stiffness` defaults to 0.49 because its displacement "
                         "elements lock above 0.495)")
-    p.add_argument("--relaxation", default="none", metavar="none|default|FILE.csv",
-                   help="relaxation modulus E_eff(t): none, the default power law (4.4 MPa at 1 s, "
-                        "1.8 MPa at 3e4 s), or a CSV with columns t_s,E_Pa (default: none)")
+    add_flags(p, ("material.relaxation",), helps={
+        "material.relaxation": "relaxation modulus E_eff(t): none, the default power law (4.4 MPa at 1 s, "
+                               "1.8 MPa at 3e4 s), or a CSV with columns t_s,E_Pa (default: none)"},
+        **{"--relaxation": {"type": str, "metavar": "none|default|FILE.csv"}})
     p.add_argument("--phi0-s", dest="phi0_s", type=float, default=None,
                    help="contact time of the stiffness measurement in s (default: l/rdot at r_start "
                         "and 0.12 mm/s plate speed, 13.0 s for cup A)")
-    p.add_argument("--fluid", default="air", choices=("air", "water"),
-                   help="what fills the cavity and leaks in: air (ideal gas, eqs 8, 19) or water "
-                        "(incompressible, eq 24; p_b from the force balance, may be negative) (default: air)")
+    add_flags(p, ("fluid.kind",), helps={
+        "fluid.kind": "what fills the cavity and leaks in: air (ideal gas, eqs 8, 19) or water "
+                      "(incompressible, eq 24; p_b from the force balance, may be negative) (default: air)"})
     p.add_argument("--liquid-viscosity-Pa-s", dest="liquid_viscosity", type=float, default=1.002e-3,
                    help="viscosity of the liquid in Pa s for --fluid water "
                         "(default: 1.002e-3, water at 20 C)")
@@ -254,7 +262,6 @@ def run(args: argparse.Namespace) -> int:
     from validation.output import check_file_names, check_outputs, command_inputs
     check_outputs(directories={"--out": args.out}, inputs=command_inputs(args))
     check_file_names({f"--force {f!r}": [f"trajectory_F1_{f:g}N.csv"] for f in args.force_N if args.out})
-    from validation.commands._fem_route import FEM_ONLY, run_fem_route
     if args.route == "fem":
         return run_fem_route(args)
     given = [option for option, name, default in FEM_ONLY if getattr(args, name) != default]
