@@ -107,3 +107,23 @@ def test_refinement_goes_only_where_the_estimate_asks(paper_lattice):
             assert len(axes.rounds) == 2 and gaps.min() >= 4
         errors[tol] = np.abs(_lifetimes(goal, lattice_subtable(lattice, axes.u_index, axes.dp_index)) / full - 1)
     assert errors[1e-3].max() < 1e-3 < errors[math.inf].max()
+
+
+# ---------------------------------------------------------------- cup A's FEM table (slow)
+@pytest.mark.slow
+def test_adaptive_lifetimes_are_the_full_tables():
+    """Cup A, coarse, frictionless, pmma-1.89: the adaptive table built for 5, 10, 20, 40 N gives
+    the full default grid's lifetimes and largest holdable force to 0.5 %, from a tenth of its states."""
+    from validation.bridge.coupled.build import suction_table_for
+    from validation.cli import build_parser
+    from validation.commands.lifetime import build_model, build_uc
+
+    args = build_parser().parse_args(["lifetime", "--surface", "pmma-1.89"])
+    model = build_model(args).model
+    goal = SuctionGoal(replace(model, stiffness=None, u_c=build_uc(args)), (5.0, 10.0, 20.0, 40.0))
+    full = suction_table_for("A", fidelity="coarse")
+    adaptive = suction_table_for("A", fidelity="coarse", goal=goal)
+    expected, got = _lifetimes(goal, full), _lifetimes(goal, adaptive)
+    assert np.all(expected[:3] > 0) and expected[3] == got[3] == 0.0      # 40 N: over the largest force
+    np.testing.assert_allclose(got, expected, rtol=5e-3)
+    assert adaptive.provenance["states_solved"] < 0.1 * full.u_m.size * full.dp_Pa.size

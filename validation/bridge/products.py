@@ -244,10 +244,12 @@ class Products:
             s = self.study
             if s.suction_table is not None:
                 return SuctionTable.from_json(s.suction_table)
+            from validation.bridge.coupled.adaptive import goal_for
             from validation.bridge.coupled.build import suction_table_for
             return suction_table_for(s.design.cup_geometry(), fidelity=s.fidelity, contact=s.contact.contact_law(),
                                      E_Pa=s.material.E_MPa * 1e6, nu=s.material.nu,
                                      cache_dir=self._suction_cache_dir,
+                                     goal=goal_for(_model(s, None, self.uc_table(), self.cup()), s.loads.forces_N),
                                      progress=self._fem_report or (lambda f, m: self._progress(f"suction {m}")))
         return self._get("suction_table", compute)
 

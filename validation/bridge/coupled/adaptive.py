@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["AdaptiveSpec", "SuctionGoal", "Round", "AdaptiveAxes", "adaptive_axes", "lattice_subtable"]
+__all__ = ["AdaptiveSpec", "SuctionGoal", "Round", "AdaptiveAxes", "adaptive_axes", "goal_for", "lattice_subtable"]
 
 
 @dataclass(frozen=True)
@@ -94,6 +94,15 @@ class AdaptiveAxes:
 
     def describe(self) -> str:
         return f"adaptive {len(self.u_index)} u x {len(self.dp_index)} dp"
+
+
+def goal_for(model, forces_N: Sequence[float]) -> SuctionGoal | None:
+    """The goal of a lifetime job's table (`model`: its `reduced.LeakageModel`, any table), or
+    None where the job needs the full grid: with relaxation the stiffness factor follows the
+    contact time and the paths cross the table in ways the unrelaxed ones do not sample."""
+    if model.relaxation is not None or model.fluid != "air":
+        return None
+    return SuctionGoal(replace(model, suction=None, stiffness=None), tuple(forces_N))
 
 
 def lattice_subtable(table, u_index: Sequence[int], dp_index: Sequence[int]):
@@ -196,11 +205,19 @@ class _Paths:
         err_u: dict = {}
         err_dp: dict = {}
 
-        def charge(u: float, dp: float, amount: float) -> None:
-            i = int(np.clip(np.searchsorted(self.table.u_m, u) - 1, 0, len(U) - 2))
-            j = int(np.clip(np.searchsorted(self.table.dp_Pa, dp) - 1, 0, len(D) - 2))
-            err_u[(U[i], U[i + 1])] = err_u.get((U[i], U[i + 1]), 0.0) + amount
-            err_dp[(D[j], D[j + 1])] = err_dp.get((D[j], D[j + 1]), 0.0) + amount
+        def intervals(u: np.ndarray, dp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            i = np.clip(np.searchsorted(self.table.u_m, u) - 1, 0, len(U) - 2)
+            j = np.clip(np.searchsorted(self.table.dp_Pa, dp) - 1, 0, len(D) - 2)
+            return i, j
+
+        def charge(u: np.ndarray, dp: np.ndarray, amount: np.ndarray, signed: bool) -> None:
+            """Add each interval's share (signed: the shares summed with their signs first)."""
+            i, j = intervals(np.atleast_1d(u), np.atleast_1d(dp))
+            for err, index, axis in ((err_u, i, U), (err_dp, j, D)):
+                for k in np.unique(index):
+                    total = float(np.sum(np.atleast_1d(amount)[index == k]))
+                    key = (axis[k], axis[k + 1])
+                    err[key] = err.get(key, 0.0) + (abs(total) if signed else total)
 
         for F, r, life, life_new in zip(self.forces, self.records, self.lifetimes, new.lifetimes):
             if not len(r.trajectory["t_s"]) or not (math.isfinite(life) and life > 0):
@@ -212,15 +229,12 @@ class _Paths:
             ok = np.isfinite(N2[1:]) & np.isfinite(N2[:-1]) & (q2[1:] > 0) & (q2[:-1] > 0)
             seg = 0.5 * (1 / q[1:] + 1 / q[:-1]) * np.diff(N)
             seg2 = np.where(ok, 0.5 * (1 / np.where(ok, q2[1:], 1) + 1 / np.where(ok, q2[:-1], 1)) * np.diff(N2), 0.0)
-            change = np.abs(np.where(ok, seg2 - seg, seg)) / life
-            for k in range(len(seg)):
-                charge(0.5 * (u[k] + u[k + 1]), 0.5 * (dp[k] + dp[k + 1]), float(change[k]))
+            charge(0.5 * (u[1:] + u[:-1]), 0.5 * (dp[1:] + dp[:-1]), np.abs(np.where(ok, seg2 - seg, -seg)) / life, False)
             ends = abs(life_new - life) / life
-            charge(u[0], dp[0], ends)
-            charge(u[-1], dp[-1], ends)
+            charge(np.array([u[0], u[-1]]), np.array([dp[0], dp[-1]]), np.array([ends, ends]), False)
         ends = abs(new.largest_N - self.largest_N) / self.largest_N
-        charge(self.u_start, self.start_dp, ends)
-        charge(self.table.u_m[0], self.end_dp, ends)
+        charge(np.array([self.u_start, self.table.u_m[0]]), np.array([self.start_dp, self.end_dp]),
+               np.array([ends, ends]), False)
         return err_u, err_dp
 
     def _along(self, F: float, dp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
