@@ -113,7 +113,7 @@ def test_refinement_goes_only_where_the_estimate_asks(paper_lattice):
 @pytest.mark.slow
 def test_adaptive_lifetimes_are_the_full_tables():
     """Cup A, coarse, frictionless, pmma-1.89: the adaptive table built for 5, 10, 20, 40 N gives
-    the full default grid's lifetimes and largest holdable force to 0.5 %, from a tenth of its states."""
+    the full default grid's lifetimes and largest holdable force to 0.5 %, from a third of its states."""
     from validation.bridge.coupled.build import suction_table_for
     from validation.cli import build_parser
     from validation.commands.lifetime import build_model, build_uc
@@ -126,4 +126,4 @@ def test_adaptive_lifetimes_are_the_full_tables():
     expected, got = _lifetimes(goal, full), _lifetimes(goal, adaptive)
     assert np.all(expected[:3] > 0) and expected[3] == got[3] == 0.0      # 40 N: over the largest force
     np.testing.assert_allclose(got, expected, rtol=5e-3)
-    assert adaptive.provenance["states_solved"] < 0.1 * full.u_m.size * full.dp_Pa.size
+    assert adaptive.provenance["states_solved"] < full.u_m.size * full.dp_Pa.size / 3

@@ -17,10 +17,13 @@ It starts on every 8th u and every 10th dp of the lattice, then:
 - an interval whose error is below `tol` is not split again; the others' halves are, while the
   paths cross them, down to the lattice.
 
-Lazily solving the states along each path would need fewer states but an interpolation that
-tolerates holes; goal-oriented splitting of a tensor grid keeps `reduced` unchanged and bounds
-the work by the paths' extent. The lifetimes' error against the full grid, and the cost of
-both, are measured in benchmarks/bench_coupled.py (`--adaptive`).
+Why a tensor grid and not the states along each path: the leak through a profile jumps where a
+node lands, so a path needs the grid's own u spacing wherever it goes (coarser rows move the
+lifetimes by percents), and states solved only next to the paths would need `reduced.coupled` to
+interpolate a table with holes. Splitting a tensor grid where the asked lifetimes need it keeps
+`reduced` unchanged, reproduces the full table's lifetimes and skips what no path reads; its
+cost is every row the paths cross times every column any force's path crosses. The lifetimes'
+error against the full grid and the cost of both: benchmarks/bench_coupled.py --adaptive.
 """
 
 from __future__ import annotations
@@ -210,14 +213,14 @@ class _Paths:
             j = np.clip(np.searchsorted(self.table.dp_Pa, dp) - 1, 0, len(D) - 2)
             return i, j
 
-        def charge(u: np.ndarray, dp: np.ndarray, amount: np.ndarray, signed: bool) -> None:
-            """Add each interval's share (signed: the shares summed with their signs first)."""
+        def charge(u: np.ndarray, dp: np.ndarray, amount: np.ndarray) -> None:
+            """Add to each interval the shares of the points (u, dp) that lie in it."""
             i, j = intervals(np.atleast_1d(u), np.atleast_1d(dp))
             for err, index, axis in ((err_u, i, U), (err_dp, j, D)):
                 for k in np.unique(index):
                     total = float(np.sum(np.atleast_1d(amount)[index == k]))
                     key = (axis[k], axis[k + 1])
-                    err[key] = err.get(key, 0.0) + (abs(total) if signed else total)
+                    err[key] = err.get(key, 0.0) + total
 
         for F, r, life, life_new in zip(self.forces, self.records, self.lifetimes, new.lifetimes):
             if not len(r.trajectory["t_s"]) or not (math.isfinite(life) and life > 0):
@@ -229,12 +232,12 @@ class _Paths:
             ok = np.isfinite(N2[1:]) & np.isfinite(N2[:-1]) & (q2[1:] > 0) & (q2[:-1] > 0)
             seg = 0.5 * (1 / q[1:] + 1 / q[:-1]) * np.diff(N)
             seg2 = np.where(ok, 0.5 * (1 / np.where(ok, q2[1:], 1) + 1 / np.where(ok, q2[:-1], 1)) * np.diff(N2), 0.0)
-            charge(0.5 * (u[1:] + u[:-1]), 0.5 * (dp[1:] + dp[:-1]), np.abs(np.where(ok, seg2 - seg, -seg)) / life, False)
+            charge(0.5 * (u[1:] + u[:-1]), 0.5 * (dp[1:] + dp[:-1]), np.abs(np.where(ok, seg2 - seg, -seg)) / life)
             ends = abs(life_new - life) / life
-            charge(np.array([u[0], u[-1]]), np.array([dp[0], dp[-1]]), np.array([ends, ends]), False)
+            charge(np.array([u[0], u[-1]]), np.array([dp[0], dp[-1]]), np.array([ends, ends]))
         ends = abs(new.largest_N - self.largest_N) / self.largest_N
         charge(np.array([self.u_start, self.table.u_m[0]]), np.array([self.start_dp, self.end_dp]),
-               np.array([ends, ends]), False)
+               np.array([ends, ends]))
         return err_u, err_dp
 
     def _along(self, F: float, dp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
