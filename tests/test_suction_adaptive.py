@@ -127,3 +127,18 @@ def test_adaptive_lifetimes_are_the_full_tables():
     assert np.all(expected[:3] > 0) and expected[3] == got[3] == 0.0      # 40 N: over the largest force
     np.testing.assert_allclose(got, expected, rtol=5e-3)
     assert adaptive.provenance["states_solved"] < full.u_m.size * full.dp_Pa.size / 3
+
+
+def test_goal_only_where_the_adaptive_table_holds():
+    """Products build the adaptive table for frictionless contact without relaxation only."""
+    from fem.interface import ContactLaw
+    from reduced.viscoelastic import default_relaxation
+    from validation.bridge.coupled.adaptive import goal_for
+
+    model = reference_model(cup_by_name("A"), illustrative_uc_table())
+    goal = goal_for(model, [5, 10], ContactLaw())
+    assert goal.forces_N == (5.0, 10.0) and goal.model.stiffness is None and goal.model.suction is None
+    assert goal_for(model, [5], ContactLaw("sticking")) is None
+    assert goal_for(replace(model, relaxation=default_relaxation(), phi0_s=13.0), [5]) is None
+    with pytest.raises(ValueError, match="forces_N"):
+        goal_for(model, [0.0])

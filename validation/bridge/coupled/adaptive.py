@@ -99,11 +99,15 @@ class AdaptiveAxes:
         return f"adaptive {len(self.u_index)} u x {len(self.dp_index)} dp"
 
 
-def goal_for(model, forces_N: Sequence[float]) -> SuctionGoal | None:
-    """The goal of a lifetime job's table (`model`: its `reduced.LeakageModel`, any table), or
-    None where the job needs the full grid: with relaxation the stiffness factor follows the
-    contact time and the paths cross the table in ways the unrelaxed ones do not sample."""
+def goal_for(model, forces_N: Sequence[float], contact=None) -> SuctionGoal | None:
+    """The goal of a lifetime job's table (`model`: its `reduced.LeakageModel`, any table;
+    contact: the table's `fem.interface.ContactLaw`, None: frictionless), or None where the job
+    needs the full grid: with relaxation the stiffness factor follows the contact time and the
+    paths cross the table where the unrelaxed ones do not, and with sticking or Coulomb contact a
+    state depends on the dp steps that reached it, which the adaptive table takes differently."""
     if model.relaxation is not None or model.fluid != "air":
+        return None
+    if contact is not None and contact.law != "frictionless":
         return None
     return SuctionGoal(replace(model, suction=None, stiffness=None), tuple(forces_N))
 
