@@ -34,7 +34,7 @@ from .interface import ContactLaw
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["SuctionGrid", "suction_grid"]
+__all__ = ["SuctionGrid", "SuctionStates", "suction_grid"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,56 +73,107 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
     with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input,
     `fem.solver.ConvergenceError` naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
     converged state violates contact between the nodes or folds onto itself."""
-    h1 = cup_height(mesh)
-    u = np.asarray(u_m, float)
-    dp = np.asarray(dp_Pa, float)
-    _check_axes(u, dp, h1, material)
-    cup = CupSetup.of(mesh, material, contact, friction)
-    options = SolverOptions(**solver_opts)
-    # a dp interval is one load step unless it needs cutting: the grid itself is the sampling
-    ramp_options = replace(options, initial_step=1.0, max_step=1.0)
-    cavity = CavitySurface.of(mesh, wetting_m)
+    states = SuctionStates(mesh, material, contact, friction, wetting_m, **solver_opts)
+    return states.grid(u_m, dp_Pa, progress=progress)
 
-    def segment(mech, dirichlet, t_max, start, u_plate, where) -> tuple[StepResult, SolverStats]:
+
+class SuctionStates:
+    """The cup's converged suction states, solved on demand and kept, so that a grid can grow by
+    rows and columns (an adaptive table) without solving a state twice. A new u is pressed from
+    the kept pressed state just below it, a new dp at u is ramped from the kept state just below
+    it in that row; asked in increasing u and dp, as `grid` does, the solves are exactly
+    `suction_grid`'s. Frictionless contact is path independent, so any order reaches the same
+    states to the solver's tolerance; with sticking or Coulomb contact a state is the response
+    to the path that reached it."""
+
+    def __init__(self, mesh: Mesh, material: NeoHookean, contact: ContactLaw | str = ContactLaw(),
+                 friction: float = 0.0, wetting_m: float = 0.0, **solver_opts: Any):
+        self.mesh, self.material = mesh, material
+        self.h1_m = cup_height(mesh)
+        self._cup = CupSetup.of(mesh, material, contact, friction)
+        self._options = SolverOptions(**solver_opts)
+        # a dp interval is one load step unless it needs cutting: the grid itself is the sampling
+        self._ramp_options = replace(self._options, initial_step=1.0, max_step=1.0)
+        self._cavity = CavitySurface.of(mesh, wetting_m)
+        self._pressed: dict[float, StepResult] = {}
+        self._rows: dict[float, dict[float, tuple[StepResult, tuple]]] = {}
+        self.stats: SolverStats | None = None     # the cost of every state solved so far
+
+    @property
+    def solved(self) -> int:
+        """How many states (u, dp) have been solved."""
+        return sum(len(row) for row in self._rows.values())
+
+    def has(self, u: float, dp: float) -> bool:
+        return dp in self._rows.get(u, {})
+
+    def grid(self, u_m: Sequence[float], dp_Pa: Sequence[float],
+             progress: Callable[[float, str], None] | None = None) -> SuctionGrid:
+        """The states on u_m x dp_Pa (as `suction_grid`), solving only those not kept."""
+        u = np.asarray(u_m, float)
+        dp = np.asarray(dp_Pa, float)
+        _check_axes(u, dp, self.h1_m, self.material)
+        todo = sum(not self.has(float(a), float(b)) for a in u for b in dp[1:])
+        done = 0
+        outputs = np.empty((u.size, dp.size), dtype=object)
+        for i, u_i in enumerate(u):
+            for j, dp_j in enumerate(dp):
+                new = not self.has(float(u_i), float(dp_j))
+                outputs[i, j] = self.state(float(u_i), float(dp_j))
+                if new and j > 0 and progress:
+                    done += 1
+                    progress(done / todo, f"u = {u_i * 1e3:.4g} mm, dp = {dp_j / 1e3:.4g} kPa")
+        take = np.vectorize(lambda o, k: o[k], otypes=[float])
+        cup = self._cup
+        return SuctionGrid(
+            h1_m=self.h1_m, contact=cup.plane.law.name, friction=cup.plane.law.mu, material=self.material,
+            u_m=u, dp_Pa=dp, F1_N=take(outputs, 0), contact_force_N=take(outputs, 1), V_m3=take(outputs, 2),
+            seal_r_m=take(outputs, 3), cut_r_m=take(outputs, 4), r_c_m=take(outputs, 5),
+            potential_J=take(outputs, 6),
+            profiles=tuple(tuple(o[7] for o in row) for row in outputs), stats=self.stats)
+
+    def state(self, u: float, dp: float) -> tuple:
+        """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile) at (u, dp), solved if not kept."""
+        row = self._rows.setdefault(u, {})
+        if dp not in row:
+            below = [d for d in row if d < dp]
+            if not below:
+                state = self._press(u)
+                row[0.0] = (state, _outputs(state, self._cup.mech, self._cup, self._cavity))
+                below = [0.0]
+            if dp > 0.0:
+                lo = max(below)
+                mech = PressurizedMechanics(self._cup.mech, self._cavity, dp,
+                                            schedule=lambda t, lo=lo, hi=dp: lo + t * (hi - lo))
+                state = self._segment(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
+                                      f"u = {u * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa")
+                row[dp] = (state, _outputs(state, mech.at(1.0), self._cup, self._cavity))
+        return row[dp][1]
+
+    def _press(self, u: float) -> StepResult:
+        """The cup pressed to u without suction, from the kept pressed state just below u."""
+        below = [a for a in self._pressed if a < u]
+        u_prev = max(below) if below else 0.0
+        start = self._pressed[u_prev] if below else None
+        state = self._segment(self._cup.mech, self._cup.plate_at(u_prev), u - u_prev, start, u,
+                              f"pressing to u = {u * 1e3:.4g} mm")
+        self._pressed[u] = state
+        return state
+
+    def _segment(self, mech, dirichlet, t_max, start, u_plate, where) -> StepResult:
         """The converged state at the end of one path (pressing, or a dp interval at u_plate)."""
         last: list[StepResult] = []
+        options = self._ramp_options if isinstance(mech, PressurizedMechanics) else self._options
         try:
-            stats = follow_path(mech, dirichlet, t_max, plane=cup.plane, start=start,
-                                options=ramp_options if isinstance(mech, PressurizedMechanics) else options,
-                                on_step=last.append)
+            stats = follow_path(mech, dirichlet, t_max, plane=self._cup.plane, start=start,
+                                options=options, on_step=last.append)
         except RuntimeError as err:
             err.args = (f"{where}: {err}",)
             raise
+        self.stats = stats if self.stats is None else _joined(self.stats, stats)
         end = last[-1]
-        check_state(mesh, end.u, u_plate, 0, u_plate)     # contact kept between the nodes
-        return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0), stats
-
-    outputs = np.empty((u.size, dp.size), dtype=object)
-    total: SolverStats | None = None
-    pressed, u_prev = None, 0.0
-    for i, u_i in enumerate(u):
-        pressed, stats = segment(cup.mech, cup.plate_at(u_prev), u_i - u_prev, pressed, u_i,
-                                 f"pressing to u = {u_i * 1e3:.4g} mm")
-        total = stats if total is None else _joined(total, stats)
-        u_prev, state = u_i, pressed
-        outputs[i, 0] = _outputs(state, cup.mech, cup, cavity)
-        for j in range(1, dp.size):
-            lo, hi = dp[j - 1], dp[j]
-            mech = PressurizedMechanics(cup.mech, cavity, hi, schedule=lambda t, lo=lo, hi=hi: lo + t * (hi - lo))
-            state, stats = segment(mech, cup.plate_at(u_i, moving=False), 1.0, state, u_i,
-                                   f"u = {u_i * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {hi / 1e3:.4g} kPa")
-            total = _joined(total, stats)
-            outputs[i, j] = _outputs(state, mech.at(1.0), cup, cavity)
-            if progress:
-                progress((i * (dp.size - 1) + j) / (u.size * (dp.size - 1)),
-                         f"u = {u_i * 1e3:.4g} mm, dp = {hi / 1e3:.4g} kPa")
-    take = np.vectorize(lambda o, k: o[k], otypes=[float])
-    return SuctionGrid(
-        h1_m=h1, contact=cup.plane.law.name, friction=cup.plane.law.mu, material=material, u_m=u, dp_Pa=dp,
-        F1_N=take(outputs, 0), contact_force_N=take(outputs, 1), V_m3=take(outputs, 2),
-        seal_r_m=take(outputs, 3), cut_r_m=take(outputs, 4), r_c_m=take(outputs, 5),
-        potential_J=take(outputs, 6),
-        profiles=tuple(tuple(o[7] for o in row) for row in outputs), stats=total)
+        check_state(self.mesh, end.u, u_plate, 0, u_plate)     # contact kept between the nodes
+        return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0)
 
 
 def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:

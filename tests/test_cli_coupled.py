@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from fem.solver import SolverOptions
 from reduced.coupled import CoupledCavity
 from reduced.critical_gap import ILLUSTRATIVE_UC_CSV, UcTable
 from reduced.cup import CUP_A
@@ -89,6 +90,10 @@ def test_coupled_route_bad_input(capsys, table_path, tmp_path, argv, field):
     (["--dp-kPa", "10", "20"], "dp_kPa"), (["--dp-kPa", "0", "2000"], "dp_kPa"),
     (["--u-mm", "0", "1"], "u_mm"), (["--u-mm", "3", "1"], "u_mm"), (["--u-mm", "50"], "u_mm"),
     (["--nu", "0.499"], "nu"), (["--E-MPa", "-1"], "E"),
+    (["--force", "5"], "--force: applies to --grid adaptive only"),
+    (["--surface", "pmma-1.89"], "--surface: applies to --grid adaptive only"),
+    (["--grid", "adaptive", "--force", "5", "-1"], "--force"),
+    (["--grid", "adaptive", "--surface", "no-such-surface"], "surface"),
 ])
 def test_suction_bad_input(capsys, tmp_path, extra, field):
     out = tmp_path / "t.json"
@@ -152,3 +157,21 @@ def test_relaxed_node_conductance_is_the_unrelaxed_one_at_each_kappa(table_path)
         ok = np.isfinite(g) & (g > 0)
         assert ok.sum() > 0.5 * g.size
         assert np.max(np.abs(fitted[ok] - np.log(g[ok]))) < 1e-7
+
+
+def test_adaptive_suction_table_is_the_full_tables_rows_and_columns(capsys, table_path, tmp_path):
+    """--grid adaptive on the same lattice keeps a subset of its rows and columns, whose states
+    are the full table's to the solver's tolerance, and says how many it solved."""
+    out = tmp_path / "adaptive.json"
+    code, stdout, _ = _run(capsys, "suction", "--cup", "A", "--fidelity", "coarse", "--u-mm", "0.05", "1", "3", "5",
+                           "--dp-kPa", "0", "2", "5", "10", "20", "40", "--grid", "adaptive", "--force", "2",
+                           "--surface", "illustrative", "--out", str(out))
+    assert code == 0 and "states solved" in stdout
+    full, adaptive = SuctionTable.from_json(table_path), SuctionTable.from_json(out)
+    rows = [int(np.argmin(np.abs(full.u_m - u))) for u in adaptive.u_m]
+    cols = [int(np.argmin(np.abs(full.dp_Pa - d))) for d in adaptive.dp_Pa]
+    assert np.array_equal(full.u_m[rows], adaptive.u_m) and np.array_equal(full.dp_Pa[cols], adaptive.dp_Pa)
+    np.testing.assert_allclose(adaptive.F1_N, full.F1_N[np.ix_(rows, cols)], rtol=0,
+                               atol=SolverOptions().rtol * np.abs(full.F1_N).max())
+    assert adaptive.provenance["states_solved"] <= full.u_m.size * full.dp_Pa.size
+    assert adaptive.provenance["forces_N"] == [2.0]

@@ -264,16 +264,20 @@ class Products:
 
     def suction_table(self):
         """The coupled route's FEM suction table: the study's file, or built for the design at its
-        mesh level and contact law (kept in suction_cache_dir)."""
+        mesh level and contact law (kept in suction_cache_dir), only where the study's lifetimes
+        read it when `validation.bridge.coupled.adaptive.goal_for` allows."""
         def compute():
             from reduced.suction_table import SuctionTable
             s = self.study
             if s.suction_table is not None:
                 return SuctionTable.from_json(s.suction_table)
+            from validation.bridge.coupled.adaptive import goal_for
             from validation.bridge.coupled.build import suction_table_for
             return suction_table_for(s.design.cup_geometry(), fidelity=s.fidelity, contact=s.contact.contact_law(),
                                      E_Pa=s.material.E_MPa * 1e6, nu=s.material.nu,
                                      cache_dir=self._suction_cache_dir,
+                                     goal=goal_for(_model(s, None, self.uc_table(), self.cup()), s.loads.forces_N,
+                                                   s.contact.contact_law()),
                                      progress=self._fem_report or (lambda f, m: self._progress(f"suction {m}")))
         return self._get("suction_table", compute)
 

@@ -7,12 +7,17 @@ on the handle F1, the cavity volume, the seal radius and the contact-pressure pr
 `cupcheck lifetime --route coupled --suction-table FILE` reads. Every input is checked before the
 solve (one line, exit 2); a solve that fails exits 1; no file is left behind either way.
 
+--grid adaptive builds only the rows and columns of that grid which the lifetimes at --force on
+--surface need (`validation.bridge.coupled.adaptive`: refined where the interpolation changes
+those lifetimes); --grid full (the default) builds every state.
+
 The contact law is --contact (with --friction for coulomb), else the --geometry file's [contact]
 table, else frictionless; the table's provenance records it and where it came from.
 
 examples:
   cupcheck suction --cup A --out out/cupA_suction.json
   cupcheck suction --cup B --fidelity coarse --dp-kPa 0 25 50 75 100 --out cupB.json
+  cupcheck suction --cup A --fidelity coarse --grid adaptive --force 5 10 20 --out cupA_5_20N.json
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from validation.commands._cup import add_contact_arguments, add_cup_arguments, contact_choice, load_cup_design
+from validation.commands._surface import add_surface_arguments, has_surface
 
 NAME = "suction"
 HELP = "FEM response to the cavity suction on a (u, dp) grid, for lifetime --route coupled (JSON)"
@@ -48,6 +54,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    metavar="DP",
                    help="pressure differences p_a - p_b [kPa], from 0, increasing, at most 1000 "
                         "(default 0, 1, ..., 100)")
+    r.add_argument("--grid", choices=("full", "adaptive"), default="full",
+                   help="every state of the grid, or only those the lifetimes at --force on --surface "
+                        "need (default full)")
+    r.add_argument("--force", dest="force_N", type=float, nargs="+", default=None, metavar="F1_N",
+                   help="with --grid adaptive: the pull forces [N] the table is for (default 5 10 20 40)")
+    add_surface_arguments(parser, r.add_mutually_exclusive_group())
+    parser.set_defaults(uc_method="emt", gamma=0.45, a_c=0.42, uc_table=None)
     r.add_argument("--out", type=Path, required=True, metavar="JSON",
                    help="the suction table (.json); a missing directory is created")
 
@@ -60,20 +73,42 @@ def run(args: argparse.Namespace) -> int:
     from validation.bridge.coupled.table import suction_table
     from validation.output import atomic_file, terminal_progress
 
+    provenance = {"geometry": job["geometry"], "fidelity": args.fidelity, "contact_source": job["contact"].source}
     try:
-        grid = suction_grid(job["mesh"], job["material"], job["u_m"], job["dp_Pa"], contact=job["contact"].contact,
-                            progress=terminal_progress("suction"))
+        if job["goal"] is not None:
+            table, what = _adaptive(args, job, provenance, terminal_progress("suction"))
+        else:
+            grid = suction_grid(job["mesh"], job["material"], job["u_m"], job["dp_Pa"],
+                                contact=job["contact"].contact, progress=terminal_progress("suction"))
+            table, what = suction_table(grid, provenance), f"{grid.u_m.size} x {grid.dp_Pa.size} states"
     except ConvergenceError as exc:
         raise solver_failure(exc, Path(args.out).with_suffix(".failure.json")) from None
-    table = suction_table(grid, {"geometry": job["geometry"], "fidelity": args.fidelity,
-                                 "contact_source": job["contact"].source})
     with atomic_file(args.out) as tmp:
         table.to_json(tmp)
-    s = grid.stats
-    print(f"cupcheck suction: wrote {args.out}: {grid.u_m.size} x {grid.dp_Pa.size} states, "
-          f"{s.newton_iterations} Newton iterations, {s.dofs} dofs, {s.wall_time_s:.1f} s; "
-          f"largest pull in the table {grid.F1_N.max():.4g} N")
+    s = table.provenance["solver"]
+    print(f"cupcheck suction: wrote {args.out}: {what}, "
+          f"{s['newton_iterations']} Newton iterations, {s['dofs']} dofs, {s['wall_time_s']:.1f} s; "
+          f"largest pull in the table {table.F1_N.max():.4g} N")
     return 0
+
+
+def _adaptive(args: argparse.Namespace, job: dict, provenance: dict, progress):
+    """The adaptive table on the lattice u_m x dp_Pa for the goal (`validation.bridge.coupled.adaptive`)."""
+    from fem.suction import SuctionStates
+    from validation.bridge.coupled.adaptive import adaptive_axes
+    from validation.bridge.coupled.table import suction_table
+
+    states = SuctionStates(job["mesh"], job["material"], job["contact"].contact)
+    u, dp = job["u_m"], job["dp_Pa"]
+
+    def table_on(iu, jd):
+        return suction_table(states.grid(u[list(iu)], dp[list(jd)], progress=progress), provenance)
+
+    axes = adaptive_axes(table_on, u.size, dp.size, job["goal"])
+    grid = states.grid(u[list(axes.u_index)], dp[list(axes.dp_index)])
+    table = suction_table(grid, {**provenance, "grid": axes.describe(), "lattice": f"{u.size} u x {dp.size} dp",
+                                 "states_solved": states.solved, "forces_N": list(job["goal"].forces_N)})
+    return table, f"{axes.describe()} of {u.size} x {dp.size}, {states.solved} states solved"
 
 
 def _prepare(args: argparse.Namespace) -> dict:
@@ -111,7 +146,28 @@ def _prepare(args: argparse.Namespace) -> dict:
         raise ValueError(f"dp_kPa: pressure differences must start at 0 and increase, at most "
                          f"1000 kPa, at least two, got {args.dp_kPa}")
     return {"mesh": mesh, "material": material, "u_m": np.minimum(u, h1), "dp_Pa": 1e3 * dp,
-            "geometry": geometry, "contact": contact}
+            "geometry": geometry, "contact": contact, "goal": _goal(args, h1)}
+
+
+def _goal(args: argparse.Namespace, h1_m: float):
+    """The `SuctionGoal` of --grid adaptive (None for the full grid); ValueError naming the option."""
+    if args.grid == "full":
+        for option, given in (("--force", args.force_N is not None), ("--surface", has_surface(args))):
+            if given:
+                raise ValueError(f"{option}: applies to --grid adaptive only")
+        return None
+    from reduced.gas import Gas
+    from reduced.lifetime import LeakageModel
+    from validation.bridge.coupled.adaptive import SuctionGoal
+    from validation.bridge.design import resolve_cup
+    from validation.commands._reduced_options import build_uc
+
+    forces = [5.0, 10.0, 20.0, 40.0] if args.force_N is None else args.force_N
+    if not all(np.isfinite(f) and f > 0 for f in forces):
+        raise ValueError(f"--force: pull forces must be > 0 N, got {' '.join(f'{f:g}' for f in forces)}")
+    choice = resolve_cup(None, cup=args.cup, geometry_file=args.geometry, laws="curve")
+    model = LeakageModel(cup=choice.cup, u_c=build_uc(args), gas=Gas(T_K=293.15), p_a_Pa=1e5)
+    return SuctionGoal(model, tuple(forces))
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -9,6 +9,9 @@ model's `SuctionTable`; with a cache directory the table goes through `validatio
 design, the law, the grid and a hash of the sources that make it (`fem`, `validation.bridge.coupled` and
 the table's data types in `reduced`), so a second call computes nothing and a change to that code
 recomputes (a change to the leak, which reads the table, does not).
+With a `SuctionGoal` (the model and the pull forces the table is for) it builds only the rows and
+columns of the grid that those lifetimes need (`validation.bridge.coupled.adaptive`); the goal
+and the whole of `reduced` are then part of the key.
 """
 
 from __future__ import annotations
@@ -20,10 +23,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from validation.bridge.coupled.adaptive import AdaptiveSpec, SuctionGoal, adaptive_axes
+
 if TYPE_CHECKING:
     from fem.interface import ContactLaw
 
-__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "QUICK_GRID", "suction_table_for"]
+__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "QUICK_GRID", "SuctionGoal", "AdaptiveSpec", "suction_table_for"]
 
 _U_COARSE = (0.001, 0.0025, 0.005, 0.0075, 0.01, 0.0175, 0.025, 0.0375, 0.05, 0.075, 0.1, 0.125,
              0.15, 0.175, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8)
@@ -59,11 +64,13 @@ QUICK_GRID = SuctionGridSpec(_U_COARSE, tuple(float(x) for x in range(0, 101, 5)
 def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw | None = None,
                       E_Pa: float = 4e6, nu: float = 0.49,
                       grid: SuctionGridSpec = DEFAULT_GRID, cache_dir: str | Path | None = None,
-                      progress: Callable[[float, str], None] | None = None):
+                      progress: Callable[[float, str], None] | None = None,
+                      goal: SuctionGoal | None = None, adaptive: AdaptiveSpec = AdaptiveSpec()):
     """The `SuctionTable` of a design (`fem.geometry.CupGeometry` or a preset name 'A', 'B') at a
     mesh level, contact law (a `fem.interface.ContactLaw`, None: frictionless) and grid (module
-    docstring); `progress(fraction, message)` while the
-    FEM runs. Raises `fem.solver.ConvergenceError` where a state does not converge."""
+    docstring); with a `goal`, only the part of the grid the goal's lifetimes need, chosen as
+    `adaptive` says. `progress(fraction, message)` while the FEM runs. Raises
+    `fem.solver.ConvergenceError` where a state does not converge."""
     from fem.geometry import cup_geometry
     from fem.interface import ContactLaw
     from validation.bridge.cache import Cache, source_hash
@@ -73,6 +80,10 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw
     contact = ContactLaw() if contact is None else contact
     if not isinstance(contact, ContactLaw):
         raise ValueError(f"contact: expected a fem.interface.ContactLaw, got {type(contact).__name__}")
+    if goal is not None:
+        build = Cache(cache_dir).cached(_build_adaptive, ignore=["progress"])
+        code = source_hash("fem", "validation/bridge/coupled", "reduced")
+        return build(geometry, fidelity, contact, E_Pa, nu, grid, goal, adaptive, code, progress=progress)
     build = Cache(cache_dir).cached(_build, ignore=["progress"])
     code = source_hash("fem", "validation/bridge/coupled", *_TABLE_TYPES)
     return build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=progress)
@@ -81,6 +92,29 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw
 #: the `reduced` modules a table is made of (part of its key; the rest of `reduced`, the leak
 #: included, only reads tables; an entry that no longer loads is recomputed by joblib)
 _TABLE_TYPES = ("reduced/suction_table.py", "reduced/stiffness_curve.py")
+
+
+def _build_adaptive(geometry, fidelity, contact, E_Pa, nu, grid, goal, adaptive, code, progress=None):
+    from fem.cup import cup_height
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+    from fem.suction import SuctionStates
+    from validation.bridge.coupled.table import suction_table
+
+    mesh = cup_mesh(geometry, fidelity)
+    states = SuctionStates(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), contact)
+    u, dp = grid.u_m(cup_height(mesh)), grid.dp_Pa
+    provenance = {"geometry": geometry.describe(), "fidelity": fidelity}
+
+    def table_on(iu: tuple[int, ...], jd: tuple[int, ...]):
+        if progress:
+            progress(0.0, f"{states.solved} states solved; table {len(iu)} u x {len(jd)} dp")
+        return suction_table(states.grid(u[list(iu)], dp[list(jd)], progress=progress), provenance)
+
+    axes = adaptive_axes(table_on, u.size, dp.size, goal, adaptive)
+    final = states.grid(u[list(axes.u_index)], dp[list(axes.dp_index)])
+    return suction_table(final, {**provenance, "grid": axes.describe(), "lattice": grid.describe(),
+                                 "states_solved": states.solved, "forces_N": list(goal.forces_N)})
 
 
 def _build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=None):

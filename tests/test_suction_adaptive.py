@@ -1,0 +1,144 @@
+"""The adaptive suction table (`validation.bridge.coupled.adaptive`): the states it keeps are the
+full grid's states, its refinement goes only where its error estimate asks, and its lifetimes
+are the full grid's (slow: cup A's coarse FEM table)."""
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from fem.cup import cup_height
+from fem.geometry import cup_geometry
+from fem.material import NeoHookean
+from fem.mesh import cup_mesh
+from fem.solver import SolverOptions
+from fem.suction import SuctionStates, suction_grid
+from reduced.critical_gap import illustrative_uc_table
+from reduced.cup import cup_by_name
+from reduced.lifetime import largest_holdable_force, reference_model, solve_lifetime
+from tests.test_reduced_coupled import paper_table
+from validation.bridge.coupled.adaptive import AdaptiveSpec, SuctionGoal, adaptive_axes, lattice_subtable
+
+
+@pytest.fixture(scope="module")
+def coarse_cup():
+    mesh = cup_mesh(cup_geometry("A"), "coarse")
+    return mesh, cup_height(mesh)
+
+
+def test_kept_states_are_the_grids_states(coarse_cup):
+    """Asked in the grid's order the solves are the grid's (bitwise); grown by rows and columns
+    afterwards, each state is solved once and is the grid's to the solver's tolerance."""
+    mesh, h1 = coarse_cup
+    u, dp = np.array([0.1, 0.2, 0.3]) * h1, np.array([0.0, 5e3, 10e3, 20e3])
+    full = suction_grid(mesh, NeoHookean(), u, dp)
+    same = SuctionStates(mesh, NeoHookean()).grid(u, dp)
+    assert np.array_equal(same.F1_N, full.F1_N) and np.array_equal(same.V_m3, full.V_m3)
+    grown = SuctionStates(mesh, NeoHookean())
+    grown.grid(u[[0, 2]], dp[[0, 3]])                 # the coarse grid first
+    assert grown.solved == 4
+    fine = grown.grid(u, dp)                           # then its midpoints
+    assert grown.solved == u.size * dp.size
+    tol = SolverOptions().rtol                         # Newton's relative residual tolerance
+    np.testing.assert_allclose(fine.F1_N, full.F1_N, rtol=0, atol=tol * np.abs(full.F1_N).max())
+    np.testing.assert_allclose(fine.V_m3, full.V_m3, rtol=tol, atol=0)
+    np.testing.assert_allclose(fine.seal_r_m, full.seal_r_m, rtol=tol, atol=0)
+    p_max = max(p.p_Pa.max() for row in full.profiles for p in row)
+    for row, row_full in zip(fine.profiles, full.profiles):
+        for p, q in zip(row, row_full):
+            np.testing.assert_allclose(p.r_m, q.r_m, rtol=tol, atol=0)
+            np.testing.assert_allclose(p.p_Pa, q.p_Pa, rtol=0, atol=tol * p_max)
+
+
+# ---------------------------------------------------------------- refinement, on the paper's own table
+@pytest.fixture(scope="module")
+def paper_lattice():
+    """Cup A's eqs (3)-(7) sampled on a 41 x 41 lattice (no FEM) and a goal of two forces."""
+    model = reference_model(cup_by_name("A"), illustrative_uc_table())
+    goal = SuctionGoal(replace(model, stiffness=None, interface="p_b"), (5.0, 20.0))
+    return paper_table(model, 41, 41), goal
+
+
+def _lifetimes(goal, table):
+    model = replace(goal.model, suction=table)
+    return np.array([solve_lifetime(model, F, route="coupled").lifetime_s for F in goal.forces_N]
+                    + [largest_holdable_force(model, route="coupled")])
+
+
+def _adaptive(lattice, goal, tol):
+    asked = set()
+
+    def table_on(iu, jd):
+        asked.update((i, j) for i in iu for j in jd)
+        return lattice_subtable(lattice, iu, jd)
+    axes = adaptive_axes(table_on, lattice.u_m.size, lattice.dp_Pa.size, goal,
+                         AdaptiveSpec(u_every=8, dp_every=8, tol=tol))
+    return axes, asked
+
+
+def test_refined_to_the_lattice_it_is_the_full_table(paper_lattice):
+    """tol = 0 splits every interval a path crosses down to the lattice: the lifetimes are the
+    full table's (the rows and columns no path reads do not enter), from fewer states."""
+    lattice, goal = paper_lattice
+    axes, asked = _adaptive(lattice, goal, 0.0)
+    np.testing.assert_allclose(_lifetimes(goal, lattice_subtable(lattice, axes.u_index, axes.dp_index)),
+                               _lifetimes(goal, lattice), rtol=1e-9)
+    assert len(asked) < 0.5 * lattice.u_m.size * lattice.dp_Pa.size
+
+
+def test_refinement_goes_only_where_the_estimate_asks(paper_lattice):
+    """After the first split of the crossed intervals, an interval is split again only where its
+    error estimate exceeded tol; with an infinite tol nothing is split twice, and the lifetimes
+    come closer to the full table's as tol falls."""
+    lattice, goal = paper_lattice
+    full = _lifetimes(goal, lattice)
+    errors = {}
+    for tol in (math.inf, 1e-3):
+        axes, _ = _adaptive(lattice, goal, tol)
+        for before, after in zip(axes.rounds, axes.rounds[1:]):
+            for split, error, start in ((after.split_u, before.error_u, 8), (after.split_dp, before.error_dp, 8)):
+                for a, b in split:
+                    parents = [p for p in error if p[0] <= a and b <= p[1]]
+                    if b - a < start:          # a half of an earlier split: only if that one erred
+                        assert parents and all(error[p] > tol for p in parents), (tol, a, b)
+        gaps = np.diff(axes.u_index[:-1])
+        if math.isinf(tol):
+            assert len(axes.rounds) == 2 and gaps.min() >= 4
+        errors[tol] = np.abs(_lifetimes(goal, lattice_subtable(lattice, axes.u_index, axes.dp_index)) / full - 1)
+    assert errors[1e-3].max() < 1e-3 < errors[math.inf].max()
+
+
+# ---------------------------------------------------------------- cup A's FEM table (slow)
+@pytest.mark.slow
+def test_adaptive_lifetimes_are_the_full_tables():
+    """Cup A, coarse, frictionless, pmma-1.89: the adaptive table built for 5, 10, 20, 40 N gives
+    the full default grid's lifetimes and largest holdable force to 0.5 %, from a third of its states."""
+    from validation.bridge.coupled.build import suction_table_for
+    from validation.cli import build_parser
+    from validation.commands.lifetime import build_model, build_uc
+
+    args = build_parser().parse_args(["lifetime", "--surface", "pmma-1.89"])
+    model = build_model(args).model
+    goal = SuctionGoal(replace(model, stiffness=None, u_c=build_uc(args)), (5.0, 10.0, 20.0, 40.0))
+    full = suction_table_for("A", fidelity="coarse")
+    adaptive = suction_table_for("A", fidelity="coarse", goal=goal)
+    expected, got = _lifetimes(goal, full), _lifetimes(goal, adaptive)
+    assert np.all(expected[:3] > 0) and expected[3] == got[3] == 0.0      # 40 N: over the largest force
+    np.testing.assert_allclose(got, expected, rtol=5e-3)
+    assert adaptive.provenance["states_solved"] < full.u_m.size * full.dp_Pa.size / 3
+
+
+def test_goal_only_where_the_adaptive_table_holds():
+    """Products build the adaptive table for frictionless contact without relaxation only."""
+    from fem.interface import ContactLaw
+    from reduced.viscoelastic import default_relaxation
+    from validation.bridge.coupled.adaptive import goal_for
+
+    model = reference_model(cup_by_name("A"), illustrative_uc_table())
+    goal = goal_for(model, [5, 10], ContactLaw())
+    assert goal.forces_N == (5.0, 10.0) and goal.model.stiffness is None and goal.model.suction is None
+    assert goal_for(model, [5], ContactLaw("sticking")) is None
+    assert goal_for(replace(model, relaxation=default_relaxation(), phi0_s=13.0), [5]) is None
+    with pytest.raises(ValueError, match="forces_N"):
+        goal_for(model, [0.0])
