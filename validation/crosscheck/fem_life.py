@@ -156,6 +156,24 @@ def live(run: LifeRun, code: str = "", progress: Callable[[float, str], None] | 
                        sealed, trajectory, time.perf_counter() - t0)
 
 
+def lives(runs, one: Callable[[LifeRun], LifeOutcome]) -> dict[tuple, LifeOutcome]:
+    """(cup, law, mu, F1) -> outcome of each run by `one`, except a force above the largest holdable
+    force of its cup and law (planned before it): the route's branch does not start there (its
+    definition of the largest force), so the cell says over_force without running it."""
+    out: dict[tuple, LifeOutcome] = {}
+    for r in runs:
+        held = out.get((r.cup, r.law, r.friction, None))
+        if r.force_N is not None and held is not None and not held.failed and r.force_N > held.largest_force_N:
+            o = LifeOutcome(r, 0.0, "over_force", f"F1 above the largest holdable force "
+                            f"{held.largest_force_N:.4g} N: the cup lets go at once (branch not run)",
+                            held.largest_force_N, held.sealed, wall_s=0.0)
+            print(f"{NAME}: {r.label()}: {o.cell()} (above {held.largest_force_N:.4g} N, not run)", flush=True)
+        else:
+            o = one(r)
+        out[(r.cup, r.law, r.friction, r.force_N)] = o
+    return out
+
+
 def _runner(ctx: Context) -> Callable[[LifeRun], LifeOutcome]:
     """`live` through the run memo's cache directory (when there is one), keyed by the run and the
     sources of fem, reduced and the route."""
@@ -178,8 +196,7 @@ def run(ctx: Context) -> None:
 
     rep = ctx.report
     rep.text(NAME, __doc__.split("\n\n", 1)[1])
-    one = _runner(ctx)
-    outcomes = {(r.cup, r.law, r.friction, r.force_N): one(r) for r in plan(ctx.quick)}
+    outcomes = lives(plan(ctx.quick), _runner(ctx))
     others = {cup: other_routes(ctx, cup, forces) for cup, forces in
               (QUICK_FORCES_N if ctx.quick else FORCES_N).items()}
     write_section(ctx, outcomes, others)
@@ -220,60 +237,3 @@ def suction_table(ctx: Context, cup: str):
     cache = None if ctx.memo.cache_dir is None else ctx.memo.cache_dir / "suction"
     return suction_table_for(cup, fidelity=CROSSCHECK_FIDELITY, grid=DEFAULT_GRID, cache_dir=cache)
 
-
-def merge_into(report_dir, quick: bool = False, cache_dir=None) -> list[str]:
-    """Run this section alone (`cupcheck validate --only fem_life`, the validate cache) and put its
-    files, its README section and its summary entry into an existing report directory, leaving the
-    other sections' files as they are; returns the files written."""
-    import json
-    import shutil
-    import tempfile
-    from pathlib import Path
-
-    from validation.bridge.cache import user_cache_dir
-    from validation.crosscheck import run_validation
-    from validation.crosscheck.runs import RunMemo
-    from validation.output import terminal_progress
-
-    root = Path(report_dir)
-    memo = RunMemo(cache_dir=user_cache_dir("validate") if cache_dir is None else cache_dir)
-    with tempfile.TemporaryDirectory() as tmp:
-        rep = run_validation(tmp, quick=quick, only=[NAME], memo=memo, scene=False,
-                             progress=terminal_progress(NAME))
-        for name in rep.files:
-            shutil.copyfile(Path(tmp) / name, root / name)
-        section = (Path(tmp) / "README.md").read_text().split(f"## {TITLE}\n", 1)[1]
-    readme = root / "README.md"
-    readme.write_text(replace_section(readme.read_text(), f"## {TITLE}\n", section.strip() + "\n"))
-    summary_path = root / "summary.json"
-    summary = json.loads(summary_path.read_text())
-    summary[NAME] = json.loads(json.dumps(rep.summary[NAME], default=float,
-                                          allow_nan=True).replace("NaN", "null").replace("Infinity", "null"))
-    summary_path.write_text(json.dumps(summary, indent=1, sort_keys=True) + "\n")
-    return [*rep.files, readme.name, summary_path.name]
-
-
-def replace_section(text: str, header: str, body: str) -> str:
-    """`text` (a report's README) with the section under `header` replaced by `body`, or the section
-    added before the next numbered-or-not section that follows the numbered ones ("## Deformed cup")."""
-    lines = text.splitlines(keepends=True)
-    new = [header, "\n", body, "\n"]
-    if header in lines:
-        i = lines.index(header)
-        j = next((k for k in range(i + 1, len(lines)) if lines[k].startswith("## ")), len(lines))
-        return "".join(lines[:i] + new + lines[j:])
-    j = next((k for k, line in enumerate(lines) if line.startswith("## ") and not line[3:4].isdigit()),
-             len(lines))
-    return "".join(lines[:j] + new + lines[j:])
-
-
-if __name__ == "__main__":
-    import argparse
-
-    ap = argparse.ArgumentParser(description="Rerun section 8 into an existing report, e.g. "
-                                             "python -m validation.crosscheck.fem_life --into validation/report")
-    ap.add_argument("--into", required=True, help="the report directory (README.md and summary.json there)")
-    ap.add_argument("--quick", action="store_true", help="the CI subset")
-    ap.add_argument("--cache-dir", default=None, help="the validate cache (default: the user's)")
-    a = ap.parse_args()
-    print("wrote " + ", ".join(merge_into(a.into, a.quick, a.cache_dir)))
