@@ -9,7 +9,7 @@ import pytest
 
 from validation.crosscheck import fem_life
 from validation.crosscheck.fem_life import LifeRun, live, plan
-from validation.crosscheck.fem_life_report import replace_section
+from validation.crosscheck.fem_life_rerun import replace_section
 
 
 def test_the_full_section_plans_every_law_and_force_once():

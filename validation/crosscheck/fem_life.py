@@ -192,14 +192,15 @@ def _runner(ctx: Context) -> Callable[[LifeRun], LifeOutcome]:
 
 
 def run(ctx: Context) -> None:
-    from validation.crosscheck.fem_life_report import write_section
+    from validation.crosscheck.fem_life_report import Layout, write_section
 
     rep = ctx.report
     rep.text(NAME, __doc__.split("\n\n", 1)[1])
     outcomes = lives(plan(ctx.quick), _runner(ctx))
-    others = {cup: other_routes(ctx, cup, forces) for cup, forces in
-              (QUICK_FORCES_N if ctx.quick else FORCES_N).items()}
-    write_section(ctx, outcomes, others)
+    others = {cup: other_routes(ctx, cup, Fs) for cup, Fs in (QUICK_FORCES_N if ctx.quick else FORCES_N).items()}
+    forces = QUICK_FORCES_N if ctx.quick else FORCES_N
+    write_section(ctx, Layout(NAME, QUICK_LAWS if ctx.quick else LAWS, forces, SEAL_FORCES_N, FIGURE_LAWS,
+                              FIGURE_FORCE_N, FIDELITY, PAPER_HOLD_N, P_A_PA), outcomes, others)
 
 
 def other_routes(ctx: Context, cup: str, forces) -> dict[str, tuple[list[str], float]]:

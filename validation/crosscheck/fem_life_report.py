@@ -1,21 +1,35 @@
 """Section 8's tables, figure and prose from its FEM lives (`validation.crosscheck.fem_life`): the
 lifetimes by route and contact law, the largest holdable forces, the seal radii under suction, and
-a paragraph on whether friction explains the paper's ~88 N hold and its 80 N lifetimes; and the one
-command that reruns the section into an existing report:
-
-    python -m validation.crosscheck.fem_life_report --into validation/report
-"""
+a paragraph on whether friction explains the paper's ~88 N hold and its 80 N lifetimes. What the
+section ran is given as a `Layout` (this module imports no section)."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from validation.crosscheck.context import SURFACE, Context
 from validation.crosscheck.report import new_figure
 
-__all__ = ["write_section", "suction_radius_m", "merge_into", "replace_section"]
+__all__ = ["Layout", "write_section", "suction_radius_m"]
+
+
+@dataclass(frozen=True)
+class Layout:
+    """What the section ran: its name, the (law, mu) pairs, cup -> forces [N], the forces of the
+    seal table, the laws and force of the figure, the mesh level, the paper's hold [N] and p_a [Pa]."""
+
+    name: str
+    laws: tuple
+    forces: dict
+    seal_forces_N: tuple
+    figure_laws: tuple
+    figure_force_N: float
+    fidelity: str
+    paper_hold_N: float
+    p_a_Pa: float
 
 
 def suction_radius_m(force_N: float, dp_Pa: float) -> float:
@@ -24,20 +38,17 @@ def suction_radius_m(force_N: float, dp_Pa: float) -> float:
     return math.sqrt(force_N / (math.pi * dp_Pa))
 
 
-def write_section(ctx: Context, outcomes: dict, others: dict) -> None:
+def write_section(ctx: Context, fl: Layout, outcomes: dict, others: dict) -> None:
     """outcomes: (cup, law, mu, F1 or None) -> `LifeOutcome`; others: cup -> route -> (cells, largest)."""
-    from validation.crosscheck import fem_life as fl
-
-    laws = fl.QUICK_LAWS if ctx.quick else fl.LAWS
-    forces = fl.QUICK_FORCES_N if ctx.quick else fl.FORCES_N
-    _lifetime_table(ctx, outcomes, others, laws, forces)
-    largest = _largest_table(ctx, outcomes, others, laws, forces)
-    seal = _seal_table(ctx, outcomes, laws, forces)
-    _seal_figure(ctx, outcomes, laws)
-    _conclusion(ctx, outcomes, others, largest, seal, laws, forces)
+    laws, forces = fl.laws, fl.forces
+    _lifetime_table(ctx, fl, outcomes, others, laws, forces)
+    largest = _largest_table(ctx, fl, outcomes, others, laws, forces)
+    seal = _seal_table(ctx, fl, outcomes, laws, forces)
+    _seal_figure(ctx, fl, outcomes, laws)
+    _conclusion(ctx, fl, outcomes, others, largest, seal, laws, forces)
     failed = [o for o in outcomes.values() if o.failed]
-    ctx.report.summary[fl.NAME] = {
-        "fidelity": fl.FIDELITY, "quick": ctx.quick,
+    ctx.report.summary[fl.name] = {
+        "fidelity": fl.fidelity, "quick": ctx.quick,
         "largest_force_N": largest,
         "lifetime_s": {f"{k[0]} {_law(k[1], k[2])} {k[3]:g}N": o.lifetime_s for k, o in outcomes.items()
                        if k[3] is not None},
@@ -57,9 +68,7 @@ def _col(law: str, mu: float | None) -> str:
     return "fem_" + _law(law, mu).replace(" ", "_") + "_s"
 
 
-def _lifetime_table(ctx, outcomes, others, laws, forces) -> None:
-    from validation.crosscheck import fem_life as fl
-
+def _lifetime_table(ctx, fl, outcomes, others, laws, forces) -> None:
     routes = list(next(iter(others.values())))
     rows = []
     for cup, Fs in forces.items():
@@ -67,15 +76,13 @@ def _lifetime_table(ctx, outcomes, others, laws, forces) -> None:
             rows.append([cup, F] + [others[cup][r][0][i] for r in routes]
                         + [outcomes[(cup, law, mu, F)].cell() for law, mu in laws])
     cols = ["cup", "force_N"] + [f"{r}_s" for r in routes] + [_col(law, mu) for law, mu in laws]
-    ctx.report.table(fl.NAME, "fem_life_lifetimes", cols, rows,
+    ctx.report.table(fl.name, "fem_life_lifetimes", cols, rows,
                      f"Lifetime [s] (reason) on {SURFACE}: paper route (the paper's inputs), table-coupled "
-                     f"route (frictionless FEM suction table) and the fem route by contact law ({fl.FIDELITY} "
+                     f"route (frictionless FEM suction table) and the fem route by contact law ({fl.fidelity} "
                      f"mesh)")
 
 
-def _largest_table(ctx, outcomes, others, laws, forces) -> dict:
-    from validation.crosscheck import fem_life as fl
-
+def _largest_table(ctx, fl, outcomes, others, laws, forces) -> dict:
     rows, largest = [], {}
     for cup in forces:
         for r, (_, held) in others[cup].items():
@@ -85,9 +92,9 @@ def _largest_table(ctx, outcomes, others, laws, forces) -> dict:
             o = outcomes[(cup, law, mu, None)]
             rows.append([cup, "fem", _law(law, mu), o.largest_force_N if not o.failed else o.cell()])
             largest[cup][f"fem {_law(law, mu)}"] = o.largest_force_N
-    ctx.report.table(fl.NAME, "fem_life_largest_force", ["cup", "route", "contact", "largest_force_N"], rows,
+    ctx.report.table(fl.name, "fem_life_largest_force", ["cup", "route", "contact", "largest_force_N"], rows,
                      f"Largest force the freshly pressed and sealed cup holds (the paper's cup A held about "
-                     f"{fl.PAPER_HOLD_N:g} N)")
+                     f"{fl.paper_hold_N:g} N)")
     return largest
 
 
@@ -106,13 +113,11 @@ def _states(o) -> list[tuple[str, dict]]:
     return out
 
 
-def _seal_table(ctx, outcomes, laws, forces) -> dict:
-    from validation.crosscheck import fem_life as fl
-
+def _seal_table(ctx, fl, outcomes, laws, forces) -> dict:
     rows, seal = [], {}
     keys = ("r_c_mm", "r_k_mm", "r_out_mm", "u_mm", "p_b_kPa", "N_over_N0")
     for cup, Fs in forces.items():
-        for F in (F for F in fl.SEAL_FORCES_N if F in Fs):
+        for F in (F for F in fl.seal_forces_N if F in Fs):
             for law, mu in laws:
                 o = outcomes[(cup, law, mu, F)]
                 states = _states(o)
@@ -120,20 +125,18 @@ def _seal_table(ctx, outcomes, laws, forces) -> dict:
                     note = "" if len(states) > 1 else o.cell()
                     rows.append([cup, F, _law(law, mu), name, *[v[k] for k in keys], note])
                     seal.setdefault(cup, {}).setdefault(f"{F:g}N", {}).setdefault(_law(law, mu), {})[name] = v
-    ctx.report.table(fl.NAME, "fem_life_seal", ["cup", "force_N", "contact", "state", *keys, "note"], rows,
+    ctx.report.table(fl.name, "fem_life_seal", ["cup", "force_N", "contact", "state", *keys, "note"], rows,
                      "What friction does to the seal under suction: inner contact radius r_c, seal node r_k "
                      "and the contact's outer end r_out at the sealed state, at the branch's start (pulled "
                      "to F1 at N0) and at the detachment")
     return seal
 
 
-def _seal_figure(ctx, outcomes, laws) -> None:
-    from validation.crosscheck import fem_life as fl
-
+def _seal_figure(ctx, fl, outcomes, laws) -> None:
     fig, ax = new_figure(2, 1, 4.2, 3.3)
     drawn = 0
-    for law, mu in fl.FIGURE_LAWS:
-        o = outcomes.get(("A", law, mu, fl.FIGURE_FORCE_N))
+    for law, mu in fl.figure_laws:
+        o = outcomes.get(("A", law, mu, fl.figure_force_N))
         if o is None or not o.trajectory or not len(o.trajectory.get("N", ())):
             continue
         x = o.trajectory["N"] / o.sealed["N0"]
@@ -142,18 +145,16 @@ def _seal_figure(ctx, outcomes, laws) -> None:
         drawn += 1
     for a, what in zip(ax[0], ("inner contact radius r_c", "outer end of contact r_out")):
         a.set(xlabel="N / N0 (gas in the cavity)", ylabel=f"{what.split()[-1]} (mm)",
-              title=f"cup A, F1 = {fl.FIGURE_FORCE_N:g} N: {what}")
+              title=f"cup A, F1 = {fl.figure_force_N:g} N: {what}")
         if drawn:
             a.legend(fontsize=7)
-    ctx.report.figure(fl.NAME, "fem_life_seal", fig,
-                      f"Cup A held at {fl.FIGURE_FORCE_N:g} N on the fem route: the seal's radii along the "
+    ctx.report.figure(fl.name, "fem_life_seal", fig,
+                      f"Cup A held at {fl.figure_force_N:g} N on the fem route: the seal's radii along the "
                       f"branch, from the branch's start to the detachment, by contact law")
 
 
-def _conclusion(ctx, outcomes, others, largest, seal, laws, forces) -> None:
+def _conclusion(ctx, fl, outcomes, others, largest, seal, laws, forces) -> None:
     """The paragraph on the paper's ~88 N hold and its 80 N lifetimes, from the tables' numbers."""
-    from validation.crosscheck import fem_life as fl
-
     if "A" not in largest:
         return
     held = {k[4:]: v for k, v in largest["A"].items() if k.startswith("fem ") and math.isfinite(v)}
@@ -161,22 +162,22 @@ def _conclusion(ctx, outcomes, others, largest, seal, laws, forces) -> None:
     if held:
         best = max(held, key=held.get)
         listing = ", ".join(f"{k} {v:.3g} N" for k, v in held.items())
-        if held[best] >= fl.PAPER_HOLD_N:
-            parts.append(f"**Friction does explain the paper's ~{fl.PAPER_HOLD_N:g} N hold of cup A**: with "
+        if held[best] >= fl.paper_hold_N:
+            parts.append(f"**Friction does explain the paper's ~{fl.paper_hold_N:g} N hold of cup A**: with "
                          f"{best} the sealed FEM cup holds {held[best]:.3g} N ({listing}).")
         else:
-            parts.append(f"**Friction does not explain the paper's ~{fl.PAPER_HOLD_N:g} N hold of cup A.** "
+            parts.append(f"**Friction does not explain the paper's ~{fl.paper_hold_N:g} N hold of cup A.** "
                          f"The sealed FEM cup holds at most {held[best]:.3g} N, "
-                         f"{100 * held[best] / fl.PAPER_HOLD_N:.0f} % of it, with {best} (by law: {listing})"
+                         f"{100 * held[best] / fl.paper_hold_N:.0f} % of it, with {best} (by law: {listing})"
                          + (f"; none of the laws tested, up to sticking (friction's mu -> inf limit), holds "
-                            f"{fl.PAPER_HOLD_N:g} N." if "sticking" in held else "."))
+                            f"{fl.paper_hold_N:g} N." if "sticking" in held else "."))
         routes = [f"the {r} route {largest['A'][r]:.3g} N" for r in ("paper", "coupled")
                   if r in largest["A"] and math.isfinite(largest["A"][r])]
         if routes:
             parts.append("Beside it: " + ", ".join(routes) + ".")
-        parts.append(f"A hold of {fl.PAPER_HOLD_N:g} N needs the suction to act over a disc of radius at least "
-                     f"{1e3 * suction_radius_m(fl.PAPER_HOLD_N, fl.P_A_PA):.3g} mm even at full vacuum "
-                     f"(F1 <= dp pi r_out^2, dp <= p_a = {fl.P_A_PA / 1e3:g} kPa); " + _reach(seal))
+        parts.append(f"A hold of {fl.paper_hold_N:g} N needs the suction to act over a disc of radius at least "
+                     f"{1e3 * suction_radius_m(fl.paper_hold_N, fl.p_a_Pa):.3g} mm even at full vacuum "
+                     f"(F1 <= dp pi r_out^2, dp <= p_a = {fl.p_a_Pa / 1e3:g} kPa); " + _reach(seal))
     if 80.0 in forces.get("A", ()):
         lives = {_law(law, mu): outcomes[("A", law, mu, 80.0)] for law, mu in laws}
         ok = [f"{k} {o.cell()}" for k, o in lives.items() if not o.failed and o.lifetime_s > 0]
@@ -185,7 +186,7 @@ def _conclusion(ctx, outcomes, others, largest, seal, laws, forces) -> None:
         parts.append(f"At 80 N the paper route gives {paper80}; the fem route gives "
                      + (f"a lifetime with {', '.join(ok)}" if ok else "no lifetime with any law")
                      + (f" ({'; '.join(not_ok)})." if not_ok else "."))
-        if not ok and held and max(held.values()) < fl.PAPER_HOLD_N:
+        if not ok and held and max(held.values()) < fl.paper_hold_N:
             parts.append("The paper's 80 N lifetimes and its ~88 N hold therefore rest on its own "
                          "approximations (the rigid cone of eqs 3-5 keeps the seal at r(h), the force "
                          "balance of eq 7 with beta), not on the FEM cup. To reproduce them the FEM cup would "
@@ -194,7 +195,7 @@ def _conclusion(ctx, outcomes, others, largest, seal, laws, forces) -> None:
                          "neo-Hookean, E = 4 MPa, Table 1's thickness line; a stiffer wall, or a wall "
                          "stiffened viscoelastically under the pull, is drawn onto the plane less) and the "
                          "rim's real shape and roughness (a sharp corner on a smooth plane here).")
-    ctx.report.text(fl.NAME, " ".join(parts))
+    ctx.report.text(fl.name, " ".join(parts))
 
 
 def _reach(seal: dict) -> str:
@@ -215,61 +216,3 @@ def _reach(seal: dict) -> str:
                 f"{span('detachment')} mm at the detachment ({ends} mm by law; the seal table above).")
     return "the seal table above gives the FEM cup's r_out."
 
-
-def merge_into(report_dir, quick: bool = False, cache_dir=None) -> list[str]:
-    """Run this section alone (`cupcheck validate --only fem_life`, the validate cache) and put its
-    files, its README section and its summary entry into an existing report directory, leaving the
-    other sections' files as they are; returns the files written."""
-    import json
-    import shutil
-    import tempfile
-    from pathlib import Path
-
-    from validation.bridge.cache import user_cache_dir
-    from validation.crosscheck import run_validation
-    from validation.crosscheck.fem_life import NAME, TITLE
-    from validation.crosscheck.runs import RunMemo
-    from validation.output import terminal_progress
-
-    root = Path(report_dir)
-    memo = RunMemo(cache_dir=user_cache_dir("validate") if cache_dir is None else cache_dir)
-    with tempfile.TemporaryDirectory() as tmp:
-        rep = run_validation(tmp, quick=quick, only=[NAME], memo=memo, scene=False,
-                             progress=terminal_progress(NAME))
-        for name in rep.files:
-            shutil.copyfile(Path(tmp) / name, root / name)
-        section = (Path(tmp) / "README.md").read_text().split(f"## {TITLE}\n", 1)[1]
-    readme = root / "README.md"
-    readme.write_text(replace_section(readme.read_text(), f"## {TITLE}\n", section.strip() + "\n"))
-    summary_path = root / "summary.json"
-    summary = json.loads(summary_path.read_text())
-    summary[NAME] = json.loads(json.dumps(rep.summary[NAME], default=float,
-                                          allow_nan=True).replace("NaN", "null").replace("Infinity", "null"))
-    summary_path.write_text(json.dumps(summary, indent=1, sort_keys=True) + "\n")
-    return [*rep.files, readme.name, summary_path.name]
-
-
-def replace_section(text: str, header: str, body: str) -> str:
-    """`text` (a report's README) with the section under `header` replaced by `body`, or the section
-    added before the next numbered-or-not section that follows the numbered ones ("## Deformed cup")."""
-    lines = text.splitlines(keepends=True)
-    new = [header, "\n", body, "\n"]
-    if header in lines:
-        i = lines.index(header)
-        j = next((k for k in range(i + 1, len(lines)) if lines[k].startswith("## ")), len(lines))
-        return "".join(lines[:i] + new + lines[j:])
-    j = next((k for k, line in enumerate(lines) if line.startswith("## ") and not line[3:4].isdigit()),
-             len(lines))
-    return "".join(lines[:j] + new + lines[j:])
-
-
-if __name__ == "__main__":
-    import argparse
-
-    ap = argparse.ArgumentParser(description="Rerun section 8 into an existing report, e.g. "
-                                             "python -m validation.crosscheck.fem_life_report --into validation/report")
-    ap.add_argument("--into", required=True, help="the report directory (README.md and summary.json there)")
-    ap.add_argument("--quick", action="store_true", help="the CI subset")
-    ap.add_argument("--cache-dir", default=None, help="the validate cache (default: the user's)")
-    a = ap.parse_args()
-    print("wrote " + ", ".join(merge_into(a.into, a.quick, a.cache_dir)))
