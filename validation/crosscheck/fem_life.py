@@ -15,9 +15,14 @@ A cell gives the lifetime [s] and why it ended: fold (the branch's largest N at 
 (the seal opened at the rim), over_force (F1 above what the sealed cup holds: it lets go at
 once), sealed or horizon (no detachment: inf). A run that ends without a detachment or fails says
 so ("no branch: stopped: ...", "failed: ..."), never a number. The largest holdable force is the
-largest pull at fixed N0 from the sealed state. The seal radii are the inner contact radius r_c,
+largest pull at fixed N0 from the sealed state; a force above it is over_force by the route's own
+definition (its branch does not start), so that branch is not run. The seal radii are the inner contact radius r_c,
 the seal node r_k and the outer end of the contact r_out, at the sealed state (pressed, before the
 pull), at the start of the branch (pulled to F1 at N0) and at its end (the detachment).
+
+Rerun into the committed report: `python -m validation.crosscheck.fem_life_rerun --into
+validation/report` (each run is kept in the validate cache, keyed by the sources of fem, reduced
+and the route).
 """
 
 from __future__ import annotations
@@ -203,8 +208,8 @@ def run(ctx: Context) -> None:
                               FIGURE_FORCE_N, FIDELITY, PAPER_HOLD_N, P_A_PA), outcomes, others)
 
 
-def other_routes(ctx: Context, cup: str, forces) -> dict[str, tuple[list[str], float]]:
-    """route label -> (cells per force, largest holdable force [N]) of the paper route (the paper's
+def other_routes(ctx: Context, cup: str, forces) -> dict[str, tuple[list[str], float, list[float]]]:
+    """route label -> (cells per force, largest holdable force [N], lifetimes [s]) of the paper route (the paper's
     inputs) and, in the full section, the table-coupled route (frictionless FEM suction table)."""
     from dataclasses import replace
 
@@ -221,13 +226,14 @@ def other_routes(ctx: Context, cup: str, forces) -> dict[str, tuple[list[str], f
     return out
 
 
-def _route_cells(compute: Callable, n: int) -> tuple[list[str], float]:
+def _route_cells(compute: Callable, n: int) -> tuple[list[str], float, list[float]]:
+    """(cells, largest holdable force [N], lifetimes [s], nan where the route failed)."""
     try:
         res = compute()
     except (ValueError, RuntimeError, ArithmeticError) as exc:
-        return [f"failed: {type(exc).__name__}: {str(exc).splitlines()[0][:120]}"] * n, math.nan
+        return [f"failed: {type(exc).__name__}: {str(exc).splitlines()[0][:120]}"] * n, math.nan, [math.nan] * n
     cells = [("inf" if math.isinf(r.lifetime_s) else f"{r.lifetime_s:.4g}") + f" ({r.reason})" for r in res]
-    return cells, float(res.largest_force_N)
+    return cells, float(res.largest_force_N), [float(r.lifetime_s) for r in res]
 
 
 def suction_table(ctx: Context, cup: str):

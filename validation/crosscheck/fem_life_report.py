@@ -39,12 +39,13 @@ def suction_radius_m(force_N: float, dp_Pa: float) -> float:
 
 
 def write_section(ctx: Context, fl: Layout, outcomes: dict, others: dict) -> None:
-    """outcomes: (cup, law, mu, F1 or None) -> `LifeOutcome`; others: cup -> route -> (cells, largest)."""
+    """outcomes: (cup, law, mu, F1 or None) -> `LifeOutcome`; others: cup -> route -> (cells, largest [N], lifetimes [s])."""
     laws, forces = fl.laws, fl.forces
     _lifetime_table(ctx, fl, outcomes, others, laws, forces)
     largest = _largest_table(ctx, fl, outcomes, others, laws, forces)
     seal = _seal_table(ctx, fl, outcomes, laws, forces)
     _seal_figure(ctx, fl, outcomes, laws)
+    _routes_note(ctx, fl, outcomes, others, forces)
     _conclusion(ctx, fl, outcomes, others, largest, seal, laws, forces)
     failed = [o for o in outcomes.values() if o.failed]
     ctx.report.summary[fl.name] = {
@@ -85,7 +86,7 @@ def _lifetime_table(ctx, fl, outcomes, others, laws, forces) -> None:
 def _largest_table(ctx, fl, outcomes, others, laws, forces) -> dict:
     rows, largest = [], {}
     for cup in forces:
-        for r, (_, held) in others[cup].items():
+        for r, (_, held, _) in others[cup].items():
             rows.append([cup, r, _OTHER_CONTACT.get(r, ""), held])
             largest.setdefault(cup, {})[r] = held
         for law, mu in laws:
@@ -151,6 +152,28 @@ def _seal_figure(ctx, fl, outcomes, laws) -> None:
     ctx.report.figure(fl.name, "fem_life_seal", fig,
                       f"Cup A held at {fl.figure_force_N:g} N on the fem route: the seal's radii along the "
                       f"branch, from the branch's start to the detachment, by contact law")
+
+
+def _routes_note(ctx, fl, outcomes, others, forces) -> None:
+    """The frictionless fem route beside the table-coupled route (two paths to one cup at mu = 0)."""
+    if "A" not in forces or "coupled" not in others.get("A", {}):
+        return
+    pairs, ratios, u_end = [], [], []
+    for F, t_table in zip(forces["A"], others["A"]["coupled"][2]):
+        o = outcomes[("A", "frictionless", None, F)]
+        if not o.failed and 0 < o.lifetime_s < math.inf and 0 < t_table < math.inf:
+            pairs.append(f"{F:g} N: {t_table:.4g} / {o.lifetime_s:.4g} s")
+            ratios.append(t_table / o.lifetime_s)
+            u_end.append(o.trajectory["u_mm"][-1])
+    if not pairs:
+        return
+    text = (f"Frictionless cup A, table-coupled / fem route: {'; '.join(pairs)} (ratio "
+            f"{min(ratios):.3g}-{max(ratios):.3g}).")
+    if max(u_end) < 0:
+        text += (f" The fem branch detaches with the plate above its touching height (u = "
+                 f"{min(u_end):.3g} to {max(u_end):.3g} mm), beyond the coupled table's edge near u = 0, "
+                 f"where the table route's cup has to let go.")
+    ctx.report.text(fl.name, text)
 
 
 def _conclusion(ctx, fl, outcomes, others, largest, seal, laws, forces) -> None:
