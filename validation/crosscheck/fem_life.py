@@ -97,7 +97,7 @@ class LifeOutcome:
 
     @property
     def failed(self) -> bool:
-        return self.reason in ("failed", "no branch")
+        return self.reason in ("failed", "no branch", "not run")
 
     def cell(self) -> str:
         """The table cell: 'lifetime (reason)', or what stopped the run."""
@@ -179,36 +179,43 @@ def lives(runs, one: Callable[[LifeRun], LifeOutcome]) -> dict[tuple, LifeOutcom
     return out
 
 
-def _runner(ctx: Context) -> Callable[[LifeRun], LifeOutcome]:
+def _runner(ctx: Context, cached_only: bool = False) -> Callable[[LifeRun], LifeOutcome]:
     """`live` through the run memo's cache directory (when there is one), keyed by the run and the
-    sources of fem, reduced and the route."""
+    sources of fem, reduced and the route; `cached_only`: a run not in the cache is not run (its
+    cell says so)."""
+    from joblib import Memory
+
     from validation.bridge.cache import Cache, source_hash
 
     root = ctx.memo.cache_dir
     cached = Cache(None if root is None else root / "fem_life").cached(live, ignore=["progress"])
     code = source_hash("fem", "reduced", "validation/bridge/fem_route.py", "validation/bridge/pipeline.py")
+    stored = None if root is None else Memory(str(root / "fem_life"), verbose=0).cache(live, ignore=["progress"])
 
     def run_one(run: LifeRun) -> LifeOutcome:
         ctx.progress(0.0, f"{NAME}: {run.label()}")
-        out = cached(run, code)
+        if cached_only and (stored is None or not stored.check_call_in_cache(run, code)):
+            out = LifeOutcome(run, math.nan, "not run", "not in the cache (rerun to fill)", math.nan)
+        else:
+            out = cached(run, code)
         print(f"{NAME}: {run.label()}: {out.cell()} ({out.wall_s:.0f} s)", flush=True)
         return out
     return run_one
 
 
-def run(ctx: Context) -> None:
+def run(ctx: Context, cached_only: bool = False) -> None:
     from validation.crosscheck.fem_life_report import Layout, write_section
 
     rep = ctx.report
     rep.text(NAME, __doc__.split("\n\n", 1)[1])
-    outcomes = lives(plan(ctx.quick), _runner(ctx))
-    others = {cup: other_routes(ctx, cup, Fs) for cup, Fs in (QUICK_FORCES_N if ctx.quick else FORCES_N).items()}
+    outcomes = lives(plan(ctx.quick), _runner(ctx, cached_only))
+    others = {cup: other_routes(ctx, cup, Fs, cached_only) for cup, Fs in (QUICK_FORCES_N if ctx.quick else FORCES_N).items()}
     forces = QUICK_FORCES_N if ctx.quick else FORCES_N
     write_section(ctx, Layout(NAME, QUICK_LAWS if ctx.quick else LAWS, forces, SEAL_FORCES_N, FIGURE_LAWS,
                               FIGURE_FORCE_N, FIDELITY, PAPER_HOLD_N, P_A_PA), outcomes, others)
 
 
-def other_routes(ctx: Context, cup: str, forces) -> dict[str, tuple[list[str], float, list[float]]]:
+def other_routes(ctx: Context, cup: str, forces, cached_only: bool = False) -> dict[str, tuple[list[str], float, list[float]]]:
     """route label -> (cells per force, largest holdable force [N], lifetimes [s]) of the paper route (the paper's
     inputs) and, in the full section, the table-coupled route (frictionless FEM suction table)."""
     from dataclasses import replace
@@ -219,7 +226,9 @@ def other_routes(ctx: Context, cup: str, forces) -> dict[str, tuple[list[str], f
     model = model_for(cup)
     ctx.progress(0.0, f"{NAME}: paper route, cup {cup}")
     out["paper"] = _route_cells(lambda: lifetimes(model, forces, "paper"), len(forces))
-    if not ctx.quick:
+    if not ctx.quick and cached_only and not suction_table_cached(ctx, cup):
+        out["coupled"] = (["not run: no suction table in the cache"] * len(forces), math.nan, [math.nan] * len(forces))
+    elif not ctx.quick:
         ctx.progress(0.0, f"{NAME}: coupled route, cup {cup} (suction table, cached)")
         out["coupled"] = _route_cells(lambda: lifetimes(replace(model, suction=suction_table(ctx, cup)),
                                                         forces, "coupled"), len(forces))
@@ -244,3 +253,19 @@ def suction_table(ctx: Context, cup: str):
     cache = None if ctx.memo.cache_dir is None else ctx.memo.cache_dir / "suction"
     return suction_table_for(cup, fidelity=CROSSCHECK_FIDELITY, grid=DEFAULT_GRID, cache_dir=cache)
 
+
+def suction_table_cached(ctx: Context, cup: str) -> bool:
+    """Whether `suction_table` would read the table from the cache (not build it)."""
+    from joblib import Memory
+
+    from fem.geometry import cup_geometry
+    from fem.interface import ContactLaw
+    from validation.bridge.cache import source_hash
+    from validation.bridge.coupled import build
+
+    if ctx.memo.cache_dir is None:
+        return False
+    memo = Memory(str(ctx.memo.cache_dir / "suction"), verbose=0).cache(build._build, ignore=["progress"])
+    code = source_hash("fem", "validation/bridge/coupled", *build._TABLE_TYPES)
+    return memo.check_call_in_cache(cup_geometry(cup), CROSSCHECK_FIDELITY, ContactLaw(), 4e6, 0.49,
+                                    build.DEFAULT_GRID, code)

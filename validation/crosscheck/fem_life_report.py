@@ -181,7 +181,9 @@ def _conclusion(ctx, fl, outcomes, others, largest, seal, laws, forces) -> None:
     if "A" not in largest:
         return
     held = {k[4:]: v for k, v in largest["A"].items() if k.startswith("fem ") and math.isfinite(v)}
-    parts = []
+    missing = [_law(law, mu) for law, mu in laws if _law(law, mu) not in held]
+    parts = [f"*Incomplete: no largest holdable force for {', '.join(missing)} (see the table); the "
+             f"statements below are about the laws that ran.*"] if missing else []
     if held:
         best = max(held, key=held.get)
         listing = ", ".join(f"{k} {v:.3g} N" for k, v in held.items())
@@ -192,8 +194,8 @@ def _conclusion(ctx, fl, outcomes, others, largest, seal, laws, forces) -> None:
             parts.append(f"**Friction does not explain the paper's ~{fl.paper_hold_N:g} N hold of cup A.** "
                          f"The sealed FEM cup holds at most {held[best]:.3g} N, "
                          f"{100 * held[best] / fl.paper_hold_N:.0f} % of it, with {best} (by law: {listing})"
-                         + (f"; none of the laws tested, up to sticking (friction's mu -> inf limit), holds "
-                            f"{fl.paper_hold_N:g} N." if "sticking" in held else "."))
+                         + (f"; none of the laws, up to sticking (friction's mu -> inf limit), holds "
+                            f"{fl.paper_hold_N:g} N." if not missing else "."))
         routes = [f"the {r} route {largest['A'][r]:.3g} N" for r in ("paper", "coupled")
                   if r in largest["A"] and math.isfinite(largest["A"][r])]
         if routes:
@@ -207,9 +209,10 @@ def _conclusion(ctx, fl, outcomes, others, largest, seal, laws, forces) -> None:
         not_ok = [f"{k} {o.cell()}" for k, o in lives.items() if o.failed or o.lifetime_s <= 0]
         paper80 = others["A"]["paper"][0][forces["A"].index(80.0)]
         parts.append(f"At 80 N the paper route gives {paper80}; the fem route gives "
-                     + (f"a lifetime with {', '.join(ok)}" if ok else "no lifetime with any law")
+                     + (f"a lifetime with {', '.join(ok)}" if ok else
+                        "no lifetime with any law" + (" that ran" if not_ok_failed(lives) else ""))
                      + (f" ({'; '.join(not_ok)})." if not_ok else "."))
-        if not ok and held and max(held.values()) < fl.paper_hold_N:
+        if not ok and held and max(held.values()) < fl.paper_hold_N and not missing and not not_ok_failed(lives):
             parts.append("The paper's 80 N lifetimes and its ~88 N hold therefore rest on its own "
                          "approximations (the rigid cone of eqs 3-5 keeps the seal at r(h), the force "
                          "balance of eq 7 with beta), not on the FEM cup. To reproduce them the FEM cup would "
@@ -219,6 +222,11 @@ def _conclusion(ctx, fl, outcomes, others, largest, seal, laws, forces) -> None:
                          "stiffened viscoelastically under the pull, is drawn onto the plane less) and the "
                          "rim's real shape and roughness (a sharp corner on a smooth plane here).")
     ctx.report.text(fl.name, " ".join(parts))
+
+
+def not_ok_failed(lives: dict) -> bool:
+    """Whether any of these outcomes has no result (failed, no branch, not run)."""
+    return any(o.failed for o in lives.values())
 
 
 def _reach(seal: dict) -> str:
