@@ -104,7 +104,7 @@ def _states(o) -> list[tuple[str, dict]]:
     s = o.sealed
     out = [("sealed", {"r_c_mm": s.get("r_c_mm", math.nan), "r_k_mm": s.get("r_k_mm", math.nan),
                        "r_out_mm": s.get("r_out_mm", math.nan), "u_mm": s.get("u_mm", math.nan),
-                       "p_b_kPa": s.get("p_b_kPa", math.nan), "N_over_N0": 1.0})]
+                       "p_b_kPa": s.get("p_b_kPa", math.nan), "N_over_N0": 1.0 if s else math.nan})]
     tr = o.trajectory
     if tr and len(tr.get("N", ())) and s.get("N0"):
         for name, k in (("branch start", 0), ("detachment", -1)):
