@@ -172,7 +172,7 @@ def _routes_note(ctx, fl, outcomes, others, forces) -> None:
     if max(u_end) < 0:
         text += (f" The fem branch detaches with the plate above its touching height (u = "
                  f"{min(u_end):.3g} to {max(u_end):.3g} mm), beyond the coupled table's edge near u = 0, "
-                 f"where the table route stops (reason table_edge): the two agree only up to that edge.")
+                 f"where the table route stops (its reason table_edge).")
     ctx.report.text(fl.name, text)
 
 
