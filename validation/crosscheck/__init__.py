@@ -1,5 +1,6 @@
 """The validation report of issue 5: cross-checks of Appendix A, the cone laws, the lifetime, the
-speed-accuracy trade, the extremes, the paper's numbers and Coulomb friction, each a section with
+speed-accuracy trade, the extremes, the paper's numbers, Coulomb friction and the cup's whole life in
+the FEM, each a section with
 the FEM runs it needs declared up front.
 
     from validation.crosscheck import run_validation
@@ -14,14 +15,14 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from validation.crosscheck import appendix, cone_laws, extremes, friction, lifetimes, paper, speed
+from validation.crosscheck import appendix, cone_laws, extremes, fem_life, friction, lifetimes, paper, speed
 from validation.crosscheck.context import Context
 from validation.crosscheck.report import Report
 from validation.crosscheck.runs import FemRun, RunMemo
 
 __all__ = ["SECTIONS", "section_names", "planned_requests", "run_validation", "FemRun", "RunMemo"]
 
-SECTIONS = (appendix, cone_laws, lifetimes, speed, extremes, paper, friction)
+SECTIONS = (appendix, cone_laws, lifetimes, speed, extremes, paper, friction, fem_life)
 
 
 def section_names() -> tuple[str, ...]:

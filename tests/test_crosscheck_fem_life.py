@@ -1,0 +1,86 @@
+"""Section 8 of the validation report (the cup's whole life in the FEM): the runs it plans, a run
+that ends without a lifetime kept as a cell with its reason, the README splice, and the quick
+section end to end (~25 s on one core)."""
+
+import json
+import math
+
+import pytest
+
+from validation.crosscheck import fem_life
+from validation.crosscheck.fem_life import LifeRun, live, plan
+from validation.crosscheck.fem_life_rerun import replace_section
+
+
+def test_the_full_section_plans_every_law_and_force_once():
+    runs = plan(False)
+    assert len(set(runs)) == len(runs)
+    laws = {("frictionless", None), ("coulomb", 0.3), ("coulomb", 0.5), ("coulomb", 1.0), ("coulomb", 2.0),
+            ("sticking", None)}
+    for cup, forces in (("A", {5.0, 10.0, 20.0, 40.0, 60.0, 80.0}), ("B", {5.0, 10.0, 20.0, 40.0})):
+        for law in laws:
+            mine = [r.force_N for r in runs if r.cup == cup and (r.law, r.friction) == law]
+            assert mine[0] is None                      # the largest holdable force first
+            assert set(mine[1:]) == forces and len(mine) == len(forces) + 1
+    assert {r.cup for r in runs} == {"A", "B"}
+    assert all(r.fidelity == "coarse" for r in runs)
+
+
+def test_the_quick_subset_is_cup_a_frictionless_and_mu_half_at_10_N():
+    assert set(plan(True)) == {LifeRun("A", law, mu, F) for law, mu in (("frictionless", None), ("coulomb", 0.5))
+                               for F in (None, 10.0)}
+    assert fem_life.requests(True) == fem_life.requests(False) == ()
+
+
+def test_an_invalid_law_is_a_failed_cell_naming_it():
+    out = live(LifeRun("A", "coulomb", -1.0, 10.0))
+    assert out.failed and math.isnan(out.lifetime_s)
+    assert out.cell().startswith("failed: ValueError:") and "friction" in out.cell()
+
+
+def test_a_force_above_the_largest_holdable_is_an_over_force_cell_not_a_lifetime():
+    """Cup A (frictionless, coarse) holds about 52 N once sealed: at 80 N it lets go at once, by the
+    route's branch (run) and by the section's rule (F1 above the largest holdable force: not run)."""
+    runs = (LifeRun("A", "frictionless", None, None), LifeRun("A", "frictionless", None, 80.0))
+    calls = []
+    section = fem_life.lives(runs, lambda r: calls.append(r) or live(r))
+    assert calls == [runs[0]]
+    largest = section[("A", "frictionless", None, None)]
+    assert 20.0 < largest.largest_force_N < 80.0
+    skipped = section[("A", "frictionless", None, 80.0)]
+    out = live(runs[1])
+    for o in (out, skipped):
+        assert o.reason == "over_force" and o.lifetime_s == 0.0 and o.cell() == "0 (over_force)"
+    assert out.largest_force_N == pytest.approx(largest.largest_force_N, rel=1e-9)
+    # the sealed state's seal lies inside the contact, inside the cup's rim (19 mm + the wall)
+    s = out.sealed
+    assert 0 < s["r_c_mm"] <= s["r_k_mm"] <= s["r_out_mm"] < 25.0
+
+
+README = "# r\n\n## 7. Friction\n\nseven\n\n## Deformed cup\n\npic\n"
+
+
+def test_the_section_goes_before_the_unnumbered_tail_and_replaces_itself():
+    header = f"## {fem_life.TITLE}\n"
+    once = replace_section(README, header, "first\n")
+    assert once.index("seven") < once.index(header) < once.index("first") < once.index("## Deformed cup")
+    twice = replace_section(once, header, "second\n")
+    assert "first" not in twice and twice.count(header) == 1
+    assert twice.replace("second", "first") == once
+
+
+def test_quick_section_end_to_end(tmp_path):
+    from validation.cli import main
+
+    out = tmp_path / "report"
+    assert main(["validate", "--quick", "--only", "fem_life", "--no-scene", "--out", str(out),
+                 "--cache-dir", str(tmp_path / "cache")]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert {"fem_life_lifetimes.csv", "fem_life_largest_force.csv", "fem_life_seal.csv",
+            "fem_life_seal.png"} <= names
+    s = json.loads((out / "summary.json").read_text())["fem_life"]
+    assert s["failed_runs"] == []
+    for law in ("frictionless", "mu 0.5"):
+        assert s["lifetime_s"][f"A {law} 10N"] > 0
+        assert s["largest_force_N"]["A"][f"fem {law}"] > 10.0
+    assert "88 N" in (out / "README.md").read_text()

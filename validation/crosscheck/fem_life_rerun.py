@@ -1,0 +1,76 @@
+"""The one command that reruns section 8 (`validation.crosscheck.fem_life`) into an existing
+report, leaving the other sections' files as they are:
+
+    python -m validation.crosscheck.fem_life_rerun --into validation/report
+
+It runs the section alone as `cupcheck validate --only fem_life` does (the validate cache: a rerun
+computes only what changed), copies its tables and figure, replaces its README section (or adds it
+before the unnumbered tail) and its entry of summary.json."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+__all__ = ["merge_into", "replace_section"]
+
+
+def merge_into(report_dir, quick: bool = False, cache_dir=None, cached_only: bool = False) -> list[str]:
+    """Run section 8 alone (as `cupcheck validate --only fem_life`, through the validate cache) and
+    put its files, its README section and its summary entry into an existing report directory,
+    leaving the other sections' files as they are; returns the files written. `cached_only`: runs
+    not in the cache are not run, their cells say so (a report cut at a time budget)."""
+    import json
+    import shutil
+    import tempfile
+
+    from validation.bridge.cache import user_cache_dir
+    from validation.crosscheck import fem_life
+    from validation.crosscheck.context import Context
+    from validation.crosscheck.report import Report, _finite
+    from validation.crosscheck.runs import RunMemo
+    from validation.output import terminal_progress
+
+    root = Path(report_dir)
+    memo = RunMemo(cache_dir=user_cache_dir("validate") if cache_dir is None else cache_dir)
+    with tempfile.TemporaryDirectory() as tmp:
+        rep = Report(Path(tmp))
+        fem_life.run(Context(memo=memo, report=rep, quick=quick, progress=terminal_progress(fem_life.NAME)),
+                     cached_only=cached_only)
+        for name in rep.files:
+            shutil.copyfile(Path(tmp) / name, root / name)
+    header = f"## {fem_life.TITLE}\n"
+    readme = root / "README.md"
+    readme.write_text(replace_section(readme.read_text(), header, "\n".join(rep.pages[fem_life.NAME])))
+    summary_path = root / "summary.json"
+    summary = json.loads(summary_path.read_text())
+    summary[fem_life.NAME] = _finite(json.loads(json.dumps(rep.summary[fem_life.NAME], default=float)))
+    summary_path.write_text(json.dumps(summary, indent=1, sort_keys=True) + "\n")
+    return [*rep.files, readme.name, summary_path.name]
+
+
+def replace_section(text: str, header: str, body: str) -> str:
+    """`text` (a report's README) with the section under `header` replaced by `body`, or the section
+    added before the next numbered-or-not section that follows the numbered ones ("## Deformed cup")."""
+    lines = text.splitlines(keepends=True)
+    new = [header, "\n", body, "\n"]
+    if header in lines:
+        i = lines.index(header)
+        j = next((k for k in range(i + 1, len(lines)) if lines[k].startswith("## ")), len(lines))
+        return "".join(lines[:i] + new + lines[j:])
+    j = next((k for k, line in enumerate(lines) if line.startswith("## ") and not line[3:4].isdigit()),
+             len(lines))
+    return "".join(lines[:j] + new + lines[j:])
+
+
+if __name__ == "__main__":
+    import argparse
+
+    ap = argparse.ArgumentParser(description="Rerun section 8 into an existing report, e.g. "
+                                             "python -m validation.crosscheck.fem_life_rerun --into validation/report")
+    ap.add_argument("--into", required=True, help="the report directory (README.md and summary.json there)")
+    ap.add_argument("--quick", action="store_true", help="the CI subset")
+    ap.add_argument("--cache-dir", default=None, help="the validate cache (default: the user's)")
+    ap.add_argument("--cached-only", action="store_true",
+                    help="run nothing: runs not in the cache become cells saying so")
+    a = ap.parse_args()
+    print("wrote " + ", ".join(merge_into(a.into, a.quick, a.cache_dir, a.cached_only)))
