@@ -49,7 +49,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
            "critical gap u_c(p) of a rough surface (Persson theory; presets, PSD or line scan)"),
     "validate": ("validation.commands.validate",
                  "cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes, the paper's "
-                 "numbers, Coulomb friction (CSV, MD, PNG, JSON)"),
+                 "numbers, Coulomb friction, the fem route by contact law (CSV, MD, PNG, JSON)"),
 }
 
 

@@ -1,5 +1,6 @@
 """Cross-check report: Appendix A vs FEM, rigid-cone laws vs FEM, the lifetime consequence
-of the stiffness source, the speed-accuracy trade, and the extremes.
+of the stiffness source, the speed-accuracy trade, the extremes, the paper's numbers, Coulomb
+friction, and the cup's whole life in the FEM (the fem route by contact law).
 
 Writes to DIR, atomically: README.md (all sections, tables inline), one CSV per table (units in the
 column names), PNG figures, and summary.json with the headline numbers (appendix_a_slope_N_per_mm,
@@ -11,7 +12,9 @@ FAILs (the rows marked FAIL), 0 when all pass.
 
 examples:
   cupcheck validate --quick --out out/validate-quick            # the CI subset, ~1 min
-  cupcheck validate --out validation/report                     # the full report, ~10 min on 2 cores
+  cupcheck validate --out validation/report                     # the full report: sections 1-7 ~10 min on 2 cores;
+                                                                #   section 8 (fem_life) hours (mu >= 1, sticking)
+  cupcheck validate --only fem_life --out out/v                 # the cup's whole life in the FEM by contact law
   cupcheck validate --only appendix cone_laws --out out/v --no-cache
 """
 
@@ -25,7 +28,7 @@ from validation.bridge.cache import user_cache_dir
 
 NAME = "validate"
 HELP = ("cross-check report: Appendix A, cone laws, lifetimes, speed-accuracy, extremes, the paper's "
-        "numbers, Coulomb friction (CSV, MD, PNG, JSON)")
+        "numbers, Coulomb friction, the fem route by contact law (CSV, MD, PNG, JSON)")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
