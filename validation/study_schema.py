@@ -24,7 +24,7 @@ from typing import Any
 from validation.bridge.lifetimes import ROUTES
 from validation.bridge.pipeline import DEFAULT_SURFACE
 
-__all__ = ["Field", "FIELDS", "SPELLINGS", "field_of", "parse", "add_flags", "values_from_args",
+__all__ = ["Field", "FIELDS", "SPELLINGS", "field_of", "parse", "finite_number", "add_flags", "values_from_args",
            "study_from_values", "check_route", "check_surface_preset"]
 
 #: the spellings of a study: a scene file, a sweep file's [base], the command line
@@ -145,7 +145,8 @@ def field_of(key: str) -> Field:
     return _BY_KEY[key]
 
 
-def _number(value: Any, where: str, positive: bool) -> float:
+def finite_number(value: Any, where: str, positive: bool) -> float:
+    """`value` as a float if it is a finite number (and > 0 if `positive`); else ValueError naming `where`."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ValueError(f"{where}: expected a finite number, got {value!r}")
     if positive and value <= 0:
@@ -175,12 +176,12 @@ def parse(f: Field, value: Any, spelling: str, where: str | None = None) -> Any:
         values = value if isinstance(value, list) else [value]
         if not values:
             raise ValueError(f"{where}: expected at least one value (an empty list gives an empty table)")
-        values = [_number(v, f"{where}[{i}]", f.positive) for i, v in enumerate(values)]
+        values = [finite_number(v, f"{where}[{i}]", f.positive) for i, v in enumerate(values)]
         if f.guard == "forces":
             guards.check_forces(values, where)
         return values
     if f.type == "number":
-        number = _number(value, where, f.positive)
+        number = finite_number(value, where, f.positive)
         if f.guard == "modulus":
             guards.check_modulus(number, where)
         elif f.guard == "forces":

@@ -19,7 +19,6 @@ alone imports no fem); `Scene.contact_source` says where the law came from.
 
 from __future__ import annotations
 
-import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -28,7 +27,8 @@ from typing import Any
 
 from validation.bridge.study import Study, Sweep
 from validation.study_schema import FIELDS as STUDY_FIELDS
-from validation.study_schema import check_route, check_surface_preset, field_of, parse, study_from_values
+from validation.study_schema import (check_route, check_surface_preset, field_of, finite_number, parse,
+                                     study_from_values)
 
 __all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES", "key_rows"]
 
@@ -190,7 +190,7 @@ def _sweep(table: Any, tables: dict[str, dict[str, Any]]) -> dict[str, Any]:
         for j, v in enumerate(values):
             check_surface_preset(v, f"sweep.values[{j}]")
     elif key != "contact.friction":
-        values = [_number(v, f"sweep.values[{i}]", positive=True) for i, v in enumerate(values)]
+        values = [finite_number(v, f"sweep.values[{i}]", positive=True) for i, v in enumerate(values)]
     if key == "contact.friction":
         if tables["contact"]["law"] != "coulomb":
             raise ValueError("sweep.key: contact.friction needs contact.law = \"coulomb\"")
@@ -317,7 +317,7 @@ def _output(output: Any, i: int) -> dict[str, Any]:
         raise ValueError(f"{where}.u_mm: {', '.join(STATE_KINDS)} need u_mm (the plate displacement shown), "
                          "and only they")
     if u_mm is not None:
-        u_mm = _number(u_mm, f"{where}.u_mm", positive=True)
+        u_mm = finite_number(u_mm, f"{where}.u_mm", positive=True)
     field = output.get("field")
     if field is not None and kind not in ("render", "squeeze"):
         raise ValueError(f"{where}.field: only for kind = \"render\" or \"squeeze\"")
@@ -336,11 +336,3 @@ def _output(output: Any, i: int) -> dict[str, Any]:
     if not isinstance(name, str) or not name or "/" in name or name.startswith("."):
         raise ValueError(f"{where}.name: expected a plain file stem, got {name!r}")
     return {"kind": kind, "name": name, "figure": figure, "u_mm": u_mm, "field": field, "frames": frames}
-
-
-def _number(value: Any, where: str, positive: bool) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError(f"{where}: expected a finite number, got {value!r}")
-    if positive and value <= 0:
-        raise ValueError(f"{where}: must be > 0, got {value:g}")
-    return float(value)
