@@ -166,6 +166,16 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
         progress(0, first.u_m, first.N)
     N_ref = abs(slopes[0]) * du_m if math.isfinite(slopes[0]) and slopes[0] else 1e-3 * first.N
     tangent = walk.tangent(first, du_m, N_ref, None)
+
+    def crossed(restored: GasState) -> np.ndarray:
+        """Take the state a jump of the pull was crossed to; the tangent to go on from it."""
+        trials.append(restored)
+        if progress:
+            progress(len(trials) - 1, restored.u_m, restored.N)
+        slopes.append(walk.slope(restored))
+        tangent = walk.tangent(restored, du_m, N_ref, None)
+        walk.snaps += 1
+        return tangent
     h = 1.0
     while len(trials) < max_states:
         prev = trials[-1]
@@ -188,13 +198,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
                 return walk.result(None, "u_min", trials, slopes)
             if _open(cup, restored):
                 return walk.result(prev, "seal opened", trials, slopes)
-            trials.append(restored)
-            if progress:
-                progress(len(trials) - 1, restored.u_m, restored.N)
-            slopes.append(walk.slope(restored))
-            tangent = walk.tangent(restored, du_m, N_ref, None)
-            walk.snaps += 1
-            h = 1.0
+            tangent, h = crossed(restored), 1.0
             continue
         except RuntimeError as err:
             if h > 1.0 / 16.0 * (1 + 1e-9):
@@ -210,13 +214,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
                 restored = None
             if not restored:
                 return walk.result(None, f"stopped: {err}", trials, slopes)
-            trials.append(restored)
-            if progress:
-                progress(len(trials) - 1, restored.u_m, restored.N)
-            slopes.append(walk.slope(restored))
-            tangent = walk.tangent(restored, du_m, N_ref, None)
-            walk.snaps += 1
-            h = 1.0
+            tangent, h = crossed(restored), 1.0
             continue
         h = min(1.0, 2.0 * h)
         if _open(cup, s):
