@@ -13,8 +13,7 @@ The nouns are loaded on first use (PEP 562), so `import reduced` stays cheap.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from reduced._lazy import lazy_exports
 
 #: public name -> the module that defines it
 _WHERE = {
@@ -35,14 +34,4 @@ _WHERE = {
 __all__ = list(_WHERE)
 
 
-def __getattr__(name: str) -> Any:
-    module = _WHERE.get(name)
-    if module is None:
-        raise AttributeError(f"module 'reduced' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(list(globals()) + __all__)
+__getattr__, __dir__ = lazy_exports("reduced", _WHERE, globals())

@@ -12,8 +12,7 @@ of the coupled route.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from reduced._lazy import lazy_exports
 
 #: public name -> the module that defines it
 _WHERE = {
@@ -28,14 +27,4 @@ __all__ = ["LeakageModel", "reference_model", "solve_lifetime", "largest_holdabl
            "REASONS", "ROUTES", "Route", "Run", "register_route", "lifetime_by_quadrature"]
 
 
-def __getattr__(name: str) -> Any:
-    module = _WHERE.get(name)
-    if module is None:
-        raise AttributeError(f"module 'reduced.lifetime' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(list(globals()) + __all__)
+__getattr__, __dir__ = lazy_exports("reduced.lifetime", _WHERE, globals())
