@@ -153,7 +153,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     if not (u_min < sealed.u_m):
         raise ValueError(f"u_min_m: must be below the sealed plate position {sealed.u_m * 1e3:.4g} mm, "
                          f"got {u_min * 1e3:.4g} mm")
-    walk = _Walk(cup, float(F1_N))
+    walk = _walk(cup, float(F1_N))
     start = _Trial(sealed.u_m, sealed.N, sealed.F1_N, sealed.state)
     try:
         first = walk.pull_to_force(start, du_m, u_min)
@@ -238,7 +238,7 @@ def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float) -> Gas
     """A state holding F1_N between two consecutive states a and b of a branch, reached from a
     (its history): N the unknown at the plate midway, or where that fails, the plate at N
     midway. None where neither is found between them (a jump of the pull between a and b)."""
-    walk = _Walk(cup, float(F1_N))
+    walk = _walk(cup, float(F1_N))
     prev = _Trial(a.u_m, a.N, a.F1_N, a.state)
     u, N = 0.5 * (a.u_m + b.u_m), 0.5 * (a.N + b.N)
     for find in (walk.hold, walk.hold_u):
@@ -249,6 +249,13 @@ def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float) -> Gas
         if min(a.N, b.N) < s.N < max(a.N, b.N) and not _open(cup, s):
             return walk.result(None, "between", [s]).states[0]
     return None
+
+
+def _walk(cup: CupWithGas, F1_N: float) -> "_Walk":
+    """The walk for the cup's cavity content: the gas's, or the one the cup names
+    (`branch_walk(F1_N)`: `fem.water_branch` for a water-filled cavity, V_w in place of N)."""
+    own = getattr(cup, "branch_walk", None)
+    return _Walk(cup, F1_N) if own is None else own(F1_N)
 
 
 def _open(cup: CupWithGas, s: "_Trial") -> bool:
