@@ -17,14 +17,14 @@ Lagrangian: at a multiplier estimate dp_lam the potential
 is added to W (`WaterMechanics`), with its exact tangent K + dp Hess(V) + c grad V grad V^T (the
 trapped gas's rank-one form, `fem.trapped_gas.GasTangent`, solved by Sherman-Morrison on the
 body's factor), so the solver stays an energy minimization with its line search and contact
-problem; then dp_lam <- dp (Uzawa) until c |V - V_w| is below UZAWA_TOL rtol p_a (or stalls
+problem; then dp_lam <- dp (Uzawa) until c |V - V_w| is below UZAWA_TOL rtol max(p_a, |dp|) (or stalls
 below STALL times that, the solver's own resolution). Each update solves a
 state whose constraint is off by 1 / (1 + c s) of the last (s = dV/d(dp) of the cup), so with c
 AL_FACTOR p_a / V_w it takes two or three. The penalty c is the stiffness a gas would need at
 AL_FACTOR times the ambient pressure: it holds the wall where at fixed dp it would snap, as the
 gas does. A bordered Newton (dp an unknown beside u) would give the same states, but the solver's
 line search needs an energy, which the saddle point has not. A converged state is the exact
-constrained one: r + dp dV/du = 0 on the free dofs and V = V_w to c |V - V_w| <= UZAWA_TOL rtol p_a.
+constrained one: r + dp dV/du = 0 on the free dofs and V = V_w to that tolerance.
 
 The stages are those of `fem.gas_path.CupWithGas` (whose pressing, measuring and cost keeping
 this cup inherits): pressed with the cavity open (the water expelled, V_w = V, p_b = p_a), the
@@ -58,7 +58,8 @@ __all__ = ["WaterMechanics", "WaterState", "CupWithWater", "AL_FACTOR", "UZAWA_T
 #: the augmented Lagrangian's penalty c = AL_FACTOR p_a / V_w [Pa/m^3] (module docstring)
 AL_FACTOR = 100.0
 #: the multiplier update c |V - V_w| below which the constraint is met, as a share of the
-#: solver's rtol times p_a (0.01 Pa at rtol 1e-6: the solver's own resolution of dp is ~1e-3 Pa)
+#: solver's rtol times max(p_a, |dp|) (0.01 Pa at rtol 1e-6 and dp <= p_a: the solver resolves dp
+#: to ~1e-3 Pa there)
 UZAWA_TOL = 0.1
 UZAWA_MAX = 12
 #: ... or below STALL times that where an update no longer halves it (the solver's resolution:
@@ -234,11 +235,11 @@ class CupWithWater(CupWithGas):
         stats = follow_path(mech, self._line(u0_m, u1_m), 1.0, plane=plane, start=start,
                             options=options, on_step=last.append)
         end, fixed = mech.at(1.0), replace(options, initial_step=1.0, max_step=1.0)
-        tol = UZAWA_TOL * options.rtol * self.p_a_Pa
         before = math.inf
         for _ in range(UZAWA_MAX):
             dp = end.dp_Pa(last[-1].u)
             update = abs(dp - end.dp_lam_Pa)
+            tol = UZAWA_TOL * options.rtol * max(self.p_a_Pa, abs(dp))
             if update <= tol or (update <= STALL * tol and update > 0.5 * before):
                 return last[-1], dp, stats
             before = update

@@ -269,7 +269,7 @@ def check_route(values: Mapping[str, Any], given: Iterable[str], spelling: str,
                 swept: str | None = None) -> None:
     """The rules between the route and the other fields, in the names of `spelling`: the routes
     that need the FEM; the fem route's own fields (the press, the plate step) with it only, one
-    press, and what it does not model (water, relaxation, kappa, Appendix A). `values`: {key
+    press, and what it does not model (relaxation, kappa, Appendix A). `values`: {key
     path: value} with defaults; `given`: the key paths the user wrote; `swept`: a swept key path."""
     name = lambda key: _BY_KEY[key].name(spelling)                                   # noqa: E731
     route_is = lambda value: _BY_KEY["stiffness.route"].setting(spelling, value)    # noqa: E731
@@ -289,8 +289,7 @@ def check_route(values: Mapping[str, Any], given: Iterable[str], spelling: str,
                          f"{', '.join(name(k) for k in press)}")
     if source != "fem":
         raise ValueError(f"{name('stiffness.route')}: 'fem' needs source = \"fem\" (the cup's whole life in the FEM)")
-    for key, default, why in (("fluid.kind", "air", " models a gas-filled cavity only"),
-                              ("material.relaxation", "none", "'s wall is the FEM's elastic one"),
+    for key, default, why in (("material.relaxation", "none", "'s wall is the FEM's elastic one"),
                               ("loads.kappa", 1.0, "'s stiffness is the FEM's own")):
         if values.get(key, default) != default:
             raise ValueError(f"{name(key)}: the fem route{why}; drop {_BY_KEY[key].setting(spelling, values[key])}")

@@ -24,6 +24,15 @@ quadrature and branch error (benchmarks/bench_fem_route.py, docs/lifetime.md).
 
 The largest holdable force is the largest pull along the plate raised at fixed N0 from the sealed
 state (the branch at a larger F1 does not start: the cup lets go at once).
+
+Water (model.fluid = "water"): the cavity is full of incompressible water (`fem.water_cavity`:
+V_cav = V_w, the cavity pressure its multiplier, which may fall below zero: a metastable liquid,
+no cavitation). Pressed, the cup expels water (V_w follows V); sealed, V_w0 = V; under F1 it follows
+`fem.water_branch` (the same walk, V_w in place of N) to the fold (largest V_w held at F1) or the
+seal opening. The inflow Q_w [m^3/s] is eq (24) ring by ring in series through each state's profile
+(`reduced.profile_leak.profile_liquid_rate`, the model's liquid viscosity), the solid pressure as
+for the gas; t = int dV_w / Q_w by the same trapezoid. The largest holdable force is the largest
+pull along the plate raised at fixed V_w0 (`largest_pull_water`).
 """
 
 from __future__ import annotations
@@ -71,14 +80,19 @@ class FemCup:
         return {"geometry": geometry, "fidelity": self.fidelity, "E_Pa": self.E_Pa, "nu": self.nu,
                 **self.contact.describe()}
 
-    def build(self, T_K: float, p_a_Pa: float) -> CupWithGas:
+    def build(self, T_K: float, p_a_Pa: float, fluid: str = "air") -> CupWithGas:
+        """The FEM cup with gas (fluid "air") or water ("water") in its cavity."""
         from fem.gas_path import CupWithGas
+        from fem.water_cavity import CupWithWater
         from fem.geometry import cup_geometry
         from fem.mesh import cup_mesh
         from validation.bridge.pipeline import neo_hookean
 
         geometry = cup_geometry(self.geometry) if isinstance(self.geometry, str) else self.geometry
         mesh = cup_mesh(geometry, self.fidelity)
+        if fluid == "water":
+            return CupWithWater.of(mesh, neo_hookean(self.E_Pa, self.nu), self.contact.law,
+                                   self.contact.friction, p_a_Pa=p_a_Pa)
         return CupWithGas.of(mesh, neo_hookean(self.E_Pa, self.nu), self.contact.law,
                              self.contact.friction, T_K=T_K, p_a_Pa=p_a_Pa)
 
@@ -99,11 +113,13 @@ class Press:
 
 
 def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: str = "annulus") -> float:
-    """Molecules per second leaking into the cavity at one sealed FEM state (module docstring):
-    the solid pressure of `reduced.table_surface.solid_profile` on the state's own profile, at
-    the state's p_b, u_c read at p / E_Pa (the wall's modulus). inf where no solid contact is left
-    (the gas holds the seal open)."""
-    from reduced.profile_leak import ContactProfile, patch_average, profile_leak_rate, ring_gaps
+    """Molecules per second leaking into the cavity at one sealed FEM state (module docstring), or
+    for water the volume inflow [m^3/s] of eq (24): the solid pressure of
+    `reduced.table_surface.solid_profile` on the state's own profile, at the state's p_b, u_c read
+    at p / E_Pa (the wall's modulus). inf where no solid contact is left (the fluid holds the
+    seal open)."""
+    from reduced.profile_leak import (ContactProfile, patch_average, profile_leak_rate, profile_liquid_rate,
+                                      ring_gaps)
     from reduced.stiffness_curve import profiles_from_lists
 
     prof, = profiles_from_lists([1e3 * state.profile.r_m], [1e-3 * state.profile.p_Pa])
@@ -124,6 +140,9 @@ def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: s
     gaps = ring_gaps(solid, model.u_c, E_Pa)
     if np.all(np.isinf(gaps)):
         return math.inf
+    if model.fluid == "water":          # a liquid under tension keeps p_b < 0
+        return profile_liquid_rate(model.liquid_viscosity_Pa_s, model.p_a_Pa, min(state.p_b_Pa, model.p_a_Pa),
+                                   solid.r_m, gaps, radial)
     p_b = min(max(state.p_b_Pa, 0.0), model.p_a_Pa)
     return profile_leak_rate(model.gas, model.p_a_Pa, p_b, solid.r_m, gaps, radial)
 
@@ -168,8 +187,9 @@ class FemRoute:
             raise ValueError(f"radial: expected 'annulus' or 'strip', got {options['radial']!r}")
         if model.u_c is None:
             raise ValueError("u_c: the fem route needs a critical gap u_c(p/E) (e.g. a UcTable)")
-        if model.fluid != "air":
-            raise ValueError(f"fluid: the fem route models a gas-filled cavity only, got '{model.fluid}'")
+        if model.fluid == "water" and model.cavitation_pressure_Pa is not None:
+            raise ValueError("cavitation_pressure_Pa: the fem route's water is a metastable liquid (no "
+                             "cavitation); drop it")
         if model.relaxation is not None or model.kappa != 1.0:
             raise ValueError("relaxation, kappa: the fem route's wall is the FEM's elastic one; "
                              "drop relaxation and kappa")
@@ -178,11 +198,11 @@ class FemRoute:
              progress: Callable[[float, str], None] | None = None) -> Sealed:
         """The cup pressed with the gas escaping and sealed, once per (cup, press, gas)."""
         press = options["press"] or Press("r_start_m", model.cup.r_start_m)
-        key = (options["cup"], press, model.gas.T_K, model.p_a_Pa)
+        key = (options["cup"], press, model.gas.T_K, model.p_a_Pa, model.fluid)
         if key not in self._sealed:
             if progress:
                 progress(0.0, f"pressing the cup to {press.kind} = {press.value:g}")
-            cup = options["cup"].build(model.gas.T_K, model.p_a_Pa)
+            cup = options["cup"].build(model.gas.T_K, model.p_a_Pa, model.fluid)
             state = cup.press_to(**{press.kind: float(press.value)})[-1]
             self._sealed[key] = Sealed(cup, state, options["cup"].E_Pa)
         return self._sealed[key]
@@ -195,7 +215,8 @@ class FemRoute:
         sealed = self.seal(model, options)
         kept = self._largest.get(id(sealed))
         if kept is None or kept[0] is not sealed:
-            kept = self._largest[id(sealed)] = (sealed, *largest_pull_checked(sealed.cup, sealed.state))
+            largest = largest_pull_water if model.fluid == "water" else largest_pull_checked
+            kept = self._largest[id(sealed)] = (sealed, *largest(sealed.cup, sealed.state))
         return kept[1], kept[2]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
@@ -216,7 +237,9 @@ class FemRoute:
                       "model": model.label, "t_max_s": run.t_max_s}
         common = dict(route=self.name, force_N=float(force_N), largest_force_N=largest,
                       provenance=provenance)
-        base = {"N0": s0.N, "u_sealed_mm": 1e3 * s0.u_m, "r_start_mm": 1e3 * s0.r_c_m,
+        water = model.fluid == "water"
+        content = {"V_w0_mm3": 1e9 * s0.N} if water else {"N0": s0.N}
+        base = {**content, "u_sealed_mm": 1e3 * s0.u_m, "r_start_mm": 1e3 * s0.r_c_m,
                 "seal_r_sealed_mm": 1e3 * s0.seal_r_m, "branch_reason": branch.reason}
         if partial is not None:       # the pull was still rising where the solver stopped
             base["largest_force_lower_bound"] = partial
@@ -231,9 +254,9 @@ class FemRoute:
         states, q, added = refine_branch(sealed.cup, list(branch.states), [leak(s) for s in branch.states],
                                          float(force_N), leak)
         N = np.array([s.N for s in states])
-        columns = _columns(states, q)
+        columns = _columns(states, q, water)
         stats = branch.stats
-        details = {**base, "N_max": branch.N_max, "states": len(states), "refined": added, "snaps": branch.snaps,
+        details = {**base, **({"V_w_max_mm3": 1e9 * branch.N_max} if water else {"N_max": branch.N_max}), "states": len(states), "refined": added, "snaps": branch.snaps,
                    "newton_iterations": stats.newton_iterations, "wall_time_s": stats.wall_time_s,
                    "seal_r_final_mm": 1e3 * states[-1].seal_r_m, "p_b_final_Pa": states[-1].p_b_Pa,
                    "u_final_mm": 1e3 * states[-1].u_m}
@@ -321,9 +344,13 @@ def lifetime_integral(N: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(N))])
 
 
-def _columns(states: list, q: np.ndarray) -> dict[str, np.ndarray]:
+def _columns(states: list, q: np.ndarray, water: bool = False) -> dict[str, np.ndarray]:
     def col(name: str, scale: float = 1.0) -> np.ndarray:
         return scale * np.array([getattr(s, name) for s in states])
+    if water:
+        return {"V_w_mm3": col("N", 1e9), "p_b_Pa": col("p_b_Pa"), "u_mm": col("u_m", 1e3),
+                "F_plate_N": col("F1_N"), "V_mm3": col("V_m3", 1e9), "r_c_mm": col("r_c_m", 1e3),
+                "seal_r_mm": col("seal_r_m", 1e3), "r_out_mm": col("cut_r_m", 1e3), "Q_w_mm3_per_s": 1e9 * q}
     return {"N": col("N"), "p_b_Pa": col("p_b_Pa"), "u_mm": col("u_m", 1e3), "F_plate_N": col("F1_N"),
             "V_mm3": col("V_m3", 1e9), "r_c_mm": col("r_c_m", 1e3), "seal_r_mm": col("seal_r_m", 1e3),
             "r_out_mm": col("cut_r_m", 1e3), "N_dot_per_s": q}
@@ -374,6 +401,47 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
     partial = stopped if stopped is not None and k == F.size - 1 else None
     if 0 < k < F.size - 1:
         a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
+        if a < 0:
+            return float(max(F[k], c - b * b / (4 * a))), partial
+    return float(F[k]), partial
+
+
+def largest_pull_water(cup, sealed, du_m: float = 0.1e-3, drop: float = 0.02) -> tuple[float, str | None]:
+    """The largest pull F1 [N] along the plate raised at the sealed state's V_w (`largest_pull`'s
+    water counterpart, `fem.water_cavity.CupWithWater.solve_water`): plate steps of du_m up to -h1
+    until F1 has fallen by `drop` of its maximum or the seal opens, the maximum refined by the
+    parabola through the three states around it; with the solver's message where it stopped
+    while the pull was still rising (a lower bound: the liquid under tension can pull the wall
+    until it folds onto itself, which the FEM does not model), else None."""
+    from fem.integrity import StateRejected, check_state
+    from fem.water_branch import cavity_pressure_difference
+
+    top = cup.cup.top
+    step, u, V_w = sealed.state, sealed.u_m, sealed.N
+    dp = cavity_pressure_difference(cup, step) if sealed.stage != "pressed" else 0.0
+    seen: list[tuple[float, float]] = [(u, sealed.F1_N)]
+    stopped = None
+    options = replace(cup.options, initial_step=1.0, max_step=1.0)      # one load step per move
+    while u - du_m > -cup.h1_m:
+        try:
+            step, dp, _ = cup.solve_water(step, dp, u, u - du_m, V_w, V_w, options)
+            check_state(cup.mesh, step.u, u - du_m, 0, u - du_m)    # no fold of the wall
+        except (RuntimeError, StateRejected) as err:
+            stopped = str(err)
+            break
+        z = cup.mesh.doflocs[1, cup.cavity.nodes] + step.u[2 * cup.cavity.nodes + 1]
+        if not np.any(z <= cup.cavity.tolerance_m):           # the seal opened: not held
+            break
+        u -= du_m
+        seen.append((u, float(np.sum(step.r_int[2 * top + 1]))))
+        best = max(f for _, f in seen)
+        if best > 0 and seen[-1][1] < (1.0 - drop) * best:
+            break
+    us, F = np.array(seen).T
+    k = int(np.argmax(F))
+    partial = stopped if stopped is not None and k == F.size - 1 else None
+    if 0 < k < F.size - 1:
+        a, b, c = np.polyfit(us[k - 1:k + 2], F[k - 1:k + 2], 2)
         if a < 0:
             return float(max(F[k], c - b * b / (4 * a))), partial
     return float(F[k]), partial
