@@ -281,6 +281,9 @@ def check_route(values: Mapping[str, Any], given: Iterable[str], spelling: str,
     for key in ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"):
         if key in given and route != "fem":
             raise ValueError(f"{name(key)}: only for {route_is('fem')} (the cup pressed and sealed in the FEM)")
+    if route == "coupled" and values.get("fluid.kind", "air") != "air":
+        raise ValueError(f"{name('fluid.kind')}: {route_is('coupled')} models a gas-filled cavity only; drop "
+                         f"{_BY_KEY['fluid.kind'].setting(spelling, values['fluid.kind'])}")
     if route != "fem":
         return
     press = [k for k in ("loads.r_start_mm", "loads.press_u_mm", "loads.press_force_N") if values.get(k) is not None]

@@ -122,7 +122,7 @@ def run_fem_route(args: argparse.Namespace) -> int:
           f"{s0['u_sealed_mm']:.4g} mm, {_content(s0)}); route fem: {fem['fidelity']} mesh, E "
           f"{fem['E_Pa'] / 1e6:g} MPa, nu {fem['nu']:g}, contact {_law(cup['contact'])} "
           f"({cup['contact']['source']}), plate step {cup['du_mm']:g} mm; largest holdable force "
-          f"{results.largest_force_N:.4g} N")
+          f"{'at least ' if 'largest_force_lower_bound' in s0 else ''}{results.largest_force_N:.4g} N")
     print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'u_end_mm':>8} {'p_b_end_kPa':>11} {'seal_r_mm':>9}")
     for r in results:
         life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"

@@ -64,7 +64,7 @@ FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 #: the study's fields `example` spells as flags (`validation.study_schema`; contact: `contact_choice`)
 KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "cup.l0_mm", "cup.l1_mm", "stiffness.route",
         "loads.r_start_mm", "stiffness.fidelity", "surface.preset", "surface.uc_table", "loads.press_u_mm",
-        "loads.press_force_N", "stiffness.du_mm")
+        "loads.press_force_N", "stiffness.du_mm", "fluid.kind")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -92,6 +92,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "$CUPCHECK_CACHE_DIR moves it)")
     c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
     add_flags(p.add_argument_group("fem route"), ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"))
+    add_flags(p, ("fluid.kind",))
     add_flags(p.add_mutually_exclusive_group(), ("surface.preset", "surface.uc_table"), helps={
         "surface.preset": "calibrated surface preset for u_c(p/E) (default: pmma-1.89)",
         "surface.uc_table": "critical gap table instead, columns p_over_E,u_c_m (u_c in m)"},
