@@ -53,13 +53,13 @@ def water_branch(cup: CupWithWater, sealed: WaterState, F1_N: float, du_m: float
     ends are `fem.gas_branch.equilibrium_branch`'s, `Branch.N_max` is the largest V_w [m^3])."""
     if not isinstance(cup, CupWithWater):
         raise TypeError(f"cup: a CupWithWater is required, got {type(cup).__name__}")
-    return equilibrium_branch(cup, sealed, F1_N, du_m, u_min_m, max_states, progress)
+    return equilibrium_branch(cup, sealed, F1_N, du_m, u_min_m, max_states, progress, walk=WaterWalk)
 
 
 def water_state_between(cup: CupWithWater, a: WaterState, b: WaterState, F1_N: float) -> WaterState | None:
     """A state holding F1_N between two consecutive states of a water branch
     (`fem.gas_branch.state_between`)."""
-    return state_between(cup, a, b, F1_N)
+    return state_between(cup, a, b, F1_N, walk=WaterWalk)
 
 
 def cavity_pressure_difference(cup: CupWithWater, step: StepResult) -> float:

@@ -267,11 +267,6 @@ class CupWithWater(CupWithGas):
         F1, Nc, V, r_k, r_cut, r_c, _, profile = _outputs(step, mech, self.cup, self.cavity)
         return WaterState(stage, float(u_m), V, self.p_a_Pa, 0.0, F1, Nc, V, r_k, r_cut, r_c, profile, step)
 
-    def branch_walk(self, F1_N: float):
-        """The walk `fem.gas_branch` takes for this cup: `fem.water_branch.WaterWalk`."""
-        from .water_branch import WaterWalk
-        return WaterWalk(self, F1_N)
-
     def _line(self, u0_m: float, u1_m: float):
         """The plate from u0 to u1 as t goes from 0 to 1 (u_r = 0, u_z = -u)."""
         top = self.cup.top

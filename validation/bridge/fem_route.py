@@ -220,7 +220,8 @@ class FemRoute:
         return kept[1], kept[2]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
-        from fem.gas_branch import equilibrium_branch
+        from fem.gas_branch import equilibrium_branch, state_between
+        from fem.water_branch import water_branch, water_state_between
         from reduced.lifetime import Lifetime
         from reduced.lifetime.paper import check_run
 
@@ -228,8 +229,10 @@ class FemRoute:
         if run.refine != 1:
             raise ValueError(f"refine: the fem route has no dense output, got {run.refine}")
         sealed = self.seal(model, options, run.progress)
-        branch = equilibrium_branch(sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
-                                    progress=_branch_progress(run.progress, force_N, sealed))
+        water = model.fluid == "water"
+        branch = (water_branch if water else equilibrium_branch)(
+            sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
+            progress=_branch_progress(run.progress, force_N, sealed))
         largest, partial = self._largest_checked(model, options)
         s0 = sealed.state
         provenance = {"route": self.name, "options": {**options, "cup": options["cup"].describe(),
@@ -237,7 +240,6 @@ class FemRoute:
                       "model": model.label, "t_max_s": run.t_max_s}
         common = dict(route=self.name, force_N=float(force_N), largest_force_N=largest,
                       provenance=provenance)
-        water = model.fluid == "water"
         content = {"V_w0_mm3": 1e9 * s0.N} if water else {"N0": s0.N}
         base = {**content, "u_sealed_mm": 1e3 * s0.u_m, "r_start_mm": 1e3 * s0.r_c_m,
                 "seal_r_sealed_mm": 1e3 * s0.seal_r_m, "branch_reason": branch.reason}
@@ -252,7 +254,7 @@ class FemRoute:
                                 f"({branch.reason}) after {len(branch.states)} states")
         leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, options["radial"])  # noqa: E731
         states, q, added = refine_branch(sealed.cup, list(branch.states), [leak(s) for s in branch.states],
-                                         float(force_N), leak)
+                                         float(force_N), leak, water_state_between if water else state_between)
         N = np.array([s.N for s in states])
         columns = _columns(states, q, water)
         stats = branch.stats
@@ -291,13 +293,16 @@ REFINE_RATIO, REFINE_SHARE, REFINE_DEPTH = 2.0, 0.01, 3
 
 
 def refine_branch(cup: CupWithGas, states: list, q: list, force_N: float,
-                  leak: Callable[[Any], float]) -> tuple[list, np.ndarray, int]:
+                  leak: Callable[[Any], float], between: Callable | None = None) -> tuple[list, np.ndarray, int]:
     """The branch's states with states added where the trapezoid of 1/Q in N is not resolved:
     between neighbours whose leak differs by more than REFINE_RATIO and whose interval carries
     more than REFINE_SHARE of the lifetime (where the seal's last contact ring narrows, Q falls
     several times within one plate step), a state midway (`fem.gas_branch.state_between`, from
-    the earlier state), up to REFINE_DEPTH halvings. (states, Q [1/s], states added)."""
+    the earlier state; `between`: its water counterpart), up to REFINE_DEPTH halvings. (states,
+    Q [1/s], states added)."""
     from fem.gas_branch import state_between
+
+    between = between or state_between
 
     states, q = list(states), list(q)
     added = 0
@@ -315,7 +320,7 @@ def refine_branch(cup: CupWithGas, states: list, q: list, force_N: float,
         if len(todo) == 0:
             break
         for k in todo[::-1]:                      # from the end: the indices before stay valid
-            mid = state_between(cup, states[k], states[k + 1], force_N)
+            mid = between(cup, states[k], states[k + 1], force_N)
             if mid is not None:
                 states.insert(k + 1, mid)
                 q.insert(k + 1, leak(mid))
