@@ -27,11 +27,16 @@ still rise along it. Where V_w(u) has its maximum (the fold of the branch, dV_w/
 with more water holds F1: the cup lets go ("fold"). The branch also ends where the seal opens, no
 node of the cavity chain on the plane ("seal opened"). The lifetime is t = int dV_w / Q_w over
 the branch (`validation.bridge.fem_route`: the inflow Q_w of eq 24 through each state's profile).
+
+The largest pull the sealed cup holds (`largest_pull`) is the largest along the plate raised at
+fixed V_w0: the liquid may go into tension (p_b < 0, no cavitation), so it is bounded by the seal
+opening or by the wall folding onto itself, not by p_a pi r_k^2 as for a gas.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -40,10 +45,11 @@ import scipy.sparse.linalg as spla
 from .gas_branch import Branch, _Trial, _Walk, equilibrium_branch, state_between
 from .solver import StepResult
 from .cup import _joined
+from .integrity import check_state
 from .water_cavity import CupWithWater, WaterMechanics, WaterState
 
 __all__ = ["water_branch", "water_state_between", "pull_sensitivities", "cavity_pressure_difference",
-           "WaterWalk"]
+           "largest_pull", "WaterWalk"]
 
 
 def water_branch(cup: CupWithWater, sealed: WaterState, F1_N: float, du_m: float = 0.1e-3,
@@ -117,6 +123,44 @@ def _sensitivities(cup: CupWithWater, state: StepResult, dp_Pa: float) -> tuple[
         x[free] = -a_f - ddp * b
         return float(np.sum((Ks @ x + ddp * g)[plate_z]))
     return response(1.0, np.zeros(u.size), np.zeros(gf.size)), response(0.0, down, a)
+
+
+def largest_pull(cup: CupWithWater, sealed: WaterState, du_m: float = 0.1e-3,
+                 drop: float = 0.02) -> tuple[float, str | None]:
+    """The largest pull F1 [N] along the plate raised at the sealed state's V_w, and the solver's
+    message where it stopped while the pull was still rising (a lower bound: the liquid under
+    tension pulls the wall until it folds onto itself, which the FEM does not model), else None.
+    Plate steps of du_m up to -h1, each ending on the constraint (`CupWithWater.solve_water`),
+    until F1 has fallen by `drop` of its maximum or the seal opens; the maximum refined by the
+    parabola through the three states around it."""
+    top = cup.cup.top
+    step, u, V_w, dp = sealed.state, sealed.u_m, sealed.V_w_m3, sealed.dp_Pa
+    seen: list[tuple[float, float]] = [(u, sealed.F1_N)]
+    stopped = None
+    options = replace(cup.options, initial_step=1.0, max_step=1.0)      # one load step per move
+    while u - du_m > -cup.h1_m:
+        try:
+            step, dp, _ = cup.solve_water(step, dp, u, u - du_m, V_w, V_w, options)
+            check_state(cup.mesh, step.u, u - du_m, 0, u - du_m)    # no fold of the wall
+        except RuntimeError as err:                                 # StateRejected is one
+            stopped = str(err)
+            break
+        z = cup.mesh.doflocs[1, cup.cavity.nodes] + step.u[2 * cup.cavity.nodes + 1]
+        if not np.any(z <= cup.cavity.tolerance_m):           # the seal opened: not held
+            break
+        u -= du_m
+        seen.append((u, float(np.sum(step.r_int[2 * top + 1]))))
+        best = max(f for _, f in seen)
+        if best > 0 and seen[-1][1] < (1.0 - drop) * best:
+            break
+    us, F = np.array(seen).T
+    k = int(np.argmax(F))
+    partial = stopped if stopped is not None and k == F.size - 1 else None
+    if 0 < k < F.size - 1:
+        a, b, c = np.polyfit(us[k - 1:k + 2], F[k - 1:k + 2], 2)
+        if a < 0:
+            return float(max(F[k], c - b * b / (4 * a))), partial
+    return float(F[k]), partial
 
 
 class WaterWalk(_Walk):

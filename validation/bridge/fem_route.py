@@ -32,7 +32,7 @@ no cavitation). Pressed, the cup expels water (V_w follows V); sealed, V_w0 = V;
 seal opening. The inflow Q_w [m^3/s] is eq (24) ring by ring in series through each state's profile
 (`reduced.profile_leak.profile_liquid_rate`, the model's liquid viscosity), the solid pressure as
 for the gas; t = int dV_w / Q_w by the same trapezoid. The largest holdable force is the largest
-pull along the plate raised at fixed V_w0 (`largest_pull_water`).
+pull along the plate raised at fixed V_w0 (`fem.water_branch.largest_pull`).
 """
 
 from __future__ import annotations
@@ -215,6 +215,8 @@ class FemRoute:
         sealed = self.seal(model, options)
         kept = self._largest.get(id(sealed))
         if kept is None or kept[0] is not sealed:
+            from fem.water_branch import largest_pull as largest_pull_water
+
             largest = largest_pull_water if model.fluid == "water" else largest_pull_checked
             kept = self._largest[id(sealed)] = (sealed, *largest(sealed.cup, sealed.state))
         return kept[1], kept[2]
@@ -232,7 +234,7 @@ class FemRoute:
         water = model.fluid == "water"
         branch = (water_branch if water else equilibrium_branch)(
             sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
-            progress=_branch_progress(run.progress, force_N, sealed))
+            progress=_branch_progress(run.progress, force_N, sealed, "V_w" if water else "N"))
         largest, partial = self._largest_checked(model, options)
         s0 = sealed.state
         provenance = {"route": self.name, "options": {**options, "cup": options["cup"].describe(),
@@ -258,7 +260,8 @@ class FemRoute:
         N = np.array([s.N for s in states])
         columns = _columns(states, q, water)
         stats = branch.stats
-        details = {**base, **({"V_w_max_mm3": 1e9 * branch.N_max} if water else {"N_max": branch.N_max}), "states": len(states), "refined": added, "snaps": branch.snaps,
+        most = {"V_w_max_mm3": 1e9 * branch.N_max} if water else {"N_max": branch.N_max}
+        details = {**base, **most, "states": len(states), "refined": added, "snaps": branch.snaps,
                    "newton_iterations": stats.newton_iterations, "wall_time_s": stats.wall_time_s,
                    "seal_r_final_mm": 1e3 * states[-1].seal_r_m, "p_b_final_Pa": states[-1].p_b_Pa,
                    "u_final_mm": 1e3 * states[-1].u_m}
@@ -328,7 +331,8 @@ def refine_branch(cup: CupWithGas, states: list, q: list, force_N: float,
     return states, np.array(q), added
 
 
-def _branch_progress(report: Callable[[float, str], None] | None, force_N: float, sealed: Sealed):
+def _branch_progress(report: Callable[[float, str], None] | None, force_N: float, sealed: Sealed,
+                     content: str = "N"):
     """One progress line per branch state: the fraction is the plate's travel from the sealed
     position towards -h1 (the branch's end is not known before it is reached)."""
     if report is None:
@@ -338,7 +342,7 @@ def _branch_progress(report: Callable[[float, str], None] | None, force_N: float
 
     def on_state(k: int, u_m: float, N: float) -> None:
         report(0.1 + 0.85 * min(max((u0 - u_m) / (u0 + h1), 0.0), 1.0),
-               f"F1 = {force_N:g} N: branch state {k}, u = {1e3 * u_m:.3f} mm, N = {N / N0:.4g} N0")
+               f"F1 = {force_N:g} N: branch state {k}, u = {1e3 * u_m:.3f} mm, {content} = {N / N0:.4g} {content}0")
     return on_state
 
 
@@ -406,47 +410,6 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
     partial = stopped if stopped is not None and k == F.size - 1 else None
     if 0 < k < F.size - 1:
         a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
-        if a < 0:
-            return float(max(F[k], c - b * b / (4 * a))), partial
-    return float(F[k]), partial
-
-
-def largest_pull_water(cup, sealed, du_m: float = 0.1e-3, drop: float = 0.02) -> tuple[float, str | None]:
-    """The largest pull F1 [N] along the plate raised at the sealed state's V_w (`largest_pull`'s
-    water counterpart, `fem.water_cavity.CupWithWater.solve_water`): plate steps of du_m up to -h1
-    until F1 has fallen by `drop` of its maximum or the seal opens, the maximum refined by the
-    parabola through the three states around it; with the solver's message where it stopped
-    while the pull was still rising (a lower bound: the liquid under tension can pull the wall
-    until it folds onto itself, which the FEM does not model), else None."""
-    from fem.integrity import StateRejected, check_state
-    from fem.water_branch import cavity_pressure_difference
-
-    top = cup.cup.top
-    step, u, V_w = sealed.state, sealed.u_m, sealed.N
-    dp = cavity_pressure_difference(cup, step) if sealed.stage != "pressed" else 0.0
-    seen: list[tuple[float, float]] = [(u, sealed.F1_N)]
-    stopped = None
-    options = replace(cup.options, initial_step=1.0, max_step=1.0)      # one load step per move
-    while u - du_m > -cup.h1_m:
-        try:
-            step, dp, _ = cup.solve_water(step, dp, u, u - du_m, V_w, V_w, options)
-            check_state(cup.mesh, step.u, u - du_m, 0, u - du_m)    # no fold of the wall
-        except (RuntimeError, StateRejected) as err:
-            stopped = str(err)
-            break
-        z = cup.mesh.doflocs[1, cup.cavity.nodes] + step.u[2 * cup.cavity.nodes + 1]
-        if not np.any(z <= cup.cavity.tolerance_m):           # the seal opened: not held
-            break
-        u -= du_m
-        seen.append((u, float(np.sum(step.r_int[2 * top + 1]))))
-        best = max(f for _, f in seen)
-        if best > 0 and seen[-1][1] < (1.0 - drop) * best:
-            break
-    us, F = np.array(seen).T
-    k = int(np.argmax(F))
-    partial = stopped if stopped is not None and k == F.size - 1 else None
-    if 0 < k < F.size - 1:
-        a, b, c = np.polyfit(us[k - 1:k + 2], F[k - 1:k + 2], 2)
         if a < 0:
             return float(max(F[k], c - b * b / (4 * a))), partial
     return float(F[k]), partial
