@@ -20,7 +20,10 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
      table takes ~3 min (coarse) to ~8 min (medium) once per design and law.
    - fem: the cup's whole life in the FEM (`validation.bridge.fem_route`): pressed to r_start (or
      --press-u-mm, --press-force-N) with the gas escaping, sealed, held at F1 along its equilibrium
-     branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse).
+     branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse);
+     with --fluid water the cavity holds incompressible water that flows in by eq (24) (~10 s per
+     force, coarse; no cavitation: the water may go into tension).
+   --fluid water fills the cavity with water on the paper, profile and fem routes (eq 24).
    Another design (--geometry FILE) runs the same chain on its own geometry (`validation.bridge.design`).
    A curve of `cupcheck stiffness` (--stiffness CURVE.csv) replaces step 1: its design, contact law,
    mesh level and material are the example's; a --cup, --geometry, --contact, --friction or
@@ -34,8 +37,8 @@ Writes to DIR, atomically:
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
-  trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N, p_b, u, plate force, V, r_c,
-                          seal radius, r_out, leak rate)
+  trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N or the water volume V_w, p_b, u,
+                          plate force, V, r_c, seal radius, r_out, leak rate or water inflow)
   manifest.json           the files and the study (`validation.bridge.study.Study`) they were computed for
 """
 
