@@ -17,14 +17,14 @@ Lagrangian: at a multiplier estimate dp_lam the potential
 is added to W (`WaterMechanics`), with its exact tangent K + dp Hess(V) + c grad V grad V^T (the
 trapped gas's rank-one form, `fem.trapped_gas.GasTangent`, solved by Sherman-Morrison on the
 body's factor), so the solver stays an energy minimization with its line search and contact
-problem; then dp_lam <- dp (Uzawa) until c |V - V_w| is below UZAWA_TOL rtol max(p_a, |dp|) (or stalls
-below STALL times that, the solver's own resolution). Each update solves a
-state whose constraint is off by 1 / (1 + c s) of the last (s = dV/d(dp) of the cup), so with c
-AL_FACTOR p_a / V_w it takes two or three. The penalty c is the stiffness a gas would need at
-AL_FACTOR times the ambient pressure: it holds the wall where at fixed dp it would snap, as the
-gas does. A bordered Newton (dp an unknown beside u) would give the same states, but the solver's
-line search needs an energy, which the saddle point has not. A converged state is the exact
-constrained one: r + dp dV/du = 0 on the free dofs and V = V_w to that tolerance.
+problem; then dp_lam <- dp (Uzawa) until c |V - V_w| is below UZAWA_TOL rtol max(p_a, |dp|), or
+stalls below STALL times that (the solver's own resolution). Each update leaves 1 / (1 + c s) of
+the last constraint error (s = dV/d(dp), the cup's compliance), a few updates per state. The
+penalty c = AL_FACTOR p_a / V_w is the stiffness of a gas at AL_FACTOR times the ambient pressure:
+it holds the wall where at fixed dp it would snap, as the gas does, while a much stiffer one slows
+the Newton iteration's line search. A bordered Newton (dp an unknown beside u) would give the same
+states, but the solver's line search needs an energy, which the saddle point has not. A converged
+state is the constrained one: r + dp dV/du = 0 on the free dofs and V = V_w to that tolerance.
 
 The stages are those of `fem.gas_path.CupWithGas` (whose pressing, measuring and cost keeping
 this cup inherits): pressed with the cavity open (the water expelled, V_w = V, p_b = p_a), the
