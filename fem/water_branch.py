@@ -129,14 +129,15 @@ def largest_pull(cup: CupWithWater, sealed: WaterState, du_m: float = 0.1e-3,
                  drop: float = 0.02) -> tuple[float, str | None]:
     """The largest pull F1 [N] along the plate raised at the sealed state's V_w, and the solver's
     message where it stopped while the pull was still rising (a lower bound: the liquid under
-    tension pulls the wall until it folds onto itself, which the FEM does not model), else None.
+    tension pulls the wall until it folds onto itself, which the FEM does not model, or the plate
+    reaches -h1), else None.
     Plate steps of du_m up to -h1, each ending on the constraint (`CupWithWater.solve_water`),
     until F1 has fallen by `drop` of its maximum or the seal opens; the maximum refined by the
     parabola through the three states around it."""
     top = cup.cup.top
     step, u, V_w, dp = sealed.state, sealed.u_m, sealed.V_w_m3, sealed.dp_Pa
     seen: list[tuple[float, float]] = [(u, sealed.F1_N)]
-    stopped = None
+    stopped, opened = None, False
     options = replace(cup.options, initial_step=1.0, max_step=1.0)      # one load step per move
     while u - du_m > -cup.h1_m:
         try:
@@ -147,6 +148,7 @@ def largest_pull(cup: CupWithWater, sealed: WaterState, du_m: float = 0.1e-3,
             break
         z = cup.mesh.doflocs[1, cup.cavity.nodes] + step.u[2 * cup.cavity.nodes + 1]
         if not np.any(z <= cup.cavity.tolerance_m):           # the seal opened: not held
+            opened = True
             break
         u -= du_m
         seen.append((u, float(np.sum(step.r_int[2 * top + 1]))))
@@ -155,7 +157,9 @@ def largest_pull(cup: CupWithWater, sealed: WaterState, du_m: float = 0.1e-3,
             break
     us, F = np.array(seen).T
     k = int(np.argmax(F))
-    partial = stopped if stopped is not None and k == F.size - 1 else None
+    partial = None
+    if k == F.size - 1 and not opened:          # still rising where the path ended
+        partial = stopped or f"the pull still rising at u = {1e3 * us[-1]:.4g} mm, the plate's end (-h1)"
     if 0 < k < F.size - 1:
         a, b, c = np.polyfit(us[k - 1:k + 2], F[k - 1:k + 2], 2)
         if a < 0:
