@@ -14,7 +14,7 @@ from fem.gas_path import CupWithGas
 from fem.material import NeoHookean
 from fem.mesh import cup_mesh
 from fem.suction import suction_grid
-from fem.water_branch import cavity_pressure_difference, pull_sensitivities, water_branch
+from fem.water_branch import cavity_pressure_difference, largest_pull, pull_sensitivities, water_branch
 from fem.water_cavity import CupWithWater, WaterMechanics
 
 RTOL = 1e-9      # tight solver tolerance: states compared across two paths to ~1e-6
@@ -157,3 +157,18 @@ def test_bad_input_is_refused(mesh):
         CupWithWater.of(mesh, NeoHookean(), p_a_Pa=0.0)
     with pytest.raises(TypeError, match="CupWithWater"):
         water_branch(CupWithGas.of(mesh, NeoHookean()), pressed, 10.0)
+
+
+def test_water_holds_a_larger_pull_than_the_gas_sealed_alike(mesh, path):
+    """Raised at a fixed content from the same pressed state, the gas expands (p_b >= 0: the pull
+    is bounded by the ambient pressure on the seal) while the water goes into tension: the largest
+    pull held in water exceeds the gas's, and exceeds p_a pi r_k^2 of the sealed state."""
+    from validation.bridge.fem_route import largest_pull_checked
+
+    cup, pressed, _, _ = path
+    water, why = largest_pull(cup, pressed[-1])
+    gas_cup = CupWithGas.of(mesh, NeoHookean(), rtol=RTOL)
+    sealed = gas_cup.press(3e-3)[-1]
+    gas, _ = largest_pull_checked(gas_cup, sealed)
+    assert water > gas > 0.0
+    assert water > cup.p_a_Pa * np.pi * pressed[-1].seal_r_m**2
