@@ -19,7 +19,8 @@ trapped gas's rank-one form, `fem.trapped_gas.GasTangent`, solved by Sherman-Mor
 body's factor), so the solver stays an energy minimization with its line search and contact
 problem; then dp_lam <- dp (Uzawa) until c |V - V_w| is below UZAWA_TOL rtol max(p_a, |dp|), or
 stalls below STALL times that (the solver's own resolution). Each update leaves 1 / (1 + c s) of
-the last constraint error (s = dV/d(dp), the cup's compliance), a few updates per state. The
+the last constraint error (s = dV/d(dp), the cup's compliance), so from the second update on
+the multiplier goes to the limit of their geometric series (Aitken): two or three per state. The
 penalty c = AL_FACTOR p_a / V_w is the stiffness of a gas at AL_FACTOR times the ambient pressure:
 it holds the wall where at fixed dp it would snap, as the gas does, while a much stiffer one slows
 the Newton iteration's line search. A bordered Newton (dp an unknown beside u) would give the same
@@ -238,12 +239,15 @@ class CupWithWater(CupWithGas):
         before = math.inf
         for _ in range(UZAWA_MAX):
             dp = end.dp_Pa(last[-1].u)
-            update = abs(dp - end.dp_lam_Pa)
+            delta = dp - end.dp_lam_Pa
+            update = abs(delta)
             tol = UZAWA_TOL * options.rtol * max(self.p_a_Pa, abs(dp))
             if update <= tol or (update <= STALL * tol and update > 0.5 * before):
                 return last[-1], dp, stats
-            before = update
-            end = replace(end, dp_lam_Pa=dp)
+            rho = delta / before_signed if math.isfinite(before) else 0.0
+            before, before_signed = update, delta
+            # the updates shrink geometrically (ratio rho): go to their limit (Aitken)
+            end = replace(end, dp_lam_Pa=dp + (delta * rho / (1.0 - rho) if 0.0 < rho < 0.5 else 0.0))
             more = follow_path(end, self._line(u1_m, u1_m), 1.0, plane=plane, start=last[-1],
                                options=fixed, on_step=last.append)
             stats = _joined(stats, more)
