@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -63,8 +64,10 @@ HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.8
 FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 #: the study's fields `example` spells as flags (`validation.study_schema`; contact: `contact_choice`)
 KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "cup.l0_mm", "cup.l1_mm", "stiffness.route",
-        "loads.r_start_mm", "stiffness.fidelity", "surface.preset", "surface.uc_table", "loads.press_u_mm",
-        "loads.press_force_N", "stiffness.du_mm")
+        "loads.r_start_mm", "stiffness.fidelity", "stiffness.u_max_mm", "surface.preset", "surface.uc_table",
+        "loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm")
+#: exit status of a run whose FEM curve is the converged part of a failed path (as `cupcheck stiffness`)
+PARTIAL_EXIT = 3
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -80,9 +83,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                           "lifetimes on soap-cleaned surfaces, Sec. 5.3-5.5; sticking is Appendix A's "
                           "no-slip bound, whose contact-pressure profile is singular at the stick "
                           "edges and not mesh-converged")
-    add_flags(p, ("stiffness.fidelity",), helps={
+    add_flags(p, ("stiffness.fidelity", "stiffness.u_max_mm"), helps={
         "stiffness.fidelity": "FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
-                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)"})
+                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)",
+        "stiffness.u_max_mm": "the FEM curve's largest plate displacement u [mm], in (0, h1] (default: 0.9 h1); "
+                              "a path that fails before it keeps its converged part (exit status 3)"})
     c = p.add_argument_group("coupled route")
     c.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
                    help="the design's table from `cupcheck suction` (default: built at --fidelity "
@@ -105,12 +110,15 @@ def _inputs(args: argparse.Namespace, geometry=None):
 
     from validation.guards import check_design, check_uc_table
 
+    from validation.study_schema import check_u_max
+
     contact = None
     if geometry is None:
         design = load_cup_design(args)
         contact = contact_choice(args, design)
         geometry = design.geometry
     check_design(geometry.describe(), args.allow_unusual_design, source=geometry.name)
+    check_u_max(args.u_max_mm, geometry, "cli")
     if args.uc_table is not None:
         if not os.path.isfile(args.uc_table):
             raise ValueError(f"uc-table: no such file {args.uc_table!r}")
@@ -124,20 +132,26 @@ def _inputs(args: argparse.Namespace, geometry=None):
     return geometry, contact, name
 
 
-def write_table(results, path: Path, cup: str, study: Study) -> None:
-    """The lifetimes, one row per force: the cup, what they were computed for (`Study.record`), the outcome."""
+def write_table(results, path: Path, cup: str, study: Study, partial: dict[str, Any] | None = None) -> None:
+    """The lifetimes, one row per force: the cup, what they were computed for (`Study.record`), the
+    outcome; on a partial curve (`Products.partial`) a refused force's row has the reason
+    beyond_partial_curve and blank values, and every row says where the curve ends."""
     from validation.output import write_table as write_csv
 
     route = study.route
-    s = [r.summary() for r in results]
+    refused = {r["force_N"] for r in (partial or {}).get("refused", [])}
+    s = {r.force_N: r.summary() for r in results}
+    forces = [f for f in study.loads.forces_N if f in s or f in refused]
+    rows = [s.get(f, {"lifetime_s": "", "reason": "beyond_partial_curve"}) for f in forces]
     own = {"coupled": ("u_final_mm",), "fem": ("u_final_mm", "seal_r_final_mm")}.get(
         route, ("ballistic_share", "r_final_mm"))
     largest = {"largest_force_N": results.largest_force_N} if route == "fem" else {}
     record = {k: v for k, v in study.record().items() if k not in ("design", "route")}
-    write_csv(path, {"cup": cup, "route": route, **record, "force_N": [r.force_N for r in results],
-                     "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in s],
-                     "reason": [r.reason for r in results], **largest,
-                     **{key: [_blank(x.get(key)) for x in s] for key in (*own, "p_b_final_Pa")}},
+    ends = {"curve_partial_to_u_mm": partial["u_max_mm_that_runs"]} if partial else {}
+    write_csv(path, {"cup": cup, "route": route, **record, "force_N": forces,
+                     "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in rows],
+                     "reason": [x["reason"] for x in rows], **largest,
+                     **{key: [_blank(x.get(key)) for x in rows] for key in (*own, "p_b_final_Pa")}, **ends},
               stage="example lifetimes")
 
 
@@ -214,6 +228,9 @@ def _curve_inputs(args: argparse.Namespace) -> tuple[Any, ContactChoice, dict[st
     if args.friction is not None and (law.law != "coulomb" or args.friction != law.friction):
         raise ValueError(f"--friction: {label} was computed with {was} contact; drop --friction")
     fidelity = prov.get("fidelity")
+    if args.u_max_mm is not None:
+        raise ValueError(f"--u-max-mm: {label} ends where its FEM run ended; drop --u-max-mm or derive a curve "
+                         f"with `cupcheck stiffness --u-max-mm`")
     if args.fidelity is not None and fidelity is not None and args.fidelity != fidelity:
         raise ValueError(f"--fidelity: {label} was computed at the {fidelity} level; drop --fidelity "
                          f"{args.fidelity} or derive a curve at that level")
@@ -316,9 +333,9 @@ def run(args: argparse.Namespace) -> int:
     if curve_study is not None:
         study = replace(study, **curve_study)
     products = Products(study, suction_cache_dir=None if args.no_cache else args.cache_dir,
-                        fem_progress=terminal_progress("FEM"))
+                        fem_progress=terminal_progress("FEM"), keep_partial=True)
     from fem.solver import ConvergenceError
-    from validation.commands._failure import solver_failure
+    from validation.commands._failure import failure_record, solver_failure
 
     with atomic_directory(args.out) as tmp:
         try:
@@ -342,13 +359,17 @@ def run(args: argparse.Namespace) -> int:
             series["FEM F0, paper route (strip, eqs 3-7)"] = products.derived(
                 paper, inherit=("uc_table", "curve", "cup")).lifetimes()
         series["Appendix A-fed, paper route (d0 2 mm)"] = products.appendix_a(refine=1).lifetimes()
-        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, study)
+        partial = products.partial()
+        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, study, partial)
         if args.route == "fem":
             _write_trajectories(results, tmp, choice.cup.name)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
              f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
-        _write_manifest(tmp, study)
+        _write_manifest(tmp, study, partial)
     wall = time.perf_counter() - t0
+    failure = Path(f"{Path(args.out)}.failure.json")
+    if partial is not None and response is not None:   # after the directory, which removed an earlier record
+        failure_record(products.path_stop().error, failure)
     slope = float(curve.force(curve.h1_m - 1e-3))
     patch = getattr(products.uc_table(), "patch_length_m", None)
     crossed = {"profile": "the FEM's contact-pressure profiles" + (f", averaged over patches of {1e6 * patch:.0f} um"
@@ -359,31 +380,47 @@ def run(args: argparse.Namespace) -> int:
                       f"(largest holdable force {holdable:.4g} N)",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
                                                             if laws == "cone" else "")}[_seal(args.route)]
+    end = "0.9 h1" if study.u_max_mm is None and partial is None else f"{1e3 * curve.u_m[-1]:.4g} mm"
     print(f"{choice.label}: FEM {contact.contact.label()} stiffness (from the "
           f"{contact.source}; {args.fidelity}, {_steps(response, curve)} steps), "
-          f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
+          f"F0(1 mm) = {slope:.3g} N, F0({end}) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
           f"{_rv_source(args.route, laws)}; {args.route} route: the leak "
           f"crosses {crossed}")
     names = list(series)
     print(f"  {'F1 (N)':>7} " + " ".join(f"{n.split(',')[0] + ', ' + n.split(', ')[1].split(' ')[0]:>24}"
                                          for n in names) + "  end")
-    for i, r in enumerate(results):
-        print(f"  {r.force_N:7g} " + " ".join(f"{series[n][i].lifetime_s:24.4g}" for n in names) + f"  {r.reason}")
+    at = [{r.force_N: r for r in series[n]} for n in names]
+    for r in results:
+        print(f"  {r.force_N:7g} " + " ".join(f"{s[r.force_N].lifetime_s:24.4g}" if r.force_N in s else f"{'':>24}"
+                                              for s in at) + f"  {r.reason}")
     extra = {"coupled": ", suction_table.json", "fem": ", trajectory_F1_*.csv"}.get(args.route, "")
     print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
           f"{extra} in {wall:.1f} s")
-    return 0
+    if partial is None:
+        return 0
+    if response is None:                                # a given partial curve: used within its range
+        from validation.bridge.pipeline import partial_note
+        refused = ", ".join(f"{r['force_N']:g}" for r in partial["refused"])
+        print(f"note: --stiffness '{args.stiffness}' is {partial_note(curve.provenance)}; used within that range"
+              + (f"; lifetimes refused at F1 = {refused} N, beyond the curve" if refused else ""), file=sys.stderr)
+        return 0
+    from validation.scenes.outputs import partial_lines
+    for line in partial_lines({"study": partial}, "cli"):
+        print(f"cupcheck example: {line}; the record is in {failure}", file=sys.stderr)
+    return PARTIAL_EXIT
 
 
-def _write_manifest(tmp: Path, study: Study) -> None:
-    """manifest.json: the files written and the study they were computed for."""
+def _write_manifest(tmp: Path, study: Study, partial: dict[str, Any] | None = None) -> None:
+    """manifest.json: the files written, the study they were computed for and, for a partial FEM
+    curve, its record (`Products.partial`)."""
     import json
 
     from validation.output import MANIFEST, software_versions
 
     files = sorted(p.name for p in tmp.iterdir() if p.is_file())
     (tmp / MANIFEST).write_text(json.dumps({"files": [{"path": f} for f in files], "study": study.describe(),
+                                            **({"partial": partial} if partial else {}),
                                             "versions": software_versions()}, indent=1, default=str) + "\n")
 
 
