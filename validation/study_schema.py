@@ -135,8 +135,9 @@ FIELDS: tuple[Field, ...] = (
     Field("stiffness.fidelity", "fidelity", "choice", "coarse", "FEM mesh level", choices=_LEVELS,
           sweep="fidelity", flag="--fidelity", spelled={"cli": {"default": None}}),
     Field("stiffness.u_max_mm", "u_max_mm", "number", None, "the FEM stiffness curve's end: the largest plate "
-          "displacement u [mm], in (0, h1] (default: 0.9 h1; at h1 the plate edge reaches the plane); a path "
-          "that fails before it keeps its converged part, flagged partial, and names the u_max that runs",
+          "displacement u [mm], in (0, h1] (default: 0.9 h1; at h1 the plate edge reaches the plane); in a scene "
+          "or `cupcheck example` a path that fails before it keeps its converged part, flagged partial (exit "
+          "status 3, naming the u_max that runs); in a sweep such a design is a failed row",
           unit="mm", positive=True, guard="plate_travel", sweep="u_max_mm", flag="--u-max-mm"),
     Field("stiffness.du_mm", "loads.du_mm", "number", 0.25, "route fem: the plate step [mm] along the cup's "
           "equilibrium branch", unit="mm", positive=True, flag="--du-mm"),
