@@ -52,6 +52,7 @@ from typing import TYPE_CHECKING, Any
 from validation.bridge.cache import user_cache_dir
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
                                       contact_choice, cup_laws, load_cup_design)
+from validation.commands._example_inputs import check_suction_table, curve_inputs
 from validation.study_schema import add_flags, check_route, field_of, parse, values_from_args
 
 if TYPE_CHECKING:
@@ -201,83 +202,11 @@ def check_fields(args: argparse.Namespace) -> None:
     check_route(values, given, "cli")
 
 
-def _curve_inputs(args: argparse.Namespace) -> tuple[Any, ContactChoice, dict[str, Any]]:
-    """(the FEM geometry, the contact law, the Study's fields) of a --stiffness curve: the design,
-    law, mesh level and material its sidecar records. An option that contradicts them, or a curve
-    that names no FEM design or law, is refused (ValueError naming the option)."""
-    from fem.design_file import geometry_from_mapping
-    from fem.interface import ContactChoice, ContactLaw
-    from reduced.stiffness_curve import StiffnessCurve
-    from validation.bridge.design import preset_design, resolve_cup, shape_of
-    from validation.bridge.study import CupDesign, Material
-
-    path = Path(args.stiffness)
-    if not path.is_file():
-        raise ValueError(f"--stiffness: no such file '{path}'")
-    curve = StiffnessCurve.from_csv(path)
-    shape, law, prov = curve.design, curve.contact, curve.provenance
-    if shape is None or law is None or not isinstance(prov.get("material"), dict):
-        raise ValueError(f"--stiffness: '{path.name}' records no FEM design, contact law or material (a measured "
-                         f"or Appendix A curve); give --cup or --geometry and the example computes the FEM curve")
-    label = f"the stiffness curve '{path.name}'"
-    resolve_cup(curve, cup=args.cup, geometry_file=args.geometry, curve_label=label, laws="curve")
-    was = law.law + (f" mu = {law.friction:g}" if law.law == "coulomb" else "")
-    if args.contact is not None and args.contact != law.law:
-        raise ValueError(f"--contact: {label} was computed with {was} contact; drop --contact {args.contact} "
-                         f"(the curve's law is used) or derive a {args.contact} curve")
-    if args.friction is not None and (law.law != "coulomb" or args.friction != law.friction):
-        raise ValueError(f"--friction: {label} was computed with {was} contact; drop --friction")
-    fidelity = prov.get("fidelity")
-    if args.u_max_mm is not None:
-        raise ValueError(f"--u-max-mm: {label} ends where its FEM run ended; drop --u-max-mm or derive a curve "
-                         f"with `cupcheck stiffness --u-max-mm`")
-    if args.fidelity is not None and fidelity is not None and args.fidelity != fidelity:
-        raise ValueError(f"--fidelity: {label} was computed at the {fidelity} level; drop --fidelity "
-                         f"{args.fidelity} or derive a curve at that level")
-    args.fidelity = args.fidelity or fidelity
-    preset = next((name for name in ("A", "B") if shape.same_cup(preset_design(name))), None)
-    record = prov["geometry"]                           # the wall as written, its thickness profile included
-    data = {k: record[k] for k in ("name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention") if k in record}
-    thickness = record.get("thickness_profile", {})
-    if thickness.get("kind") in ("linear", "table"):
-        data["thickness"] = {"r_mm": thickness["r_mm"], "d_mm": thickness["d_mm"]}
-    geometry = geometry_from_mapping(data, source=path.name)
-    if not shape_of(geometry).same_cup(shape):
-        raise ValueError(f"--stiffness: {label} records a wall this example cannot rebuild; give --geometry")
-    contact = ContactChoice(ContactLaw(law.law, law.friction),
-                            f"stiffness curve {path.name}" + (f", from its {law.source}" if law.source else ""))
-    material = Material(E_MPa=prov["material"]["E_Pa"] / 1e6, nu=prov["material"]["nu"])
-    design = CupDesign(preset=preset) if preset else CupDesign(preset=args.cup or "A", geometry=geometry)
-    return geometry, contact, {"design": replace(design, l0_mm=args.l0_mm, l1_mm=args.l1_mm),
-                               "material": material, "stiffness_file": str(path)}
-
-
 def _steps(response, curve) -> Any:
     """The FEM path's load steps: the run's, or those a given curve's sidecar records."""
     if response is not None:
         return response.stats.steps
     return curve.provenance.get("solver", {}).get("steps", len(curve.u_m) - 1)
-
-
-def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
-    """--suction-table: only with the coupled route, an existing table of this very design."""
-    if args.suction_table is None:
-        return
-    if args.route != "coupled":
-        raise ValueError("--suction-table: applies to --route coupled only")
-    from reduced.suction_table import SuctionTable
-    if not Path(args.suction_table).is_file():
-        raise ValueError(f"--suction-table: no such file '{args.suction_table}'")
-    prov = SuctionTable.from_json(args.suction_table).provenance
-    if prov.get("geometry") != geometry.describe():
-        raise ValueError(f"--suction-table: '{args.suction_table}' was built for another design than "
-                         f"{geometry.name}; build it with `cupcheck suction` on the same --cup/--geometry")
-    law = contact.contact
-    built = (prov.get("contact"), float(prov.get("friction", 0.0)))
-    if built != (law.law, law.friction):
-        raise ValueError(f"--suction-table: '{args.suction_table}' was built with {built[0]} contact"
-                         f"{f' mu = {built[1]:g}' if built[0] == 'coulomb' else ''}, the example runs "
-                         f"{law.label()}; give the same --contact (and --friction)")
 
 
 def plot(series: dict, curve, cup, path: Path, title: str) -> None:
@@ -319,7 +248,7 @@ def run(args: argparse.Namespace) -> int:
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     given = curve_study = None
     if args.stiffness is not None:
-        given = _curve_inputs(args)                    # the curve's design, law, level, material
+        given = curve_inputs(args)                    # the curve's design, law, level, material
         geometry, contact, curve_study = given
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     laws = cup_laws(args, coupled=True, fem=True)
@@ -328,7 +257,7 @@ def run(args: argparse.Namespace) -> int:
         geometry, contact, uc_label = _inputs(args)
     else:
         uc_label = _inputs(args, geometry)[2]
-    _check_suction_table(args, geometry, contact)
+    check_suction_table(args, geometry, contact)
     study = study_of(args, contact)
     if curve_study is not None:
         study = replace(study, **curve_study)

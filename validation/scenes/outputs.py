@@ -95,13 +95,13 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
             if progress is not None:
                 progress(f"output {k + 1} of {n}: {o['name']}")
             _write(o, products, None)
-        return SceneResult(scene, products.computed(), [], dict(products.timings), partial=partial_records(products))
+        return SceneResult(scene, products.computed(), [], _timings(products), partial=partial_records(products))
 
     out = Path(out)
     made = [made_from(o, study) for o in scene.outputs]
     previous = _manifest(out) if reuse else None
     intact = [_intact_files(o, m["key"], previous, out) for o, m in zip(scene.outputs, made)]
-    if previous is not None and _up_to_date(previous, scene, intact):
+    if previous is not None and _up_to_date(previous, scene, intact, out):
         files = [{**f, "path": str(out / f["path"])} for kept in intact for f in kept]
         return SceneResult(scene, {}, files, {}, kept=list(files), up_to_date=True,
                            partial=previous.get("partial") or {})
@@ -123,11 +123,21 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
         manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
                     "scene": scene.resolved(), "source": scene.source, **({"partial": partial} if partial else {}),
                     "versions": software_versions(),
-                    "timings_s": {**products.timings, "total": time.perf_counter() - t0}}
+                    "timings_s": {**_timings(products), "total": time.perf_counter() - t0}}
         (Path(tmp) / MANIFEST).write_text(json.dumps(manifest, indent=1, default=str) + "\n")
     rename = lambda f: {**f, "path": str(out / Path(f["path"]).name)}    # noqa: E731
-    return SceneResult(scene, products.computed(), [rename(f) for f in files], dict(products.timings),
+    return SceneResult(scene, products.computed(), [rename(f) for f in files], _timings(products),
                        kept=[rename(f) for f in kept], partial=partial)
+
+
+def _timings(products: Products) -> dict[str, float]:
+    """The time [s] of each product computed, a swept value's own as "<value>: <product>" (the
+    sweep's "variants" only gathers them)."""
+    timings = {k: v for k, v in products.timings.items() if k != "variants"}
+    if "variants" in products.computed():
+        for value, p in products.variants():
+            timings.update({f"{value}: {k}": v for k, v in p.timings.items()})
+    return timings
 
 
 def partial_records(products: Products) -> dict[str, dict[str, Any]]:
@@ -189,10 +199,13 @@ def _same_bytes(directory: Path, entry: Mapping[str, Any]) -> bool:
     return path.is_file() and not path.is_symlink() and file_digest(path) == digest
 
 
-def _up_to_date(manifest: dict, scene: Scene, intact: list[list[dict]]) -> bool:
-    """Every output intact, the manifest lists no other file and records this very scene: nothing to write."""
+def _up_to_date(manifest: dict, scene: Scene, intact: list[list[dict]], out: Path) -> bool:
+    """Every output intact, the manifest lists no other file, `out` holds no file it does not list
+    and it records this very scene: nothing to write."""
     if not all(intact) or sum(map(len, intact)) != len(manifest["files"]):
         return False
+    if {p.name for p in out.iterdir()} != {f["path"] for f in manifest["files"]} | {MANIFEST}:
+        return False                       # a file the manifest does not list: the rerun replaces the directory
     resolved = json.loads(json.dumps(scene.resolved(), default=str))
     return manifest.get("scene") == resolved and manifest.get("source") == scene.source
 
