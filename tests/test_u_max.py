@@ -85,6 +85,15 @@ def test_a_sweep_carries_u_max_to_its_designs_and_keeps_old_design_hashes():
     assert study_of(design, geometry_of(design)).u_max_mm == 5.0
 
 
+def test_a_warm_rerun_redraws_the_curve_and_tables_of_another_u_max_only():
+    from validation.scenes.outputs import made_from
+
+    scene = {"outputs": [{"kind": "curve"}, {"kind": "lifetimes"}, {"kind": "render", "u_mm": 2}]}
+    plain, ended = (scene_from_mapping({**scene, **extra}) for extra in ({}, {"stiffness": {"u_max_mm": 5}}))
+    keys = [[made_from(o, s.study())["key"] for o in s.outputs] for s in (plain, ended)]
+    assert keys[0][:2] != keys[1][:2] and keys[0][2] == keys[1][2]      # the render ends at its own u
+
+
 # ------------------------------------------------------------------ real runs
 def test_example_keeps_a_late_failures_converged_part_and_names_the_u_max_that_runs(tmp_path, capsys):
     out, record = tmp_path / "ex", tmp_path / "ex.failure.json"

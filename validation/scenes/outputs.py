@@ -35,7 +35,7 @@ __all__ = ["run_scene", "SceneResult", "made_from", "partial_records", "partial_
 #: the manifest's name in a scene's output directory
 MANIFEST = "manifest.json"
 #: what an FEM state (render, footprint, squeeze) is made from; an FEM curve adds the stiffness
-#: source; every other output (tables, figures) depends on the whole study
+#: source and its end (u_max); every other output (tables, figures) depends on the whole study
 _FEM_PARTS = ("design", "material", "contact", "fidelity")
 
 
@@ -65,7 +65,7 @@ def made_from(output: Mapping[str, Any], study: Study) -> dict[str, Any]:
     if output["kind"] in STATE_KINDS:
         parts = _FEM_PARTS
     elif output["kind"] == "curve" and study.stiffness == "fem":
-        parts = (*_FEM_PARTS, "stiffness")
+        parts = (*_FEM_PARTS, "stiffness", "u_max_mm")
     else:
         parts = tuple(record)
     sources = source_hash("fem", "reduced", "validation")
