@@ -32,11 +32,18 @@ Writes to DIR, atomically:
                           ballistic_share, r_final_mm (paper, profile) or u_final_mm (coupled), and
                           p_b_final_Pa
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
+  lifetime_vs_force_data.csv  what the figure draws, point by point (series, quantities, x, y)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
   trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N, p_b, u, plate force, V, r_c,
                           seal radius, r_out, leak rate)
   manifest.json           the files and the study (`validation.bridge.study.Study`) they were computed for
+
+An FEM path that fails after some converged steps (before --u-max-mm, default 0.9 h1) keeps them,
+as in `cupcheck stiffness`: the curve is its converged part, flagged partial (its sidecar, a
+curve_partial_to_u_mm column, the manifest's "partial"); a force whose lifetime needs a state beyond
+it is refused (reason beyond_partial_curve), the others computed; one line names the --u-max-mm
+that runs, the record goes to DIR.failure.json, and the exit status is 3.
 """
 
 from __future__ import annotations
@@ -209,9 +216,10 @@ def _steps(response, curve) -> Any:
     return curve.provenance.get("solver", {}).get("steps", len(curve.u_m) - 1)
 
 
-def plot(series: dict, curve, cup, path: Path, title: str) -> None:
+def plot(series: dict, curve, cup, path: Path, title: str, table: Path | None = None) -> None:
     """Lifetime against F1 per series and the FEM's F0(u) beside Appendix A's, in the toolkit's
-    style; `title` names the design, contact law, mesh level, route and surface."""
+    style; `title` names the design, contact law, mesh level, route and surface; `table`: what
+    is drawn, point by point (`validation.scenes.figures.figure_table`)."""
     import matplotlib.pyplot as plt
 
     from reduced.appendix_a import appendix_a_force
@@ -233,6 +241,9 @@ def plot(series: dict, curve, cup, path: Path, title: str) -> None:
                    label="Appendix A")
         ax[1].set(xlabel="plate displacement u (mm)", ylabel="stiffness force $F_0$ (N)")
         ax[1].legend(fontsize=6)
+        if table is not None:
+            from validation.scenes.figures import write_figure_table
+            write_figure_table(fig, table, title)
         save_figure(fig, path)
 
 
@@ -293,7 +304,8 @@ def run(args: argparse.Namespace) -> int:
         if args.route == "fem":
             _write_trajectories(results, tmp, choice.cup.name)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
-             f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
+             f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}",
+             tmp / "lifetime_vs_force_data.csv")
         _write_manifest(tmp, study, partial)
     wall = time.perf_counter() - t0
     failure = Path(f"{Path(args.out)}.failure.json")
@@ -324,7 +336,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {r.force_N:7g} " + " ".join(f"{s[r.force_N].lifetime_s:24.4g}" if r.force_N in s else f"{'':>24}"
                                               for s in at) + f"  {r.reason}")
     extra = {"coupled": ", suction_table.json", "fem": ", trajectory_F1_*.csv"}.get(args.route, "")
-    print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
+    print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png (its data: "
+          f"lifetime_vs_force_data.csv), stiffness_fem.csv"
           f"{extra} in {wall:.1f} s")
     if partial is None:
         return 0

@@ -257,13 +257,14 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
         return write_view(output, products, tmp)
     from validation.scenes.figures import draw
     paths = [] if tmp is None else [tmp / f"{name}.{suffix}" for suffix in ("svg", "png")]
-    draw(output["figure"], products, paths)
-    return [_file(name, "figure", path) for path in reversed(paths)]
+    table = None if tmp is None else tmp / f"{name}_data.csv"
+    draw(output["figure"], products, paths, table)
+    return [_file(name, "figure", path) for path in (*reversed(paths), *([table] if table else []))]
 
 
 #: the files of each output kind, by suffix (as `_write` and `write_view` name them)
-_SUFFIXES = {"curve": (".csv", ".json"), "lifetimes": (".csv",), "figure": (".png", ".svg"), "render": (".png",),
-             "footprint": (".png", ".json"), "squeeze": (".gif",)}
+_SUFFIXES = {"curve": (".csv", ".json"), "lifetimes": (".csv",), "figure": (".png", ".svg", "_data.csv"),
+             "render": (".png",), "footprint": (".png", ".json"), "squeeze": (".gif",)}
 
 
 def planned_files(scene: Scene) -> dict[str, list[str]]:

@@ -58,7 +58,8 @@ MEANING: dict[str, str] = {
                       "(render, footprint, squeeze: drawn from FEM states at u_mm)",
     "outputs[].name": "file stem (default: the figure's name, else the kind)",
     "outputs[].figure": "with kind = \"figure\": which figure (lifetime_vs_parameter needs [sweep]; "
-                        "uc_vs_pressure and F0_vs_u draw one line per swept surface or cup)",
+                        "uc_vs_pressure and F0_vs_u draw one line per swept surface or cup); written as "
+                        "PNG and SVG, and what it draws, point by point, as <name>_data.csv",
     "outputs[].u_mm": "with render, footprint, squeeze (and only them): the plate displacement shown [mm]",
     "outputs[].field": "with render, squeeze: the colouring",
     "outputs[].frames": "with squeeze: the number of frames from u = 0 to u_mm",
