@@ -80,10 +80,11 @@ for argv in json.loads(sys.argv[1]):
     w, c = time.perf_counter(), time.process_time()
     with contextlib.redirect_stdout(io.StringIO()):
         try:
-            main(argv)
+            status = main(argv)
         except SystemExit as exc:
-            if exc.code not in (0, None):
-                raise
+            status = exc.code
+    if status not in (0, None):
+        raise SystemExit(f"cupcheck {' '.join(argv)}: exit status {status}")
     times.append((time.perf_counter() - w, time.process_time() - c))
 print(json.dumps(times))
 """
