@@ -49,6 +49,23 @@ def test_quad9_meshes_are_condensed_with_a_narrower_band(system):
     assert isinstance(make_solver(K_tri, tri.doflocs, tri), BandedCholesky)
 
 
+def test_a_mesh_keeps_its_solver_while_its_pattern_and_nodes_are_the_same(system):
+    """make_solver on the same mesh, pattern and coordinates returns the solver it built, whose
+    factor solves like a new solver's to the last bit; moved nodes or another pattern build anew."""
+    mesh, K, free, du_fixed, _, rng = system
+    solver = make_solver(K, mesh.doflocs, mesh)
+    assert make_solver(K.copy(), mesh.doflocs.copy(), mesh) is solver
+    fresh = CondensedCholesky(K, mesh.doflocs, mesh, interior_nodes(mesh, K))
+    rhs = rng.normal(size=K.shape[0])
+    assert np.array_equal(solver.factor(K, free).solve(rhs, du_fixed), fresh.factor(K, free).solve(rhs, du_fixed))
+    assert make_solver(K, mesh.doflocs * 1.01, mesh) is not solver
+    assert make_solver(K, mesh.doflocs, mesh) is not solver            # the last call's is kept
+    n = K.shape[0]
+    other = sp.csr_matrix(K + sp.coo_matrix(([1.0, 1.0], ([0, n - 1], [n - 1, 0])), shape=K.shape))
+    assert other.nnz == K.nnz + 2                                      # one more coupling
+    assert make_solver(other, mesh.doflocs, mesh) is not make_solver(K, mesh.doflocs, mesh)
+
+
 @pytest.mark.parametrize("shift", [0.0, 1e-3])
 def test_condensed_solve_equals_the_full_factorization(system, shift):
     mesh, K, free, du_fixed, _, rng = system
