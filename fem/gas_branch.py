@@ -54,10 +54,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from .gas_path import CupWithGas, GasState
 from .solver import SolverStats, StepResult
-from .condensation import free_block_solver
 from .cup import _joined
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
@@ -98,9 +98,8 @@ def pull_sensitivities(cup: CupWithGas, s: GasState) -> tuple[float, float]:
     full tangent K + dp Hess V + (N k_B T / V^2) grad V grad V^T on the free dofs and the state's
     held contact dofs fixed (its contact set kept). F1 is the plate's reaction (`fem.gas_path`).
     Coulomb's sliding nodes keep t = -mu lambda s: their radial row gains mu s times their normal
-    row (the reaction lambda changes with the state). The matrix is factored by the mesh's
-    banded Cholesky where it is symmetric and definite, else by sparse LU (it need not be either
-    where the gas alone holds the wall; `fem.condensation.free_block_solver`), the rank-one term
+    row (the reaction lambda changes with the state). The matrix is factored by sparse LU (it
+    need not be symmetric, nor definite where the gas alone holds the wall), the rank-one term
     added by Sherman-Morrison."""
     return _sensitivities(cup, s.N, s.state)
 
@@ -122,15 +121,13 @@ def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float,
         P = P + sp.csr_matrix((plane.law.mu * state.contact.slip[slide].astype(float),
                                (2 * nodes, 2 * nodes + 1)), shape=P.shape)
     Ks = K.plain()
-    kin = cup.cup.mech.kin
-    solve = free_block_solver(P @ Ks if slide.any() else Ks, free, kin.node_coordinates(), kin.mesh,
-                              symmetric=not slide.any())
+    lu = spla.splu((P @ Ks)[free][:, free].tocsc())
     down = np.zeros(u.size)
     down[plate_z] = -1.0                                  # u_z = -u on the plate: d/du
     b = -(K_B * cup.T_K / mech.volume_m3(u)) * g          # dr/dN at fixed u
     h = (P @ g)[free]
     rhs = np.stack([-(P @ b)[free], -(P @ (Ks @ down))[free] - c * h * (g @ down), h], axis=1)
-    y = solve(rhs)
+    y = lu.solve(rhs)
     gf = g[free]
     y[:, :2] -= np.outer(y[:, 2], c * (gf @ y[:, :2]) / (1.0 + c * gf @ y[:, 2]))
     x_N, x_u = np.zeros(u.size), down.copy()
