@@ -286,7 +286,7 @@ def check_route(values: Mapping[str, Any], given: Iterable[str], spelling: str,
                 swept: str | None = None) -> None:
     """The rules between the route and the other fields, in the names of `spelling`: the routes
     that need the FEM; the fem route's own fields (the press, the plate step) with it only, one
-    press, and what it does not model (water, relaxation, kappa, Appendix A). `values`: {key
+    press, and what it does not model (relaxation, kappa, Appendix A). `values`: {key
     path: value} with defaults; `given`: the key paths the user wrote; `swept`: a swept key path."""
     name = lambda key: _BY_KEY[key].name(spelling)                                   # noqa: E731
     route_is = lambda value: _BY_KEY["stiffness.route"].setting(spelling, value)    # noqa: E731
@@ -301,6 +301,9 @@ def check_route(values: Mapping[str, Any], given: Iterable[str], spelling: str,
     for key in ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"):
         if key in given and route != "fem":
             raise ValueError(f"{name(key)}: only for {route_is('fem')} (the cup pressed and sealed in the FEM)")
+    if route == "coupled" and values.get("fluid.kind", "air") != "air":
+        raise ValueError(f"{name('fluid.kind')}: {route_is('coupled')} models a gas-filled cavity only; drop "
+                         f"{_BY_KEY['fluid.kind'].setting(spelling, values['fluid.kind'])}")
     if route != "fem":
         return
     press = [k for k in ("loads.r_start_mm", "loads.press_u_mm", "loads.press_force_N") if values.get(k) is not None]
@@ -309,8 +312,7 @@ def check_route(values: Mapping[str, Any], given: Iterable[str], spelling: str,
                          f"{', '.join(name(k) for k in press)}")
     if source != "fem":
         raise ValueError(f"{name('stiffness.route')}: 'fem' needs source = \"fem\" (the cup's whole life in the FEM)")
-    for key, default, why in (("fluid.kind", "air", " models a gas-filled cavity only"),
-                              ("material.relaxation", "none", "'s wall is the FEM's elastic one"),
+    for key, default, why in (("material.relaxation", "none", "'s wall is the FEM's elastic one"),
                               ("loads.kappa", 1.0, "'s stiffness is the FEM's own")):
         if values.get(key, default) != default:
             raise ValueError(f"{name(key)}: the fem route{why}; drop {_BY_KEY[key].setting(spelling, values[key])}")

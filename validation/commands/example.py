@@ -20,7 +20,10 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
      table takes ~3 min (coarse) to ~8 min (medium) once per design and law.
    - fem: the cup's whole life in the FEM (`validation.bridge.fem_route`): pressed to r_start (or
      --press-u-mm, --press-force-N) with the gas escaping, sealed, held at F1 along its equilibrium
-     branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse).
+     branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse);
+     with --fluid water the cavity holds incompressible water that flows in by eq (24) (~10 s per
+     force, coarse; no cavitation: the water may go into tension).
+   --fluid water fills the cavity with water on the paper, profile and fem routes (eq 24).
    Another design (--geometry FILE) runs the same chain on its own geometry (`validation.bridge.design`).
    A curve of `cupcheck stiffness` (--stiffness CURVE.csv) replaces step 1: its design, contact law,
    mesh level and material are the example's; a --cup, --geometry, --contact, --friction or
@@ -35,8 +38,8 @@ Writes to DIR, atomically:
   lifetime_vs_force_data.csv  what the figure draws, point by point (series, quantities, x, y)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
-  trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N, p_b, u, plate force, V, r_c,
-                          seal radius, r_out, leak rate)
+  trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N or the water volume V_w, p_b, u,
+                          plate force, V, r_c, seal radius, r_out, leak rate or water inflow)
   manifest.json           the files and the study (`validation.bridge.study.Study`) they were computed for
 
 An FEM path that fails after some converged steps (before --u-max-mm, default 0.9 h1) keeps them,
@@ -73,7 +76,7 @@ FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 #: the study's fields `example` spells as flags (`validation.study_schema`; contact: `contact_choice`)
 KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "cup.l0_mm", "cup.l1_mm", "stiffness.route",
         "loads.r_start_mm", "stiffness.fidelity", "stiffness.u_max_mm", "surface.preset", "surface.uc_table",
-        "loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm")
+        "loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm", "fluid.kind")
 #: exit status of a run whose FEM curve is the converged part of a failed path (as `cupcheck stiffness`)
 PARTIAL_EXIT = 3
 
@@ -105,6 +108,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "$CUPCHECK_CACHE_DIR moves it)")
     c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
     add_flags(p.add_argument_group("fem route"), ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"))
+    add_flags(p, ("fluid.kind",))
     add_flags(p.add_mutually_exclusive_group(), ("surface.preset", "surface.uc_table"), helps={
         "surface.preset": "calibrated surface preset for u_c(p/E) (default: pmma-1.89)",
         "surface.uc_table": "critical gap table instead, columns p_over_E,u_c_m (u_c in m)"},
