@@ -99,8 +99,11 @@ def main() -> None:
         return
     if a.mesh_study and not a.jsonl:
         ap.error("--mesh-study: needs --jsonl FILE (the study's lifetimes, reused where present)")
-    for level in a.levels:
-        fem_cup(level, "frictionless")            # a bad level fails here, before any run
+    for level in a.levels:                        # a bad level fails here, before any run
+        try:
+            fem_cup(level, "frictionless")
+        except ValueError:
+            ap.error(f"--levels: expected coarse, medium, fine or N_ALONGxN_THROUGH, got {level!r}")
     model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
     if a.why:
         why(model, *a.why, level=a.levels[0])
