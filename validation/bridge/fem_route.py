@@ -58,13 +58,10 @@ def _law() -> ContactLaw:
 @dataclass(frozen=True)
 class FemCup:
     """The FEM cup of the route: the design (a `fem.geometry.CupGeometry` or a preset name), the
-    wall's neo-Hookean material (E [Pa], nu), the contact law with the plane and the mesh level
-    (default "fine": the level whose lifetimes are mesh-converged to 1 %, frictionless, at F1
-    below the largest holdable force; coarse and medium scatter by 1-7 % around it, at 1/13 and
-    1/5 of its CPU time: benchmarks/bench_fem_route.py --mesh-study, docs/lifetime.md)."""
+    wall's neo-Hookean material (E [Pa], nu), the contact law with the plane and the mesh level."""
 
     geometry: Any = "A"
-    fidelity: str = "fine"
+    fidelity: str = "coarse"
     E_Pa: float = 4e6
     nu: float = 0.49
     contact: Any = field(default_factory=_law)

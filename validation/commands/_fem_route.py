@@ -13,9 +13,8 @@ from typing import Any
 from validation.commands._reduced_options import build_uc, check_run_options, refuse_other_options
 from validation.study_schema import field_of
 
-#: mesh level of the fem route when --fidelity is not given: `FemCup`'s default, the level whose
-#: lifetime is mesh-converged to 1 % (one lifetime ~60 s of CPU; coarse ~5 s, medium ~13 s)
-DEFAULT_FIDELITY = "fine"
+#: mesh level of the fem route when --fidelity is not given (one lifetime 4-6 s of CPU coarse, ~20 s medium)
+DEFAULT_FIDELITY = "coarse"
 
 #: lifetime options the fem route replaces or does not model: (option, attribute, default)
 _NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--suction-table", "suction_table", None),

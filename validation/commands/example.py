@@ -82,8 +82,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                           "edges and not mesh-converged")
     add_flags(p, ("stiffness.fidelity",), helps={
         "stiffness.fidelity": "FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
-                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors; with "
-                              "--route fem: fine, its lifetime within 1 %%, see `cupcheck lifetime --help`)"})
+                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)"})
     c = p.add_argument_group("coupled route")
     c.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
                    help="the design's table from `cupcheck suction` (default: built at --fidelity "
@@ -305,9 +304,6 @@ def run(args: argparse.Namespace) -> int:
     if args.stiffness is not None:
         given = _curve_inputs(args)                    # the curve's design, law, level, material
         geometry, contact, curve_study = given
-    if args.fidelity is None and args.route == "fem":
-        from validation.commands._fem_route import DEFAULT_FIDELITY as FEM_ROUTE_FIDELITY
-        args.fidelity = FEM_ROUTE_FIDELITY
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     laws = cup_laws(args, coupled=True, fem=True)
     check_fields(args)

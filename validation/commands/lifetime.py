@@ -50,10 +50,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     fem = p.add_argument_group("fem route (--route fem)")
     add_contact_arguments(fem, "the paper's soap-cleaned PMMA is not frictionless, so give the law you mean")
     add_flags(fem, FEM_KEYS, helps={
-        "stiffness.fidelity": "for --route fem: mesh level of the cup (default fine with --route fem: "
-                              "the lifetime mesh-converged to 1 %%, ~60 s of CPU per force after ~80 s "
-                              "pressing and the largest force; coarse and medium are 1-7 %% off at 1/13 "
-                              "and 1/5 of the time, see benchmarks/bench_fem_route.py --mesh-study)"})
+        "stiffness.fidelity": "for --route fem: mesh level of the cup (default coarse with --route fem: one "
+                              "lifetime in ~15 s on one core; medium is ~4x slower, see "
+                              "benchmarks/bench_fem_route.py)"})
     add_flags(p, ("loads.F1_N",), helps={"loads.F1_N": "pull force(s) F1 in N, > 0 (default: 10)"},
               **{"--force": {"metavar": "F1_N"}})
     p.add_argument("--stiffness", default="appendix-a", metavar="appendix-a|FILE.csv",
