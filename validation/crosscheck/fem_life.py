@@ -50,7 +50,7 @@ QUICK_FORCES_N = {"A": (10.0,)}
 SEAL_FORCES_N = (10.0, 40.0)
 FIGURE_LAWS = (("frictionless", None), ("coulomb", 0.5), ("coulomb", 2.0), ("sticking", None))
 FIGURE_FORCE_N = 10.0
-FIDELITY = CROSSCHECK_FIDELITY           # coarse for cost; the route's own default is fine (docs/lifetime.md)
+FIDELITY = CROSSCHECK_FIDELITY           # the route's default level (`cupcheck lifetime --route fem`)
 PAPER_HOLD_N = 88.0                      # the paper's cup A held about 9 kg (Sec. 5)
 P_A_PA = 1e5
 
