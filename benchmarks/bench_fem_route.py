@@ -7,6 +7,8 @@ r_start = 12 mm, sealed, held at F1 along its FEM branch, per mesh level and con
         --forces 5 10 20 40 --du-factors 1 0.5 0.25 --jsonl study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --summarize study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --why 5 20
+    OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --mesh-study --levels coarse medium fine \
+        --laws frictionless "coulomb 0.5" --forces 5 10 20 40 --jsonl benchmarks/fem_route_mesh_study.jsonl
 
 For each (level, law, plate step): the largest holdable force (max pull at fixed N0), then per
 force the lifetime (its wall and CPU time: the CPU time is the cost on a busy machine), its
@@ -18,6 +20,11 @@ leak rate at the branch's start and end, the mean of 1/Q over N (lifetime = (N_m
 it), p_b, u, the seal radius and the contact band's width (cut radius less inner contact radius)
 at the start and end. --summarize turns such a file into the convergence table: each lifetime
 beside the one at half its plate step and the next finer mesh's at the same step, in percent.
+--mesh-study runs the (level, law, force) lifetimes missing from the --jsonl file (a level is a
+fidelity name or an intermediate mesh "N_ALONGxN_THROUGH" with the levels' grading), then prints
+the mesh study: per law and force each level's lifetime, the converged estimate (Richardson from
+the three finest levels where they converge monotonically, else the finest level) and each
+level's error against it, and the coarsest level within 1 % wherever every level has a lifetime.
 """
 
 from __future__ import annotations
@@ -32,7 +39,8 @@ import numpy as np
 
 import reduced
 from fem.interface import ContactLaw
-from validation.bridge.fem_route import DEFAULT_DU_M, FemCup, FemRouteError, lifetime_integral, register
+from fem.mesh import FIDELITIES, mesh_spec
+from validation.bridge.fem_route import DEFAULT_DU_M, FemCup, FemRouteError, Press, lifetime_integral, register
 from validation.bridge.pipeline import surface_uc_table
 
 LAWS = {"frictionless": ContactLaw(), "coulomb 0.5": ContactLaw("coulomb", 0.5),
@@ -54,16 +62,34 @@ def _explain(life) -> dict:
             "width_end_mm": float(tr["r_out_mm"][-1] - tr["r_c_mm"][-1])}
 
 
+def fem_cup(level: str, law: str) -> FemCup:
+    """Cup A at a mesh level: a fidelity name or "N_ALONGxN_THROUGH" (the levels' grading)."""
+    if level in FIDELITIES:
+        return FemCup("A", level, contact=LAWS[law])
+    n_along, n_through = (int(n) for n in level.split("x"))
+    return FemCup("A", mesh_spec("coarse", n_along=n_along, n_through=n_through), contact=LAWS[law])
+
+
+def _elements(level: str) -> int:
+    spec = FIDELITIES[level] if level in FIDELITIES else fem_cup(level, "frictionless").fidelity
+    return spec.n_along * spec.n_through
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--levels", nargs="+", default=["coarse"])
+    ap.add_argument("--levels", nargs="+", default=["coarse"],
+                    help="mesh levels: coarse, medium, fine or N_ALONGxN_THROUGH (e.g. 108x12)")
     ap.add_argument("--laws", nargs="+", default=["frictionless", "coulomb 0.5", "sticking"], choices=list(LAWS))
     ap.add_argument("--forces", nargs="+", type=float, default=[10.0])
     ap.add_argument("--du-mm", type=float, default=None, help="the plate step (default: the route's)")
     ap.add_argument("--du-factors", nargs="+", type=float, default=[1.0], help="multiples of the plate step")
+    ap.add_argument("--press-u-mm", type=float, default=None,
+                    help="press the cup to this plate displacement [mm] instead of to r_start")
     ap.add_argument("--no-largest", action="store_true", help="skip the largest holdable force")
     ap.add_argument("--jsonl", default=None, help="append every lifetime as a JSON line to this file")
     ap.add_argument("--summarize", default=None, help="print the convergence table of a --jsonl file")
+    ap.add_argument("--mesh-study", action="store_true",
+                    help="run the lifetimes missing from --jsonl, then print the mesh study (module docstring)")
     ap.add_argument("--why", nargs=2, type=float, default=None, metavar=("F_LOW", "F_HIGH"),
                     help="the leak of the two forces' frictionless branch states at equal N / N0, each "
                          "also at the other's p_b (the profile's share against the pressure's)")
@@ -71,44 +97,59 @@ def main() -> None:
     if a.summarize:
         summarize(a.summarize)
         return
+    if a.mesh_study and not a.jsonl:
+        ap.error("--mesh-study: needs --jsonl FILE (the study's lifetimes, reused where present)")
+    for level in a.levels:                        # a bad level fails here, before any run
+        try:
+            fem_cup(level, "frictionless")
+        except ValueError:
+            ap.error(f"--levels: expected coarse, medium, fine or N_ALONGxN_THROUGH, got {level!r}")
     model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
     if a.why:
         why(model, *a.why, level=a.levels[0])
         return
     du0 = DEFAULT_DU_M if a.du_mm is None else 1e-3 * a.du_mm
+    press = None if a.press_u_mm is None else Press("u_m", 1e-3 * a.press_u_mm)
+    done = _done(a.jsonl) if a.mesh_study else set()
     print("| level | law | du [mm] | F1 [N] | lifetime [s] | reason | states | Newton it. | seal r start/end [mm] "
           "| u end [mm] | wall [s]: total / press / branch FEM / rest | largest force [N] |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for level in a.levels:
         for law in a.laws:
+            todo = [(f * du0, F) for f in a.du_factors for F in a.forces
+                    if _key(level, law, 1e3 * f * du0, F, a.press_u_mm) not in done]
+            if not todo:
+                continue
             route = register()
             route._sealed.clear()
-            cup = FemCup("A", level, contact=LAWS[law])
+            cup = fem_cup(level, law)
+            options = {**route.options, "cup": cup, "press": press}
             t0 = time.perf_counter()
-            sealed = route.seal(model, {**route.options, "cup": cup})
+            sealed = route.seal(model, options)
             t_press = time.perf_counter() - t0
             t0 = time.perf_counter()
-            largest = math.nan
+            largest, partial = math.nan, None
             if not a.no_largest:
                 try:
-                    largest = route.largest_force(model, {**route.options, "cup": cup})
+                    largest, partial = route._largest_checked(model, options)
                 except Exception as err:       # reported, not hidden
                     print(f"<!-- {level} {law}: largest force failed: {err} -->")
             t_largest = time.perf_counter() - t0
-            for factor in a.du_factors:
-                du = factor * du0
-                for F in a.forces:
-                    _one(model, cup, level, law, du, F, t_press, largest, a.jsonl)
+            for du, F in todo:
+                _one(model, cup, level, law, du, F, t_press, largest, a.jsonl, press, partial)
             print(f"<!-- {level} {law}: press+seal {t_press:.1f} s, largest force {t_largest:.1f} s, "
                   f"N0 = {sealed.state.N:.4e}, u_sealed = {1e3 * sealed.state.u_m:.3f} mm, "
                   f"seal r at sealing = {1e3 * sealed.state.seal_r_m:.2f} mm -->", flush=True)
+    if a.mesh_study:
+        mesh_study(a.jsonl, a.levels, a.laws, a.forces, 1e3 * du0, a.press_u_mm)
 
 
-def _one(model, cup, level, law, du, F, t_press, largest, jsonl) -> None:
+def _one(model, cup, level, law, du, F, t_press, largest, jsonl, press=None, partial=None) -> None:
     t0, c0 = time.perf_counter(), time.process_time()
-    row = {"level": level, "law": law, "du_mm": 1e3 * du, "F1_N": F, "largest_N": largest}
+    row = {"level": level, "law": law, "du_mm": 1e3 * du, "F1_N": F, "largest_N": largest,
+           "largest_lower_bound": partial is not None, "press_u_mm": None if press is None else 1e3 * press.value}
     try:
-        life = reduced.solve_lifetime(model, F, route="fem", cup=cup, du_m=du)
+        life = reduced.solve_lifetime(model, F, route="fem", cup=cup, du_m=du, press=press)
     except (FemRouteError, RuntimeError) as err:
         wall = time.perf_counter() - t0
         print(f"| {level} | {law} | {1e3 * du:g} | {F:g} | failed | {str(err)[:90]} | | | | | "
@@ -126,7 +167,8 @@ def _one(model, cup, level, law, du, F, t_press, largest, jsonl) -> None:
               f"{wall:.1f} / {t_press:.1f} / {fem:.1f} / {wall - fem:.1f} | {largest:.2f} |", flush=True)
         row.update(lifetime_s=life.lifetime_s, reason=life.reason, wall_s=wall, fem_s=fem,
                    states=d.get("states", 0), newton=d.get("newton_iterations", 0),
-                   branch_reason=d.get("branch_reason"), **_explain(life))
+                   branch_reason=d.get("branch_reason"), N0=d["N0"], u_sealed_mm=d["u_sealed_mm"],
+                   seal_r_sealed_mm=d["seal_r_sealed_mm"], **_explain(life))
     row["cpu_s"] = time.process_time() - c0       # one core: the cost on a shared machine
     if jsonl:
         with open(jsonl, "a") as f:
@@ -185,6 +227,103 @@ def summarize(path: str) -> None:
                   f"| {r.get('p_b_start_kPa', math.nan):.1f} / {r.get('p_b_end_kPa', math.nan):.1f} "
                   f"| {r.get('seal_r_start_mm', math.nan):.2f} / {r.get('seal_r_end_mm', math.nan):.2f} "
                   f"| {r.get('wall_s', math.nan):.1f} |")
+
+
+def _key(level: str, law: str, du_mm: float, F: float, press_u_mm: float | None) -> tuple:
+    return (level, law, round(du_mm, 6), float(F),
+            None if press_u_mm is None else round(press_u_mm, 6))
+
+
+def _rows(path: str) -> list[dict]:
+    try:
+        with open(path) as f:
+            return [json.loads(line) for line in f if line.strip()]
+    except FileNotFoundError:
+        return []
+
+
+def _done(path: str) -> set:
+    return {_key(r["level"], r["law"], r["du_mm"], r["F1_N"], r.get("press_u_mm")) for r in _rows(path)}
+
+
+#: the lifetime's tolerance the default mesh level is chosen for
+MESH_TOL = 0.01
+
+
+def converged_estimate(by_level: dict[str, float]) -> tuple[float, str]:
+    """The converged lifetime from the nested levels coarse, medium, fine (ratio 2): Richardson
+    with the observed order p = log2((L_m - L_c) / (L_f - L_m)) where the three change
+    monotonically and 0.5 <= p <= 4 (a clear asymptotic order), else the finest level's value.
+    (estimate, how: "Richardson p=..." or the finest level's name)."""
+    c, m, f = (by_level.get(k, math.nan) for k in ("coarse", "medium", "fine"))
+    if all(map(math.isfinite, (c, m, f))) and (m - c) * (f - m) > 0:
+        p = math.log2((m - c) / (f - m))
+        if 0.5 <= p <= 4.0:
+            return f + (f - m) / (2.0 ** p - 1.0), f"Richardson p = {p:.2f}"
+    finite = [k for k in sorted(by_level, key=_elements) if math.isfinite(by_level[k])]
+    return (by_level[finite[-1]], finite[-1]) if finite else (math.nan, "none")
+
+
+def mesh_study(path: str, levels: list[str], laws: list[str], forces: list[float], du_mm: float,
+               press_u_mm: float | None) -> None:
+    """The mesh study of a --jsonl file (module docstring): per law and force (and the largest
+    holdable force) each level's value and its error against the converged estimate; each level's
+    largest error and mean CPU time per lifetime; the coarsest level within MESH_TOL everywhere."""
+    rows = {_key(r["level"], r["law"], r["du_mm"], r["F1_N"], r.get("press_u_mm")): r for r in _rows(path)}
+    levels = sorted(levels, key=_elements)
+    press = "r_start" if press_u_mm is None else f"u = {press_u_mm:g} mm"
+    print(f"\nMesh study: cup A, pmma-1.89, du = {du_mm:g} mm, pressed to {press}; lifetimes [s] "
+          f"(error against the estimate)\n")
+    print("| law | F1 [N] | " + " | ".join(levels) + " | estimate | from |")
+    print("|---|---|" + "---|" * len(levels) + "---|---|")
+    worst: dict[str, float] = {}
+    where = {lv: [] for lv in levels}
+    cpu = defaultdict(list)
+    for law in laws:
+        cases = [(f"{F:g}", {lv: rows.get(_key(lv, law, du_mm, F, press_u_mm)) for lv in levels}) for F in forces]
+        largest = {}
+        for lv in levels:
+            r = next((r for (lv2, law2, _, _, pr), r in rows.items()
+                      if (lv2, law2, pr) == (lv, law, press_u_mm) and math.isfinite(r.get("largest_N", math.nan))),
+                     None)
+            largest[lv] = r and {"lifetime_s": r["largest_N"], "reason": "largest",
+                                 "lower_bound": r.get("largest_lower_bound", False)}
+        cases.append(("largest", largest))
+        for label, runs in cases:
+            bound = {lv for lv, r in runs.items() if (r or {}).get("lower_bound")}
+            vals = {lv: math.nan if lv in bound else (r or {}).get("lifetime_s", math.nan) for lv, r in runs.items()}
+            vals = {lv: v if v is not None and math.isfinite(v) else math.nan for lv, v in vals.items()}
+            est, how = converged_estimate(vals)
+            cells = []
+            for lv in levels:
+                v = vals[lv]
+                if label != "largest" and runs[lv] is not None and "cpu_s" in runs[lv]:
+                    cpu[lv].append(runs[lv]["cpu_s"])
+                if lv in bound:
+                    cells.append(f">= {runs[lv]['lifetime_s']:.4g} (the solver stopped)")
+                    continue
+                if not math.isfinite(v):
+                    reason = (runs[lv] or {}).get("reason", "not run")
+                    cells.append("failed" if str(reason).startswith("failed") else reason)
+                    continue
+                err = v / est - 1.0 if math.isfinite(est) else math.nan
+                cells.append(f"{v:.4g} ({100 * err:+.2f} %)" if how != lv else f"{v:.4g}")
+                if how != lv and math.isfinite(err):
+                    worst[lv] = max(worst.get(lv, 0.0), abs(err))
+                    if abs(err) > MESH_TOL:
+                        where[lv].append(f"{law} {label}")
+            unit = " N" if label == "largest" else ""
+            print(f"| {law} | {label} | " + " | ".join(cells) + f" | {est:.4g}{unit} | {how} |")
+    print("\n| level | elements | largest error | over 1 % at | mean CPU per lifetime [s] |")
+    print("|---|---|---|---|---|")
+    for lv in levels:
+        c = cpu.get(lv, [])
+        err = f"{100 * worst[lv]:.2f} %" if lv in worst else "– (the estimate)"
+        print(f"| {lv} | {_elements(lv)} | {err} | {', '.join(where[lv]) or '–'} | "
+              f"{np.mean(c) if c else math.nan:.1f} |")
+    within = [lv for lv in levels if lv in worst and not where[lv]]
+    print(f"\nCoarsest level within {100 * MESH_TOL:g} % of the estimate everywhere: "
+          f"{within[0] if within else 'none below the finest'}")
 
 
 if __name__ == "__main__":
