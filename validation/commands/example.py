@@ -96,7 +96,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                           "edges and not mesh-converged")
     add_flags(p, ("stiffness.fidelity", "stiffness.u_max_mm"), helps={
         "stiffness.fidelity": "FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
-                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)",
+                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors; with --route "
+                              "fem coarse, as `cupcheck lifetime --route fem`: its lifetimes scatter 1.5-4 %% "
+                              "at every level, docs/lifetime.md)",
         "stiffness.u_max_mm": "the FEM curve's largest plate displacement u [mm], in (0, h1] (default: 0.9 h1); "
                               "a path that fails before it keeps its converged part (exit status 3)"})
     c = p.add_argument_group("coupled route")
@@ -257,6 +259,7 @@ def run(args: argparse.Namespace) -> int:
     from validation.bridge.products import Products
 
     from fem.mesh import DEFAULT_FIDELITY
+    from validation.commands._fem_route import DEFAULT_FIDELITY as FEM_ROUTE_FIDELITY
 
     t0 = time.perf_counter()
     from validation.output import check_outputs, command_inputs
@@ -265,7 +268,7 @@ def run(args: argparse.Namespace) -> int:
     if args.stiffness is not None:
         given = curve_inputs(args)                    # the curve's design, law, level, material
         geometry, contact, curve_study = given
-    args.fidelity = args.fidelity or DEFAULT_FIDELITY
+    args.fidelity = args.fidelity or (FEM_ROUTE_FIDELITY if args.route == "fem" else DEFAULT_FIDELITY)
     laws = cup_laws(args, coupled=True, fem=True)
     check_fields(args)
     if given is None:
