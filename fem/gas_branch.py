@@ -56,15 +56,14 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .branch_jumps import HALVINGS, LetGo, leak_and_settle, settle
 from .gas_path import CupWithGas, GasState
-from .solver import SolverStats, StepResult
+from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
 __all__ = ["Branch", "equilibrium_branch", "pull_sensitivities", "state_between"]
 
-SNAP_DN = 1e-6      # relative rise of N at the held plate that tests for a snap
-SNAP_DROP = 1e-3    # ... and the relative fall of F1 that makes it one
 STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
 
 
@@ -189,13 +188,16 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
                 s = walk.hold_u(prev, u_pred, N_pred)
         except _Jump as jump:
             # the pull jumps across F1 (a slip): the cup crosses it at the jump's N, then the
-            # plate rises (the pull fell) or gas enters (it rose) until the pull is F1 again
+            # plate rises (the pull fell) or gas enters (it rose) until the pull is F1 again,
+            # crossing the slips this releases (`fem.branch_jumps.settle`)
             try:
-                restored = walk.restore(jump.after, du_m, u_min)
+                restored, why = settle(walk, jump.after, du_m, N_ref, u_min)
+            except LetGo:
+                return walk.result(prev, "fold", trials, slopes)
             except RuntimeError as err:
                 return walk.result(None, f"stopped: {jump}; then {err}", trials, slopes)
             if restored is None:
-                return walk.result(None, "u_min", trials, slopes)
+                return walk.result(None, why, trials, slopes)
             if _open(cup, restored):
                 return walk.result(prev, "seal opened", trials, slopes)
             tangent, h = crossed(restored), 1.0
@@ -204,16 +206,15 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             if h > 1.0 / 16.0 * (1 + 1e-9):
                 h *= 0.5
                 continue
-            # a snap? F1 falls by a finite amount as N rises at the held plate (a seal slips):
-            # under the held pull the plate then rises at that N until F1 is restored
+            # no state on the line from prev (a jump the trials cannot cross: a slip, a snap):
+            # the cup moves as the leak and the held pull move it (`fem.branch_jumps`)
+            dN = h * N_ref * max(abs(tangent[1]), 0.25)
             try:
-                after = walk.solve(prev, prev.u_m, prev.N * (1.0 + SNAP_DN))
-                restored = after.F1_N < walk.F1 - SNAP_DROP * abs(walk.F1) and \
-                    walk.pull_to_force(after, du_m, u_min)
-            except RuntimeError:
-                restored = None
-            if not restored:
-                return walk.result(None, f"stopped: {err}", trials, slopes)
+                restored, why = _leak(walk, prev, dN, du_m, u_min)
+            except RuntimeError as again:
+                return walk.result(None, f"stopped: {err}; then {again}", trials, slopes)
+            if restored is None:
+                return walk.result(prev if why != "u_min" else None, why, trials, slopes)
             tangent, h = crossed(restored), 1.0
             continue
         h = min(1.0, 2.0 * h)
@@ -251,10 +252,30 @@ def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float) -> Gas
     return None
 
 
+def _leak(walk: "_Walk", prev: "_Trial", dN: float, du_m: float, u_min: float):
+    """The state holding F1 after the leak let gas in from prev (`fem.branch_jumps.leak_and_settle`),
+    the seal closed, with dN halved HALVINGS times where the cup lets go or the seal opens: (state,
+    "held"), or (None, "fold" | "seal opened" | "u_min")."""
+    why = "held"
+    for _ in range(HALVINGS + 1):
+        s, why = leak_and_settle(walk, prev, dN, du_m, u_min)
+        if why == "u_min":
+            return None, why
+        if s is not None and not _open(walk.cup, s):
+            return s, "held"
+        why = "fold" if s is None else "seal opened"
+        dN *= 0.5
+    return None, why
+
+
 def _open(cup: CupWithGas, s: "_Trial") -> bool:
     """Whether no node of the cavity chain is on the plane (the cavity is open to the outside)."""
     x = cup.mesh.doflocs + np.stack([s.step.u[0::2], s.step.u[1::2]])
     return not np.any(x[1, cup.cavity.nodes] <= cup.cavity.tolerance_m)
+
+
+class _Crossed(ConvergenceError):
+    """Stops a trial's path at the first instability it crosses (`_Walk.solve`)."""
 
 
 class _Jump(RuntimeError):
@@ -273,6 +294,7 @@ class _Trial:
     N: float
     F1_N: float
     step: StepResult
+    crossed: "_Trial | None" = None   # the state after the first instability its path crossed
 
 
 class _Walk:
@@ -293,6 +315,9 @@ class _Walk:
                                          max_step=1.0 / STICKING_STEPS, min_step=1.0 / (16 * STICKING_STEPS))
         self.stats: SolverStats | None = None
         self.snaps = 0
+        # an incremental friction law crosses instabilities by damped motion: a trial whose path
+        # crosses one has jumped (the state after it is the jump's far side, `_root`)
+        self.relaxes = bool(getattr(cup.cup.plane.law, "relaxes", False))
         self.slopes: dict[_Trial, tuple[float, float]] = {}     # by identity
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
@@ -318,8 +343,10 @@ class _Walk:
             t = -t
         return float(t[0]), float(t[1])
 
-    def solve(self, start: _Trial, u_m: float, N: float, options=None) -> _Trial:
-        """The state at (u_m, N), reached from `start` with the plate and N on a line."""
+    def solve(self, start: _Trial, u_m: float, N: float, options=None, stop_at_crossing: bool = False) -> _Trial:
+        """The state at (u_m, N), reached from `start` with the plate and N on a line; its
+        `crossed` is the state after the first instability the path crossed by damped motion
+        (a law that `relaxes`), where the path stops if `stop_at_crossing`."""
         u0, N0 = start.u_m, start.N
         mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
                             schedule=lambda t: N0 + t * (N - N0))
@@ -328,12 +355,35 @@ class _Walk:
 
         def plate(t):
             return dofs, np.concatenate([zeros, np.full(top.size, -(u0 + t * (u_m - u0)))])
-        last = []
-        stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
-                                options=options or self.options, on_step=last.append)
-        self.stats = stats if self.stats is None else _joined(self.stats, stats)
-        end = last[-1]
-        return _Trial(float(u_m), float(N), float(np.sum(end.r_int[2 * top + 1])), end)
+        last: list[StepResult] = []
+
+        def on_step(step: StepResult) -> None:
+            last.append(step)
+            if stop_at_crossing and self.relaxes and step.unstable:
+                raise _Crossed("the path crossed an instability")
+        try:
+            stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
+                                    options=options or self.options, on_step=on_step)
+        except _Crossed as stop:
+            stats = stop.stats
+        except ConvergenceError as err:         # the cost of a failed trial counts too
+            self._count(err.stats)
+            raise
+        self._count(stats)
+
+        def trial(step: StepResult, f: float) -> _Trial:
+            at_end = f >= 1.0
+            return _Trial(float(u_m if at_end else u0 + f * (u_m - u0)),
+                          float(N if at_end else N0 + f * (N - N0)), float(np.sum(step.r_int[2 * top + 1])), step)
+        crossed = next((st for st in last if st.unstable), None) if self.relaxes else None
+        end = trial(last[-1], last[-1].t)
+        if crossed is not None:
+            return replace(end, crossed=end if crossed is last[-1] else trial(crossed, crossed.t))
+        return end
+
+    def _count(self, stats: SolverStats | None) -> None:
+        if stats is not None:
+            self.stats = stats if self.stats is None else _joined(self.stats, stats)
 
     def hold(self, prev: _Trial, u_m: float, N_guess: float) -> _Trial:
         """The state at plate position u_m whose pull is F1 (N by Newton on F1(N), module
@@ -349,12 +399,16 @@ class _Walk:
         """F1(x) = F1 for x = N at the plate u_m (k = 0) or x = u at N (k = 1), every trial
         reached from prev: Newton with the exact dF1/dx, the secant where it does not halve the
         mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`)."""
-        if k == 0:
-            def at(x): return self.solve(prev, u_m, x, self.trial_options)
-            x0, x_prev, name = N, prev.N, "N"
-        else:
-            def at(x): return self.solve(prev, x, N, self.trial_options)
-            x0, x_prev, name = u_m, prev.u_m, "the plate position"
+        name = "N" if k == 0 else "the plate position"
+
+        def at(x):
+            s = self.solve(prev, u_m, x, self.trial_options, True) if k == 0 else \
+                self.solve(prev, x, N, self.trial_options, True)
+            if s.crossed is not None:       # the cup meets an instability on the way: it jumps
+                raise _Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
+                            f"crossed on the way to {name} {x:.6g}")
+            return s
+        x0, x_prev = (N, prev.N) if k == 0 else (u_m, prev.u_m)
         s = at(x0)
         tried: list[tuple[float, float, _Trial]] = [(x0, s.F1_N - self.F1, s)]
         for _ in range(12):
@@ -407,18 +461,6 @@ class _Walk:
                 a = (xa, 0.5 * fa if side == -1 else fa, sa)
                 side = -1
         raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (bracket not closed)")
-
-    def restore(self, after: _Trial, du_m: float, u_min: float) -> _Trial | None:
-        """The state holding F1 again after a jump of the pull (`_Jump`): the plate raised at
-        fixed N where the pull fell, gas let in at the held plate where it rose. None if the
-        plate reaches u_min first."""
-        if after.F1_N < self.F1:
-            return self.pull_to_force(after, du_m, u_min)
-        dF1_dN = self.derivatives(after)[0]
-        if not dF1_dN < 0.0:
-            raise RuntimeError(f"F1_N = {self.F1:g} N: the pull jumped to {after.F1_N:.4g} N and "
-                               f"more gas does not lower it")
-        return self.hold(after, after.u_m, after.N - (after.F1_N - self.F1) / dF1_dN)
 
     def pull_to_force(self, sealed: _Trial, du_m: float, u_min: float) -> _Trial | None:
         """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m
