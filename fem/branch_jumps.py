@@ -24,22 +24,40 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["CASCADE", "HALVINGS", "settle", "leak_and_settle"]
+__all__ = ["CASCADE", "HALVINGS", "LetGo", "settle", "leak_and_settle", "leak_to_hold"]
 
 CASCADE = 24        # crossings of jumps (alternations of the two moves) before a state holds F1
 HALVINGS = 4        # halvings of the leak step that locate the last state holding F1
 _MOVES = 40         # solves of one move (each a Newton step on the exact derivative, clipped)
+_CUTS = 2           # a solve that fails: the move's largest step quartered, at most this often
 
 
 class LetGo(Exception):
     """No state holds F1 with this N: the pull is below F1 and falls as the plate rises."""
 
 
+def leak_to_hold(walk, prev, dN: float, du_m: float, u_min: float, opened):
+    """`leak_and_settle` from prev with the seal closed (`opened(state)` false), dN halved
+    HALVINGS times where the cup lets go or the seal opens: (state, "held", the fraction of dN
+    taken), or (None, "fold" | "seal opened" | "u_min", 0): the last state holding F1, prev, is
+    then the detachment."""
+    why, part = "held", 1.0
+    for _ in range(HALVINGS + 1):
+        s, why = leak_and_settle(walk, prev, part * dN, du_m, u_min)
+        if why == "u_min":
+            return None, why, 0.0
+        if s is not None and not opened(s):
+            return s, "held", part
+        why = "fold" if s is None else "seal opened"
+        part *= 0.5
+    return None, why, 0.0
+
+
 def leak_and_settle(walk, prev, dN: float, du_m: float, u_min: float):
     """The state holding F1 after gas dN [molecules] entered at the held plate from the state
     `prev` (module docstring). Returns (state, why): why "held", "u_min" (the plate reached
     u_min, state None) or "let go" (state None). Raises RuntimeError where a move finds no state."""
-    start = walk.solve(prev, prev.u_m, prev.N + dN)
+    start = walk.solve(prev, prev.u_m, prev.N + dN, walk.move_options)
     try:
         return settle(walk, start, du_m, dN, u_min)
     except LetGo:
@@ -70,7 +88,7 @@ def _move(walk, s, k: int, largest: float, u_min: float):
     largest < 0, up) from s until the pull reaches F1: steps by Newton on the exact dF1/dx,
     clipped to `largest`, each solved from the last state short of F1; a step past F1 brackets
     the crossing, which Illinois regula falsi closes (trials from the near side, every third a
-    bisection). A bracket closed
+    bisection); a solve that fails quarters the largest step (_CUTS times). A bracket closed
     to 1e-3 of `largest` without a root is a jump across F1: its far side is returned. None where
     the plate would pass u_min."""
     side = 1.0 if s.F1_N < walk.F1 else -1.0         # the sign of F1 - F1(s): which way is short
@@ -79,11 +97,12 @@ def _move(walk, s, k: int, largest: float, u_min: float):
         return side * (walk.F1 - t.F1_N)
 
     def at(a, x):
-        return walk.solve(a, a.u_m, x) if k == 0 else walk.solve(a, x, a.N)
+        return walk.solve(a, a.u_m, x, walk.move_options) if k == 0 else \
+            walk.solve(a, x, a.N, walk.move_options)
 
     def x_of(t) -> float:
         return t.N if k == 0 else t.u_m
-    a, b = s, None
+    a, b, cuts = s, None, 0
     for _ in range(_MOVES):
         miss = a.F1_N - walk.F1
         if abs(miss) <= walk.tolerance:
@@ -99,7 +118,13 @@ def _move(walk, s, k: int, largest: float, u_min: float):
         x = x_of(a) + step
         if k == 1 and x < u_min:
             return None
-        t = at(a, x)
+        try:
+            t = at(a, x)
+        except RuntimeError:            # no state that far (a slip the step cannot descend):
+            if cuts == _CUTS:           # shorter moves, from the same state
+                raise
+            cuts, largest = cuts + 1, 0.25 * largest
+            continue
         if short(t) > walk.tolerance:
             a = t
         elif abs(t.F1_N - walk.F1) <= walk.tolerance:

@@ -27,13 +27,19 @@ minimization at given (u, N).
 
 Slips and snaps: the pull can jump as N rises at the held plate (or as the plate moves at fixed
 N): a sticking node whose normal reaction reaches zero while it carries a tangential one is
-released and slips (mu -> infinity has no continuous transition), or the wall snaps. Where the
-bracket of the root closes to 1e-3 of the trial's move with the pull still on both sides of F1,
-the pull jumps across F1 there; the cup crosses the jump at that N and is then restored to F1
-by the physical response of a held pull: the plate rises at fixed N where the pull fell, gas
-enters at the held plate where it rose (`Branch.snaps` counts them; the slip's dissipation is
-in the branch's stats). The sticking law's slips land where the load step puts them, so its
-moves between states are taken in STICKING_STEPS load steps.
+released and slips (mu -> infinity has no continuous transition), a Coulomb seal slips where its
+quasi-static step has no solution (crossed by damped motion, `fem.newton.relax_step`), or the
+wall snaps. Where the bracket of the root closes to 1e-3 of the trial's move with the pull still
+on both sides of F1, or a Coulomb trial's path crosses an instability (the state after it is
+taken: the cup jumped there), or no state is found on the line even with 1/16 of a step, the cup
+moves as the held pull and the leak move it, each move continuing the last state's path
+(`fem.branch_jumps`: the plate rises at fixed N where the pull fell, gas enters at the held plate
+where it rose, in turn, across the slips this releases; `Branch.snaps` counts the crossings, the
+slips' dissipation is in the branch's stats). The sticking law's slips land where its load steps
+put them, and the pull reached from the last state on a line jumps at many places (a cascade of
+releases); its whole branch is therefore walked that way: gas let in at the held plate by a step
+of the branch, then the plate's response, each state the first holding F1 (its moves in
+STICKING_STEPS load steps).
 
 Detachment (the criterion): with the pull F1 held, the leak raises N, and the cup follows the
 branch while N can still rise along it. Where N(u) has its maximum, dN/du = 0 (the fold of the
@@ -43,7 +49,8 @@ state, dN/du = -(dF1/du)/(dF1/dN), and the fold located by a secant on it). The 
 where the seal opens, no node of the cavity chain being on the plane any more: the detachment is
 then the last state with the seal closed, bisected to 1/64 of a step ("seal opened"). It ends
 without a detachment where the plate reaches u_min_m ("u_min"), or where no state holds F1 even
-with 1/16 of a step ("stopped: why").
+with 1/16 of a step ("stopped: why"). Where the cup moves by the leak and the held pull, it lets go
+(a "fold") where the pull is below F1 and falls as the plate rises (`fem.branch_jumps`).
 """
 
 from __future__ import annotations
@@ -56,7 +63,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .branch_jumps import HALVINGS, LetGo, leak_and_settle, settle
+from .branch_jumps import LetGo, leak_to_hold, settle
 from .gas_path import CupWithGas, GasState
 from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
@@ -79,7 +86,7 @@ class Branch:
     detachment: GasState | None       # the fold (largest N) or the state where the seal opened
     reason: str                       # "fold", "seal opened", "u_min", "not held", "stopped: why"
     stats: SolverStats
-    snaps: int = 0                    # snaps crossed (the plate rose at fixed N to restore F1)
+    snaps: int = 0                    # jumps of the pull crossed (`fem.branch_jumps`)
 
     @property
     def N_max(self) -> float:
@@ -178,6 +185,24 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     h = 1.0
     while len(trials) < max_states:
         prev = trials[-1]
+        if walk.staircase:        # sticking: the leak and the held pull in turn (`fem.branch_jumps`)
+            try:
+                s, why, part = leak_to_hold(walk, prev, h * N_ref * max(abs(tangent[1]), 0.25), du_m, u_min,
+                                          lambda t: _open(cup, t))
+            except RuntimeError as err:
+                if h > 1.0 / 16.0 * (1 + 1e-9):
+                    h *= 0.5
+                    continue
+                return walk.result(None, f"stopped: {err}", trials, slopes)
+            if s is None:
+                return walk.result(prev if why != "u_min" else None, why, trials, slopes)
+            h = min(1.0, 2.0 * h) if part == 1.0 else h * part
+            trials.append(s)
+            if progress:
+                progress(len(trials) - 1, s.u_m, s.N)
+            slopes.append(walk.slope(s))
+            tangent = walk.tangent(s, du_m, N_ref, tangent)
+            continue
         u_pred, N_pred = prev.u_m + h * tangent[0] * du_m, prev.N + h * tangent[1] * N_ref
         if u_pred < u_min:
             return walk.result(None, "u_min", trials, slopes)
@@ -210,7 +235,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             # the cup moves as the leak and the held pull move it (`fem.branch_jumps`)
             dN = h * N_ref * max(abs(tangent[1]), 0.25)
             try:
-                restored, why = _leak(walk, prev, dN, du_m, u_min)
+                restored, why, _ = leak_to_hold(walk, prev, dN, du_m, u_min, lambda t: _open(cup, t))
             except RuntimeError as again:
                 return walk.result(None, f"stopped: {err}; then {again}", trials, slopes)
             if restored is None:
@@ -250,22 +275,6 @@ def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float) -> Gas
         if min(a.N, b.N) < s.N < max(a.N, b.N) and not _open(cup, s):
             return walk.result(None, "between", [s]).states[0]
     return None
-
-
-def _leak(walk: "_Walk", prev: "_Trial", dN: float, du_m: float, u_min: float):
-    """The state holding F1 after the leak let gas in from prev (`fem.branch_jumps.leak_and_settle`),
-    the seal closed, with dN halved HALVINGS times where the cup lets go or the seal opens: (state,
-    "held"), or (None, "fold" | "seal opened" | "u_min")."""
-    why = "held"
-    for _ in range(HALVINGS + 1):
-        s, why = leak_and_settle(walk, prev, dN, du_m, u_min)
-        if why == "u_min":
-            return None, why
-        if s is not None and not _open(walk.cup, s):
-            return s, "held"
-        why = "fold" if s is None else "seal opened"
-        dN *= 0.5
-    return None, why
 
 
 def _open(cup: CupWithGas, s: "_Trial") -> bool:
@@ -313,11 +322,16 @@ class _Walk:
                                    max_step=1.0 / STICKING_STEPS)
             self.trial_options = replace(self.trial_options, initial_step=1.0 / STICKING_STEPS,
                                          max_step=1.0 / STICKING_STEPS, min_step=1.0 / (16 * STICKING_STEPS))
+        # a move of `fem.branch_jumps` (the leak, the plate's response): given up after 1/64 of
+        # its length or 100 iterations in a step, as a trial is (the walk then shortens it)
+        self.move_options = replace(self.options, min_step=max(self.options.min_step, 1.0 / 64.0),
+                                    max_iterations=min(self.options.max_iterations, 100))
         self.stats: SolverStats | None = None
         self.snaps = 0
         # an incremental friction law crosses instabilities by damped motion: a trial whose path
         # crosses one has jumped (the state after it is the jump's far side, `_root`)
         self.relaxes = bool(getattr(cup.cup.plane.law, "relaxes", False))
+        self.staircase = cup.cup.plane.law.name == "sticking"
         self.slopes: dict[_Trial, tuple[float, float]] = {}     # by identity
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
