@@ -29,7 +29,7 @@ __all__ = ["CASCADE", "HALVINGS", "LetGo", "settle", "leak_and_settle", "leak_to
 CASCADE = 24        # crossings of jumps (alternations of the two moves) before a state holds F1
 HALVINGS = 4        # halvings of the leak step that locate the last state holding F1
 _MOVES = 40         # solves of one move (each a Newton step on the exact derivative, clipped)
-_CUTS = 2           # a solve that fails: the move's largest step quartered, at most this often
+_CUTS = 3           # a solve that fails: the move's largest step quartered, at most this often
 
 
 class LetGo(Exception):
@@ -88,7 +88,8 @@ def _move(walk, s, k: int, largest: float, u_min: float):
     largest < 0, up) from s until the pull reaches F1: steps by Newton on the exact dF1/dx,
     clipped to `largest`, each solved from the last state short of F1; a step past F1 brackets
     the crossing, which Illinois regula falsi closes (trials from the near side, every third a
-    bisection); a solve that fails quarters the largest step (_CUTS times). A bracket closed
+    bisection); a solve that fails quarters the largest step (_CUTS times; it doubles again
+    after each solve short of F1). A bracket closed
     to 1e-3 of `largest` without a root is a jump across F1: its far side is returned. None where
     the plate would pass u_min."""
     side = 1.0 if s.F1_N < walk.F1 else -1.0         # the sign of F1 - F1(s): which way is short
@@ -102,7 +103,7 @@ def _move(walk, s, k: int, largest: float, u_min: float):
 
     def x_of(t) -> float:
         return t.N if k == 0 else t.u_m
-    a, b, cuts = s, None, 0
+    a, b, cuts, longest = s, None, 0, largest
     for _ in range(_MOVES):
         miss = a.F1_N - walk.F1
         if abs(miss) <= walk.tolerance:
@@ -126,7 +127,7 @@ def _move(walk, s, k: int, largest: float, u_min: float):
             cuts, largest = cuts + 1, 0.25 * largest
             continue
         if short(t) > walk.tolerance:
-            a = t
+            a, largest = t, math.copysign(min(2.0 * abs(largest), abs(longest)), longest)
         elif abs(t.F1_N - walk.F1) <= walk.tolerance:
             return t
         else:

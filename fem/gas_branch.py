@@ -322,9 +322,9 @@ class _Walk:
                                    max_step=1.0 / STICKING_STEPS)
             self.trial_options = replace(self.trial_options, initial_step=1.0 / STICKING_STEPS,
                                          max_step=1.0 / STICKING_STEPS, min_step=1.0 / (16 * STICKING_STEPS))
-        # a move of `fem.branch_jumps` (the leak, the plate's response): given up after 1/64 of
-        # its length or 100 iterations in a step, as a trial is (the walk then shortens it)
-        self.move_options = replace(self.options, min_step=max(self.options.min_step, 1.0 / 64.0),
+        # a move of `fem.branch_jumps` (the leak, the plate's response): given up after a step of
+        # 1/16 of its length fails in 100 iterations (the move is then shortened)
+        self.move_options = replace(self.options, min_step=max(self.options.min_step, 1.0 / 16.0),
                                     max_iterations=min(self.options.max_iterations, 100))
         self.stats: SolverStats | None = None
         self.snaps = 0
@@ -363,7 +363,7 @@ class _Walk:
         (a law that `relaxes`), where the path stops if `stop_at_crossing`."""
         u0, N0 = start.u_m, start.N
         mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
-                            schedule=lambda t: N0 + t * (N - N0))
+                            schedule=lambda t: N0 + t * (N - N0), relaxes=True)
         top = self.cup.cup.top
         dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
 
