@@ -32,6 +32,12 @@ _MOVES = 40         # solves of one move (each a Newton step on the exact deriva
 _CUTS = 3           # a solve that fails: the move's largest step quartered, at most this often
 
 
+def _tol(walk) -> float:
+    """|F1 - F1_N| accepted [N]: a tenth of the walk's (rtol of the suction over the rim), so that
+    a state holds F1 to rtol of the suction over its seal radius as the walk's Newton roots do."""
+    return 0.1 * walk.tolerance
+
+
 class LetGo(Exception):
     """No state holds F1 with this N: the pull is below F1 and falls as the plate rises."""
 
@@ -69,7 +75,7 @@ def settle(walk, s, du_m: float, dN: float, u_min: float):
     in turn until the pull is F1 (module docstring); du_m, dN: the largest plate and gas move
     per solve. Returns (state, "held") or (None, "u_min"); raises LetGo, RuntimeError."""
     for crossing in range(CASCADE):
-        if abs(s.F1_N - walk.F1) <= walk.tolerance:
+        if abs(s.F1_N - walk.F1) <= _tol(walk):
             return s, "held"
         if crossing:
             walk.snaps += 1
@@ -106,7 +112,7 @@ def _move(walk, s, k: int, largest: float, u_min: float):
     a, b, cuts, longest = s, None, 0, largest
     for _ in range(_MOVES):
         miss = a.F1_N - walk.F1
-        if abs(miss) <= walk.tolerance:
+        if abs(miss) <= _tol(walk):
             return a
         d = walk.derivatives(a)[k]
         if k == 1 and side > 0 and not d < 0.0:
@@ -126,9 +132,9 @@ def _move(walk, s, k: int, largest: float, u_min: float):
                 raise
             cuts, largest = cuts + 1, 0.25 * largest
             continue
-        if short(t) > walk.tolerance:
+        if short(t) > _tol(walk):
             a, largest = t, math.copysign(min(2.0 * abs(largest), abs(longest)), longest)
-        elif abs(t.F1_N - walk.F1) <= walk.tolerance:
+        elif abs(t.F1_N - walk.F1) <= _tol(walk):
             return t
         else:
             b = t
@@ -144,7 +150,7 @@ def _move(walk, s, k: int, largest: float, u_min: float):
         x = 0.5 * (xa + xb) if i % 3 == 2 else xa + (xb - xa) * fa / (fa - fb)
         t = at(a, x)
         f = short(t)
-        if abs(t.F1_N - walk.F1) <= walk.tolerance:
+        if abs(t.F1_N - walk.F1) <= _tol(walk):
             return t
         if f > 0.0:
             a, fa = t, f
