@@ -357,7 +357,8 @@ class _Walk:
             t = -t
         return float(t[0]), float(t[1])
 
-    def solve(self, start: _Trial, u_m: float, N: float, options=None, stop_at_crossing: bool = False) -> _Trial:
+    def solve(self, start: _Trial, u_m: float, N: float, options=None,
+              stop_at_crossing: bool = False) -> _Trial:
         """The state at (u_m, N), reached from `start` with the plate and N on a line; its
         `crossed` is the state after the first instability the path crossed by damped motion
         (a law that `relaxes`), where the path stops if `stop_at_crossing`."""
@@ -388,7 +389,8 @@ class _Walk:
         def trial(step: StepResult, f: float) -> _Trial:
             at_end = f >= 1.0
             return _Trial(float(u_m if at_end else u0 + f * (u_m - u0)),
-                          float(N if at_end else N0 + f * (N - N0)), float(np.sum(step.r_int[2 * top + 1])), step)
+                          float(N if at_end else N0 + f * (N - N0)),
+                          float(np.sum(step.r_int[2 * top + 1])), step)
         crossed = next((st for st in last if st.unstable), None) if self.relaxes else None
         end = trial(last[-1], last[-1].t)
         if crossed is not None:
