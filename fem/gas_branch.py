@@ -263,13 +263,18 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
 def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float) -> GasState | None:
     """A state holding F1_N between two consecutive states a and b of a branch, reached from a
     (its history): N the unknown at the plate midway, or where that fails, the plate at N
-    midway. None where neither is found between them (a jump of the pull between a and b)."""
+    midway. None where neither is found between them, or where the way there crosses an
+    instability (a jump of the pull between a and b)."""
     walk = _Walk(cup, float(F1_N))
     prev = _Trial(a.u_m, a.N, a.F1_N, a.state)
     u, N = 0.5 * (a.u_m + b.u_m), 0.5 * (a.N + b.N)
     for find in (walk.hold, walk.hold_u):
         try:
             s = find(prev, u, N)
+        except _Jump as jump:
+            if jump.instability:        # the cup jumps between a and b: no state midway
+                return None
+            continue
         except RuntimeError:
             continue
         if min(a.N, b.N) < s.N < max(a.N, b.N) and not _open(cup, s):
@@ -290,9 +295,9 @@ class _Crossed(ConvergenceError):
 class _Jump(RuntimeError):
     """The pull jumps across F1 between two states close together in N or u (module docstring)."""
 
-    def __init__(self, before: "_Trial", after: "_Trial", message: str):
+    def __init__(self, before: "_Trial", after: "_Trial", message: str, instability: bool = False):
         super().__init__(message)
-        self.before, self.after = before, after
+        self.before, self.after, self.instability = before, after, instability
 
 
 @dataclass(frozen=True, eq=False)
@@ -422,7 +427,7 @@ class _Walk:
                 self.solve(prev, x, N, self.trial_options, True)
             if s.crossed is not None:       # the cup meets an instability on the way: it jumps
                 raise _Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
-                            f"crossed on the way to {name} {x:.6g}")
+                            f"crossed on the way to {name} {x:.6g}", instability=True)
             return s
         x0, x_prev = (N, prev.N) if k == 0 else (u_m, prev.u_m)
         s = at(x0)
