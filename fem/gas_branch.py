@@ -336,6 +336,7 @@ class _Walk:
         # an incremental friction law crosses instabilities by damped motion: a trial whose path
         # crosses one has jumped (the state after it is the jump's far side, `_root`)
         self.relaxes = bool(getattr(cup.cup.plane.law, "relaxes", False))
+        self.stop_at_crossing = False
         self.staircase = cup.cup.plane.law.name == "sticking"
         self.slopes: dict[_Trial, tuple[float, float]] = {}     # by identity
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
@@ -362,11 +363,11 @@ class _Walk:
             t = -t
         return float(t[0]), float(t[1])
 
-    def solve(self, start: _Trial, u_m: float, N: float, options=None,
-              stop_at_crossing: bool = False) -> _Trial:
+    def solve(self, start: _Trial, u_m: float, N: float, options=None) -> _Trial:
         """The state at (u_m, N), reached from `start` with the plate and N on a line; its
         `crossed` is the state after the first instability the path crossed by damped motion
-        (a law that `relaxes`), where the path stops if `stop_at_crossing`."""
+        (a law that `relaxes`), where the path stops while `stop_at_crossing` is set (`_root`)."""
+        stop_at_crossing = self.stop_at_crossing
         u0, N0 = start.u_m, start.N
         mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
                             schedule=lambda t: N0 + t * (N - N0), relaxes=True)
@@ -423,8 +424,12 @@ class _Walk:
         name = "N" if k == 0 else "the plate position"
 
         def at(x):
-            s = self.solve(prev, u_m, x, self.trial_options, True) if k == 0 else \
-                self.solve(prev, x, N, self.trial_options, True)
+            self.stop_at_crossing = True
+            try:
+                s = self.solve(prev, u_m, x, self.trial_options) if k == 0 else \
+                    self.solve(prev, x, N, self.trial_options)
+            finally:
+                self.stop_at_crossing = False
             if s.crossed is not None:       # the cup meets an instability on the way: it jumps
                 raise _Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
                             f"crossed on the way to {name} {x:.6g}", instability=True)
