@@ -1,7 +1,8 @@
-"""Where a stiffness curve's time goes: cup A, frictionless, u = 0 .. 0.9 h1, per fidelity level.
+"""Where a stiffness curve's time goes: cup A, frictionless, u = 0 .. 0.9 h1, per fidelity level;
+and, with --route-forces, where one lifetime of the route "fem" goes.
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_fem_profile.py [--levels coarse medium]
-        [--contact frictionless] [--repeat 3] [--whole]
+        [--contact frictionless] [--repeat 3] [--whole] [--route-forces 10 [--route-only]]
 
 Runs `fem.cup.compress_cup` in-process (no start-up, no CSV) and prints per curve: load steps,
 Newton iterations, dofs, factorizations, the in-process wall time (first call and the median of
@@ -22,7 +23,18 @@ its share of the wall time:
 
 and, on the tangent of the last factorization of the path (its free block K_ff), the time of one
 factorization by the solver itself and by scipy's sparse LU (`scipy.sparse.linalg.splu`, COLAMD
-ordering): the scale of the linear algebra alone against the time per Newton iteration.
+ordering): the scale of the linear algebra alone against the time per Newton iteration, and
+their ratio (a Newton iteration in units of one factorization of each kind).
+With --route-forces F ..., also `cupcheck lifetime --route fem --cup A --force F --fidelity LEVEL`
+in-process (the command's own work: pressing, sealing, the largest holdable force, the branch,
+the leak), its CPU time per part as above plus
+
+  cavity     the cavity volume, its gradient and Hessian (`fem.cavity.CavitySurface`);
+  sens       the branch's sensitivities dF1/dN, dF1/du (`fem.gas_branch._sensitivities`: a
+             sparse LU of the bordered tangent, outside the solver's factorizations);
+  setup      building a linear solver (`fem.condensation.make_solver`'s orderings and maps);
+
+and the calls of each.
 With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
 --repeat runs, CPU time of the child and wall time), whose excess over the in-process curve is
 start-up (imports), the mesh and the output files.
@@ -33,7 +45,9 @@ quiet machine the wall time, which a busy second core inflates); the wrappers co
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
+import io
 import os
 import resource
 import statistics
@@ -52,14 +66,16 @@ import fem.contact_step  # noqa: E402
 import fem.cup  # noqa: E402
 import fem.factorization  # noqa: E402
 import fem.linsolve  # noqa: E402
+import fem.cavity  # noqa: E402
 import fem.condensation  # noqa: E402
+import fem.gas_branch  # noqa: E402
 from fem.cup import compress_cup  # noqa: E402
 from fem.forms import Mechanics  # noqa: E402
 from fem.geometry import cup_geometry  # noqa: E402
 from fem.material import NeoHookean  # noqa: E402
 from fem.mesh import cup_mesh  # noqa: E402
 
-PARTS = ("assembly", "factor", "solve", "lcp", "post")
+PARTS = ("assembly", "factor", "solve", "lcp", "post", "cavity", "sens", "setup")
 
 
 class Clock:
@@ -113,6 +129,10 @@ def _instrument() -> None:
     fem.contact_step.lcp = w("lcp", fem.contact_step.lcp)
     fem.cup._measure = w("post", fem.cup._measure)
     fem.cup.check_state = w("post", fem.cup.check_state)
+    fem.cavity.CavitySurface._terms = w("cavity", fem.cavity.CavitySurface._terms)
+    fem.gas_branch._sensitivities = w("sens", fem.gas_branch._sensitivities)
+    if hasattr(fem.condensation, "_new_solver"):     # (a solver per path, uncounted, before it)
+        fem.condensation._new_solver = w("setup", fem.condensation._new_solver)
 
 
 def _median_time(fn, repeat: int = 7) -> float:
@@ -155,6 +175,32 @@ def profile_curve(level: str, contact: str, repeat: int) -> dict:
             "free": int(free.sum())}
 
 
+def profile_route(level: str, force_N: float) -> dict:
+    """One `cupcheck lifetime --route fem` in-process: its CPU time and parts (module docstring)."""
+    from validation.cli import main as cli
+    CLOCK.reset()
+    t = time.process_time()
+    with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()):
+        cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level])
+    cpu = time.process_time() - t
+    row = next((line.split() for line in out.getvalue().splitlines()
+                if line.split()[:1] == [f"{force_N:g}"]), ["", "?", "?"])
+    return {"level": level, "force": force_N, "cpu": cpu, "lifetime": row[1], "reason": row[2],
+            "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls)}
+
+
+def report_route(r: dict) -> None:
+    total = r["cpu"]
+    print(f"\nfem route, cup A {r['level']}, F1 = {r['force']:g} N: lifetime {r['lifetime']} s "
+          f"({r['reason']}); in-process CPU time {total:.2f} s")
+    print(f"  {'part':9} {'time/s':>7} {'share':>6} {'calls':>6} {'per call/ms':>11}")
+    for part in PARTS + ("other",):
+        t = r["parts"].get(part, total - sum(r["parts"].values()))
+        calls = r["calls"].get(part, 0)
+        per_call = f"{1e3 * t / calls:11.3f}" if calls else f"{'':11}"
+        print(f"  {part:9} {t:7.3f} {t / total:6.1%} {calls:6d} {per_call}")
+
+
 def whole_process(level: str, contact: str, repeat: int) -> tuple[float, float]:
     """(CPU, wall) [s] of `cupcheck stiffness` for cup A at `level`, the medians of `repeat` runs."""
     root = Path(__file__).resolve().parents[1]
@@ -182,10 +228,11 @@ def report(r: dict) -> None:
           f"(min {r['min']:.3f} s); "
           f"per Newton iteration {1e3 * r['wall'] / n:.2f} ms")
     print(f"  one factorization of the last tangent's K_ff: the solver's own {1e3 * r['own_factor']:.2f} ms, "
-          f"scipy splu {1e3 * r['splu']:.2f} ms")
+          f"scipy splu {1e3 * r['splu']:.2f} ms; a Newton iteration costs "
+          f"{r['wall'] / n / r['own_factor']:.1f} of the former, {r['wall'] / n / r['splu']:.2f} of the latter")
     print(f"  {'part':9} {'time/s':>7} {'share':>6} {'calls':>6} {'per call/ms':>11} {'per iteration/ms':>16}")
     total = r["wall"]
-    for part in PARTS + ("other",):
+    for part in PARTS[:5] + ("other",):
         t = r["parts"].get(part, total - sum(r["parts"].values()))
         calls = r["calls"].get(part, 0)
         per_call = f"{1e3 * t / calls:11.3f}" if calls else f"{'':11}"
@@ -201,13 +248,19 @@ def main() -> None:
     ap.add_argument("--contact", default="frictionless", choices=["frictionless", "sticking"])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--whole", action="store_true", help="also time the whole cupcheck process")
+    ap.add_argument("--route-forces", nargs="*", type=float, default=[],
+                    help="also profile one fem route lifetime per force [N] and level")
+    ap.add_argument("--route-only", action="store_true", help="skip the stiffness curves")
     args = ap.parse_args()
     _instrument()
     for level in args.levels:
-        r = profile_curve(level, args.contact, args.repeat)
-        if args.whole:
-            r["whole_cpu"], r["whole_wall"] = whole_process(level, args.contact, args.repeat)
-        report(r)
+        if not args.route_only:
+            r = profile_curve(level, args.contact, args.repeat)
+            if args.whole:
+                r["whole_cpu"], r["whole_wall"] = whole_process(level, args.contact, args.repeat)
+            report(r)
+        for force in args.route_forces:
+            report_route(profile_route(level, force))
 
 
 if __name__ == "__main__":

@@ -7,7 +7,9 @@
 Every figure is a whole `cupcheck` process (start-up included), the median of --repeat runs:
 `cupcheck --help`, a coarse and a medium frictionless stiffness curve of cup A, the main job cold
 (--no-cache) and warm (its cache filled, the same output directory), one lifetime per route (paper
-and profile at 10 N; the profile route's cost per force from 16 forces against one), and with
+and profile at 10 N; the profile route's cost per further force from 16 forces against one, each
+a `cupcheck lifetime` call in one process after a warm-up call, so that start-up's noise, ~0.1 s
+a process on a loaded machine and 7 ms once divided by 15, stays out of it), and with
 --with-suction a coarse suction table on the default grid and the coupled route's lifetime on it.
 Each is printed beside benchmarks/speed_baseline.json (the same figures on an earlier main) as a
 ratio, new / baseline, so a change's speed-up or slow-down is one number, and beside its target.
@@ -38,7 +40,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = Path(__file__).with_name("speed_baseline.json")
 FORCES = [str(f) for f in range(5, 85, 5)]
-#: the targets [s] (lower is better): whole processes, except profile_per_force
+#: the targets [s] (lower is better): whole processes, except profile_per_force (in one process)
 TARGETS = {"help": 0.15, "curve_coarse": 0.35, "curve_medium": 0.7, "main_cold": 2.0,
            "lifetime_paper": 0.3, "profile_per_force": 0.03, "suction_coarse": 30.0}
 
@@ -62,6 +64,30 @@ class Runner:
         wall = time.perf_counter() - t0
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+    def calls(self, *argvs: list[str]) -> list[tuple[float, float]]:
+        """(wall, CPU) [s] of each `cupcheck ARGV` called in turn in one process (start-up excluded)."""
+        done = subprocess.run([sys.executable, "-c", IN_PROCESS, json.dumps(argvs)], cwd=self.tree,
+                              env=self.env, check=True, capture_output=True, text=True)
+        return [tuple(t) for t in json.loads(done.stdout.strip().splitlines()[-1])]
+
+
+#: runs the argument lists of argv[1] (JSON) through `validation.cli.main`, prints their (wall, CPU)
+IN_PROCESS = """import contextlib, io, json, sys, time
+from validation.cli import main
+times = []
+for argv in json.loads(sys.argv[1]):
+    w, c = time.perf_counter(), time.process_time()
+    with contextlib.redirect_stdout(io.StringIO()):
+        try:
+            status = main(argv)
+        except SystemExit as exc:
+            status = exc.code
+    if status not in (0, None):
+        raise SystemExit(f"cupcheck {' '.join(argv)}: exit status {status}")
+    times.append((time.perf_counter() - w, time.process_time() - c))
+print(json.dumps(times))
+"""
 
 
 def median(run: Callable[[], tuple[float, float]], repeat: int,
@@ -111,8 +137,11 @@ def figures(cli: Runner, repeat: int, with_suction: bool,
         if "lifetime_profile" in only:
             yield "lifetime_profile", one
         if "profile_per_force" in only:
-            many = median(lambda: cli(*profile, *FORCES), repeat)
-            yield "profile_per_force", tuple((m - o) / (len(FORCES) - 1) for m, o in zip(many, one))
+            pairs = cli.calls(profile + ["10"], *[[*profile, *f] for _ in range(repeat) for f in (["10"], FORCES)])
+            extra = [tuple((m - o) / (len(FORCES) - 1) for m, o in zip(pairs[k + 1], pairs[k]))
+                     for k in range(1, len(pairs), 2)]
+            yield "profile_per_force", (statistics.median(e[0] for e in extra),
+                                        statistics.median(e[1] for e in extra))
     if with_suction:
         table = str(w / "suction.json")
         yield "suction_coarse", median(lambda: cli("suction", "--cup", "A", "--fidelity", "coarse",

@@ -98,6 +98,7 @@ class CavitySurface:
     nodes: np.ndarray
     tolerance_m: float
     wetting_m: float = 0.0
+    _chains: dict = field(default_factory=dict, repr=False, compare=False)   # by cut index
 
     @classmethod
     def of(cls, mesh: Mesh, wetting_m: float = 0.0) -> "CavitySurface":
@@ -139,18 +140,33 @@ class CavitySurface:
         dofs 2n (r) and 2n + 1 (z) of node n, as in `fem.kinematics`."""
         return self._terms(x, 2, self.wetting_m)
 
+    def _chain(self, k: int) -> "_Chain":
+        """The chain cut at position k: its edges and their quadrature, dofs and Hessian dof
+        pairs (index work only, kept per cut: a path meets a handful of cuts)."""
+        chain = self._chains.get(k)
+        if chain is None:
+            full_edges, half = divmod(k, 2)
+            edges = self.nodes[2 * np.arange(full_edges + half)[:, None] + np.arange(3)]   # [E, 3]
+            rule = np.zeros(edges.shape[0], int)
+            rule[full_edges:] = 1
+            seal = int(self.nodes[k])
+            dofs = np.concatenate([2 * edges, 2 * edges + 1], axis=1)                   # [E, 6]
+            shape = (edges.shape[0], 6, 6)
+            d = np.array([2 * seal, 2 * seal + 1])
+            pairs = np.concatenate([np.stack([np.broadcast_to(dofs[:, :, None], shape).reshape(-1),
+                                              np.broadcast_to(dofs[:, None, :], shape).reshape(-1)]),
+                                    np.stack([np.repeat(d, 2), np.tile(d, 2)])], axis=1)
+            chain = self._chains[k] = _Chain(edges, _RULES[0][rule], _RULES[1][rule], _RULES[2][rule],
+                                             seal, np.concatenate([dofs.ravel(), d]), pairs)
+        return chain
+
     def _terms(self, x: np.ndarray, order: int, z_ref: float):
         """V_phi = pi r_k^2 Phi(z_k) - pi int_chain r^2 phi(z) dz and its derivatives, the chain
         cut at `cut_index`; all edges at once, in chain order (the last one halved if the cut is
         at a mid-side node)."""
-        k = self.cut_index(x)
-        full_edges, half = divmod(k, 2)
-        edges = self.nodes[2 * np.arange(full_edges + half)[:, None] + np.arange(3)]   # [E, 3]
-        rule = np.zeros(edges.shape[0], int)
-        rule[full_edges:] = 1
-        N, dN, w = _RULES[0][rule], _RULES[1][rule], _RULES[2][rule]    # [E, 3, q], [E, q]
-        seal = self.nodes[k]
-        rk, zk = x[:, seal]
+        c = self._chain(self.cut_index(x))
+        edges, N, dN, w = c.edges, c.N, c.dN, c.w                       # [E, 3], [E, 3, q], [E, q]
+        rk, zk = x[:, c.seal]
         Phi_k, phi_k, dphi_k, _ = (float(v) for v in wetted_fraction(np.array(zk), z_ref))
         xr, xz = x[0, edges], x[1, edges]
         r = np.einsum("eiq,ei->eq", N, xr)
@@ -160,7 +176,6 @@ class CavitySurface:
         V = np.pi * rk**2 * Phi_k - np.pi * np.sum(w * r**2 * phi * dz)
         if not order:
             return (float(V),)
-        dofs = np.concatenate([2 * edges, 2 * edges + 1], axis=1)                   # [E, 6]
         g_r = np.einsum("eiq,eq->ei", N, 2.0 * r * phi * dz * w)
         g_z = np.einsum("eiq,eq->ei", N, r**2 * dphi * dz * w) \
             + np.einsum("eiq,eq->ei", dN, r**2 * phi * w)
@@ -174,16 +189,30 @@ class CavitySurface:
         H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
         B = outer(N, r**2 * dphi * w, dN)
         H[:, 3:, 3:] = outer(N, r**2 * d2phi * dz * w, N) + B + B.transpose(0, 2, 1)
-        rows = np.broadcast_to(dofs[:, :, None], H.shape)
-        cols = np.broadcast_to(dofs[:, None, :], H.shape)
-        d = np.array([2 * seal, 2 * seal + 1])
         seal_grad = np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])
         seal_hess = np.array([2.0 * np.pi * Phi_k, 2.0 * np.pi * rk * phi_k,
                               2.0 * np.pi * rk * phi_k, np.pi * rk**2 * dphi_k])
-        pairs = np.concatenate([np.stack([rows.reshape(-1), cols.reshape(-1)]),
-                                np.stack([np.repeat(d, 2), np.tile(d, 2)])], axis=1)
-        return (float(V), (np.concatenate([dofs.ravel(), d]), np.concatenate([grad.ravel(), seal_grad])),
-                np.concatenate([-np.pi * H.ravel(), seal_hess]), pairs)
+        return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
+                np.concatenate([-np.pi * H.ravel(), seal_hess]), c.pairs)
+
+
+@dataclass(frozen=True)
+class _Chain:
+    """`CavitySurface._chain`: edges [E, 3], shape functions N, dN [E, 3, q] and weights w [E, q]
+    of their rules, the seal node, the gradient's dofs and the Hessian's dof pairs [2, m]
+    (read-only: shared by every evaluation at this cut)."""
+
+    edges: np.ndarray
+    N: np.ndarray
+    dN: np.ndarray
+    w: np.ndarray
+    seal: int
+    dofs: np.ndarray
+    pairs: np.ndarray
+
+    def __post_init__(self) -> None:
+        for a in (self.edges, self.N, self.dN, self.w, self.dofs, self.pairs):
+            a.flags.writeable = False
 
 
 @dataclass
@@ -238,7 +267,18 @@ class PressurizedMechanics:
         return W + self.dp_Pa * V, r, sp.csr_matrix((data, K.indices, K.indptr), shape=K.shape)
 
     def _positions(self, K: sp.csr_matrix, pairs: np.ndarray) -> np.ndarray:
-        """Positions of the dof pairs (i, j) in K's CSR data (sorted column indices per row)."""
+        """Positions of the dof pairs (i, j) in K's CSR data (sorted column indices per row);
+        kept for a read-only `pairs` (a cut's, `CavitySurface._chain`) and K's pattern."""
+        key = ("positions", id(pairs), K.nnz)
+        kept = self._table.get(key)
+        if kept is not None and kept[0] is pairs:
+            return kept[1]
+        pos = self._search(K, pairs)
+        if not pairs.flags.writeable:
+            self._table[key] = (pairs, pos)
+        return pos
+
+    def _search(self, K: sp.csr_matrix, pairs: np.ndarray) -> np.ndarray:
         table = self._lookup(K)
         keys = pairs[0].astype(np.int64) * K.shape[0] + pairs[1]
         pos = np.searchsorted(table, keys)

@@ -21,18 +21,64 @@ they are (`make_solver`).
 
 from __future__ import annotations
 
+import weakref
+from collections.abc import Callable
+
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from skfem import Mesh, MeshQuad2
 
 from .linsolve import BandedCholesky, BorderedFactor, NotPositiveDefinite, _constrained_rhs, strip_ordering
 
-__all__ = ["CondensedCholesky", "make_solver", "interior_nodes"]
+__all__ = ["CondensedCholesky", "free_block_solver", "make_solver", "interior_nodes"]
 
 
 def make_solver(pattern: sp.csr_matrix, coordinates: np.ndarray, mesh: Mesh | None = None):
     """The linear solver for the tangent's pattern: condensed if the mesh has element-interior
-    nodes that couple only within their element, otherwise the plain banded Cholesky."""
+    nodes that couple only within their element, otherwise the plain banded Cholesky. For a mesh,
+    the solver of the last call is reused while the mesh, its node coordinates and the pattern
+    are the same (a solver holds the ordering and the condensation maps only, each factorization
+    is a new object): a suction table or a cup's lifetime runs hundreds of paths on one mesh."""
+    if mesh is None:
+        return _new_solver(pattern, coordinates, None)
+    kept = _SOLVERS.get(id(mesh))
+    if kept is not None and kept[0]() is mesh and kept[1].shape == pattern.shape \
+            and np.array_equal(kept[1].indptr, pattern.indptr) \
+            and np.array_equal(kept[1].indices, pattern.indices) and np.array_equal(kept[2], coordinates):
+        return kept[3]
+    solver = _new_solver(pattern, coordinates, mesh)
+    for key in [k for k, v in _SOLVERS.items() if v[0]() is None]:
+        del _SOLVERS[key]
+    _SOLVERS[id(mesh)] = (weakref.ref(mesh), sp.csr_matrix((np.zeros(pattern.nnz), pattern.indices.copy(),
+                                                             pattern.indptr.copy()), shape=pattern.shape),
+                          np.array(coordinates, copy=True), solver)
+    return solver
+
+
+_SOLVERS: dict[int, tuple] = {}      # id(mesh) -> (weakref to the mesh, pattern, coordinates, solver)
+
+
+def free_block_solver(K: sp.csr_matrix, free: np.ndarray, coordinates: np.ndarray, mesh: Mesh | None,
+                      symmetric: bool) -> Callable[[np.ndarray], np.ndarray]:
+    """x_f = K_ff^-1 b_f for b_f given on the free dofs ([nf] or [nf, m]): by the mesh's banded
+    Cholesky factor (`make_solver`, K in the tangent's pattern) where K is `symmetric` and K_ff
+    positive definite, otherwise by scipy's sparse LU of K_ff (indefinite or unsymmetric)."""
+    if symmetric:
+        try:
+            factor = make_solver(K, coordinates, mesh).factor(K, free)
+        except (NotPositiveDefinite, ValueError):
+            pass
+        else:
+            def solve(b: np.ndarray) -> np.ndarray:
+                full = np.zeros((len(free),) + b.shape[1:])
+                full[free] = b
+                return factor.solve(full)[free]
+            return solve
+    return spla.splu(sp.csr_matrix(K)[free][:, free].tocsc()).solve
+
+
+def _new_solver(pattern: sp.csr_matrix, coordinates: np.ndarray, mesh: Mesh | None):
     bubbles = interior_nodes(mesh, pattern) if mesh is not None else None
     if bubbles is None:
         return BandedCholesky(pattern, coordinates, mesh)

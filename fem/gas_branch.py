@@ -143,12 +143,14 @@ def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float,
 
 def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: float = 0.1e-3,
                        u_min_m: float | None = None, max_states: int = 400,
-                       progress: Callable[[int, float, float], None] | None = None) -> Branch:
+                       progress: Callable[[int, float, float], None] | None = None,
+                       walk: type | None = None) -> Branch:
     """The states holding the pull F1_N from `sealed` (a "pressed" state, sealed there at p_a, or
     a sealed state) to detachment (module docstring). du_m: the plate step along the branch
     (halved, down to du_m / 16, where a state cannot be found); u_min_m: the lowest plate
     position (default -h1: the plate above the touching height, the suction holding the wall on
-    the plane); progress(k, u_m, N): called with every state k of the branch as it is found.
+    the plane); progress(k, u_m, N): called with every state k of the branch as it is found;
+    walk: the walk's class for another cavity content (None: the gas's; `fem.water_branch`).
     Raises ValueError for bad input; where no state is found even with the smallest step, the
     branch ends there with reason "stopped: <why>" and no detachment."""
     if not (isinstance(F1_N, (int, float)) and math.isfinite(F1_N)):
@@ -159,7 +161,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     if not (u_min < sealed.u_m):
         raise ValueError(f"u_min_m: must be below the sealed plate position {sealed.u_m * 1e3:.4g} mm, "
                          f"got {u_min * 1e3:.4g} mm")
-    walk = _Walk(cup, float(F1_N))
+    walk = (walk or _Walk)(cup, float(F1_N))
     start = _Trial(sealed.u_m, sealed.N, sealed.F1_N, sealed.state)
     try:
         first = walk.pull_to_force(start, du_m, u_min)
@@ -260,12 +262,13 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
 
 
-def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float) -> GasState | None:
+def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float,
+                  walk: type | None = None) -> GasState | None:
     """A state holding F1_N between two consecutive states a and b of a branch, reached from a
     (its history): N the unknown at the plate midway, or where that fails, the plate at N
     midway. None where neither is found between them, or where the way there crosses an
-    instability (a jump of the pull between a and b)."""
-    walk = _Walk(cup, float(F1_N))
+    instability (a jump of the pull between a and b). walk: as `equilibrium_branch`'s."""
+    walk = (walk or _Walk)(cup, float(F1_N))
     prev = _Trial(a.u_m, a.N, a.F1_N, a.state)
     u, N = 0.5 * (a.u_m + b.u_m), 0.5 * (a.N + b.N)
     for find in (walk.hold, walk.hold_u):

@@ -6,7 +6,9 @@ formula at the ends, as scipy's `PchipInterpolator`; `pchip_coefficients`) and e
 with `bisect` and Horner's rule on Python floats, about a microsecond per call; numpy arrays
 likewise (`values_and_slopes`). Outside the sampled range it raises `CurveRangeError` (never
 clamps). It is computed here, not by scipy.interpolate, whose import alone costs ~0.4 s of a
-reduced-model command's start-up.
+reduced-model command's start-up. So is `spline_coefficients`, the not-a-knot cubic spline of
+scipy's `CubicSpline` (its tridiagonal system solved in the order of LAPACK's dgtsv, which
+CubicSpline calls, and its coefficients formed as scipy forms them: bit for bit scipy's).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from bisect import bisect_right
 
 import numpy as np
 
-__all__ = ["CurveRangeError", "ScalarPchip", "pchip_coefficients"]
+__all__ = ["CurveRangeError", "ScalarPchip", "pchip_coefficients", "spline_coefficients"]
 
 
 class CurveRangeError(ValueError):
@@ -35,14 +37,7 @@ def _end_slope(h0: float, h1: float, m0: float, m1: float) -> float:
 def pchip_coefficients(x, y) -> tuple[np.ndarray, np.ndarray]:
     """(x, c): the knots and the coefficients c[k, i] of (x - x_i)^(3-k) of the PCHIP interpolant
     through (x, y) (x strictly increasing, at least 2 points); c is laid out as scipy's PPoly."""
-    x, y = np.asarray(x, float), np.asarray(y, float)
-    if x.ndim != 1 or x.shape != y.shape or x.size < 2:
-        raise ValueError(f"x, y: need two 1D arrays of equal length >= 2, got {x.shape}, {y.shape}")
-    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
-        raise ValueError("x, y: must be finite")
-    h = np.diff(x)
-    if np.any(h <= 0.0):
-        raise ValueError("x: must be strictly increasing")
+    x, y, h = _knots(x, y, 2)
     m = np.diff(y) / h                                       # the secants
     if x.size == 2:
         d = np.array([m[0], m[0]])
@@ -55,13 +50,93 @@ def pchip_coefficients(x, y) -> tuple[np.ndarray, np.ndarray]:
             d[1:-1] = np.where(same, 1.0 / harmonic, 0.0)
         d[0] = _end_slope(h[0], h[1], m[0], m[1])
         d[-1] = _end_slope(h[-1], h[-2], m[-1], m[-2])
+    return x, _hermite(x, y, h, m, d)
+
+
+def spline_coefficients(x, y) -> tuple[np.ndarray, np.ndarray]:
+    """(x, c) of the cubic spline through (x, y) with not-a-knot ends (x strictly increasing, at
+    least 4 points), laid out as `pchip_coefficients`: C2 at the knots, its third derivative also
+    continuous at the second and the last but one (scipy's `CubicSpline(x, y)`, bit for bit)."""
+    x, y, h = _knots(x, y, 4)
+    m = np.diff(y) / h
+    n = x.size
+    # the slopes d at the knots: continuity of the second derivative inside, not-a-knot at the ends
+    lower, diag, upper = np.zeros(n), np.zeros(n), np.zeros(n)
+    diag[1:-1] = 2 * (h[:-1] + h[1:])
+    upper[1:-1] = h[:-1]
+    lower[:-2] = h[1:]
+    rhs = np.empty(n)
+    rhs[1:-1] = 3 * (h[1:] * m[:-1] + h[:-1] * m[1:])
+    diag[0], upper[0] = h[1], x[2] - x[0]
+    w = x[2] - x[0]
+    rhs[0] = ((h[0] + 2 * w) * h[1] * m[0] + h[0] ** 2 * m[1]) / w
+    diag[-1], lower[-2] = h[-2], x[-1] - x[-3]
+    w = x[-1] - x[-3]
+    rhs[-1] = (h[-1] ** 2 * m[-2] + (2 * w + h[-1]) * h[-2] * m[-1]) / w
+    d = np.array(_tridiagonal_solve(lower[:-1].tolist(), diag.tolist(), upper[:-1].tolist(), rhs.tolist()))
+    return x, _hermite(x, y, h, m, d)
+
+
+def _tridiagonal_solve(dl: list[float], d: list[float], du: list[float], b: list[float]) -> list[float]:
+    """The solution of the tridiagonal system with sub-, main and super-diagonal dl, d, du (lists,
+    overwritten) and right-hand side b, by Gaussian elimination with partial pivoting, operation
+    for operation LAPACK's dgtsv with one right-hand side, on Python floats: the result is the one
+    scipy's solve_banded returns. dl[i] holds the second super-diagonal's fill-in after a row
+    interchange, as in dgtsv."""
+    n = len(d)
+    for i in range(n - 1):
+        if abs(d[i]) >= abs(dl[i]):           # no row interchange
+            if d[i] == 0.0:
+                raise ValueError("spline: singular system")
+            fact = dl[i] / d[i]
+            d[i + 1] = d[i + 1] - fact * du[i]
+            b[i + 1] = b[i + 1] - fact * b[i]
+            dl[i] = 0.0
+        else:                                  # interchange rows i and i + 1
+            fact = d[i] / dl[i]
+            d[i] = dl[i]
+            temp = d[i + 1]
+            d[i + 1] = du[i] - fact * temp
+            if i < n - 2:
+                dl[i] = du[i + 1]
+                du[i + 1] = -fact * dl[i]
+            du[i] = temp
+            temp = b[i]
+            b[i] = b[i + 1]
+            b[i + 1] = temp - fact * b[i + 1]
+    if d[n - 1] == 0.0:
+        raise ValueError("spline: singular system")
+    b[n - 1] = b[n - 1] / d[n - 1]
+    b[n - 2] = (b[n - 2] - du[n - 2] * b[n - 1]) / d[n - 2]
+    for i in range(n - 3, -1, -1):
+        b[i] = (b[i] - du[i] * b[i + 1] - dl[i] * b[i + 2]) / d[i]
+    return b
+
+
+def _knots(x, y, least: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """x, y as float arrays and the knot spacing h, checked: 1D, equal length >= least, finite,
+    x strictly increasing."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    if x.ndim != 1 or x.shape != y.shape or x.size < least:
+        raise ValueError(f"x, y: need two 1D arrays of equal length >= {least}, got {x.shape}, {y.shape}")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
+        raise ValueError("x, y: must be finite")
+    h = np.diff(x)
+    if np.any(h <= 0.0):
+        raise ValueError("x: must be strictly increasing")
+    return x, y, h
+
+
+def _hermite(x: np.ndarray, y: np.ndarray, h: np.ndarray, m: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """The coefficients c[k, i] of the cubic Hermite interpolant with slopes d at the knots
+    (secants m), formed as scipy's CubicHermiteSpline forms them."""
     t = (d[:-1] + d[1:] - 2.0 * m) / h
     c = np.empty((4, x.size - 1))
     c[0] = t / h
     c[1] = (m - d[:-1]) / h - t
     c[2] = d[:-1]
     c[3] = y[:-1]
-    return x, c
+    return c
 
 
 class ScalarPchip:

@@ -44,6 +44,7 @@ from bisect import bisect_right
 
 import numpy as np
 
+from reduced.fast_curve import spline_coefficients
 from reduced.gas import Gas, ballistic_share, interpolated_leak_rate, liquid_volume_rate
 from reduced.profile_leak import (ContactProfile, patch_average, patch_contact, profile_leak_rate,
                                   profile_leak_rates, profile_liquid_rate, ring_gaps)
@@ -323,10 +324,9 @@ class PbTable:
     TAU = np.unique(np.concatenate([np.arange(-14.0, -5.0, 0.1), np.linspace(-5.0, math.log(0.999), 251)]))
 
     def __init__(self, tau: np.ndarray, log_ratio: np.ndarray, p_a: float):
-        from scipy.interpolate import CubicSpline     # here: scipy.interpolate costs ~0.4 s to import
-        spline = CubicSpline(tau, log_ratio)
-        self.x = [float(v) for v in spline.x]
-        self.c3, self.c2, self.c1, self.c0 = ([float(v) for v in row] for row in spline.c)
+        x, c = spline_coefficients(tau, log_ratio)     # scipy's CubicSpline, without its import
+        self.x = [float(v) for v in x]
+        self.c3, self.c2, self.c1, self.c0 = ([float(v) for v in row] for row in c)
         self.lo, self.hi, self.pa = self.x[0], self.x[-1], p_a
 
     def __call__(self, drop: float) -> float | None:

@@ -34,7 +34,17 @@ HEAD = {
                "linked into the new directory, mtimes unchanged); an edited input redraws only the outputs "
                "made from it, an edited or deleted file only its own output, and a rerun that changes "
                "nothing writes nothing (`cupcheck run` says the files are up to date). `--no-cache` draws "
-               "everything afresh."),
+               "everything afresh.\n\n"
+               "**A late FEM failure keeps its converged part.** When the FEM path of the stiffness curve "
+               "fails after some converged steps (e.g. cup A, sticking, coarse, `stiffness.u_max_mm` = h1: "
+               "the wall folds into the plate at u = 8.921 mm), the curve is its converged part, flagged "
+               "partial (`\"partial\": true`, `failed_at_u_mm`, `failure_reason`, `u_max_mm_that_runs` in "
+               "the curve's sidecar; a `curve_partial_to_u_mm` column in the lifetime tables; `partial` in "
+               "the manifest). A lifetime that needs a state beyond it is refused for its force (reason "
+               "`beyond_partial_curve`), the others are computed. `cupcheck run` names the "
+               "`stiffness.u_max_mm` that runs in one line and exits with status 3, also on an up-to-date "
+               "rerun. The 3D views (render, footprint, squeeze) need their FEM path to reach their "
+               "`u_mm`: a path that stops short fails them."),
     "sweeps": ("# Sweep files: every key",
                "A sweep file (TOML) names a base design and the axes to vary; `cupcheck sweep SWEEP.toml "
                "--out DIR` evaluates every design on dask and keeps one committed result per design in DIR "

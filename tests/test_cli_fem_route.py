@@ -46,7 +46,7 @@ def test_cli_lifetime_equals_the_python_call(capsys, tmp_path):
 @pytest.mark.parametrize("extra,field", [
     (["--stiffness", "curve.csv"], "--route: .*drop --stiffness"),
     (["--suction-table", "t.json"], "--route: .*drop --suction-table"),
-    (["--fluid", "water"], "--route: .*drop --fluid"),
+    (["--fluid", "water", "--cavitation-kPa", "2.34"], "--route: .*drop --cavitation-kPa"),
     (["--relaxation", "default"], "--route: .*drop --relaxation"),
     (["--cup-laws", "curve"], "--route: .*drop --cup-laws"),
     (["--kappa", "2"], "--route: .*drop --kappa"),

@@ -1,15 +1,19 @@
 """`reduced.fast_curve` computes the PCHIP interpolant itself (so a reduced-model command need not
 import scipy.interpolate): its coefficients and its array evaluation are scipy's
 `PchipInterpolator`, bit for bit (a second implementation of the same published algorithm, Fritsch
-& Butland's monotone slopes), and the scalar Horner path agrees with both to round-off."""
+& Butland's monotone slopes), and the scalar Horner path agrees with both to round-off. Its
+not-a-knot cubic spline (the profile route's flow tables) is scipy's `CubicSpline`, bit for bit,
+also where the tridiagonal solve interchanges rows, and reproduces a cubic exactly."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.interpolate import PchipInterpolator
+from scipy.interpolate import CubicSpline, PchipInterpolator
 
-from reduced.fast_curve import CurveRangeError, ScalarPchip, pchip_coefficients
+from reduced.fast_curve import (CurveRangeError, ScalarPchip, _tridiagonal_solve, pchip_coefficients,
+                                 spline_coefficients)
+from reduced.seal import PbTable
 
 
 def _cases(seed: int = 3, count: int = 120):
@@ -79,3 +83,68 @@ def test_the_uc_tables_array_path_is_scipys_pchip_in_log_log_bit_for_bit():
                                np.where(t > lx[-1], ly[-1] + s1 * (t - lx[-1]),
                                         cubic(np.clip(t, lx[0], lx[-1])))))
     assert np.array_equal(table.values(x), expected)
+
+
+def _spline_cases(seed: int = 6, count: int = 200):
+    """Knots from even to wildly uneven (neighbouring spacings up to ~1e4 apart: there the
+    elimination interchanges rows), values smooth or random, 4 to 400 points."""
+    rng = np.random.default_rng(seed)
+    for k in range(count):
+        n = int(rng.integers(4, 400)) if k % 4 else int(rng.integers(4, 7))
+        x = np.cumsum(rng.lognormal(sigma=3.0 * (k % 3) / 2, size=n)) * 10.0 ** rng.uniform(-6, 3)
+        y = np.sin(x / x[-1] * 7.0) if k % 2 else rng.normal(size=n) * 10.0 ** rng.uniform(-5, 5)
+        yield x, y
+
+
+def test_the_spline_is_scipys_cubic_spline_bit_for_bit():
+    for x, y in [*_spline_cases(), (PbTable.TAU, np.log1p(np.exp(PbTable.TAU)) - 0.3 * PbTable.TAU ** 2)]:
+        knots, c = spline_coefficients(x, y)
+        spline = CubicSpline(x, y)
+        assert np.array_equal(knots, spline.x) and np.array_equal(c, spline.c), (x, y)
+
+
+def test_the_cases_include_row_interchanges():
+    """The test above can fail on the pivoting branch: some of its systems take it (|d_i| < |dl_i|)."""
+    pivoted = 0
+    for x, _ in _spline_cases():
+        h = np.diff(x)
+        d = [float(h[1])] + list(2 * (h[:-1] + h[1:])) + [float(h[-2])]
+        dl = list(h[1:]) + [float(x[-1] - x[-3])]
+        du = [float(x[2] - x[0])] + list(h[:-1])
+        seen = []
+        _tridiagonal_solve(_Watch(dl, seen, d), d, du, [1.0] * len(d))
+        pivoted += any(seen)
+    assert pivoted >= 10
+
+
+class _Watch(list):
+    """dl that records, at each elimination step i, whether |d_i| < |dl_i| (a row interchange)."""
+
+    def __init__(self, dl, seen, d):
+        super().__init__(dl)
+        self.seen, self.d, self.at = seen, d, set()
+
+    def __getitem__(self, i):
+        if i not in self.at:
+            self.at.add(i)
+            self.seen.append(abs(self.d[i]) < abs(super().__getitem__(i)))
+        return super().__getitem__(i)
+
+
+def test_the_spline_reproduces_a_cubic():
+    """Not-a-knot ends: a cubic polynomial is its own spline, on any knots (an exact property)."""
+    rng = np.random.default_rng(8)
+    x = np.cumsum(rng.uniform(0.01, 1.0, 30))
+    poly = np.array([0.3, -1.2, 2.0, 0.7])
+    knots, c = spline_coefficients(x, np.polyval(poly, x))
+    at = rng.uniform(x[0], x[-1], 200)
+    i = np.clip(np.searchsorted(knots, at, side="right") - 1, 0, knots.size - 2)
+    d = at - knots[i]
+    values = ((c[0, i] * d + c[1, i]) * d + c[2, i]) * d + c[3, i]
+    assert np.allclose(values, np.polyval(poly, at), rtol=1e-12, atol=1e-12)
+    assert np.allclose(c[0], poly[0], rtol=1e-9)         # one cubic throughout: the same leading coefficient
+
+
+def test_a_spline_needs_four_knots():
+    with pytest.raises(ValueError, match=">= 4"):
+        spline_coefficients([0.0, 1.0, 2.0], [0.0, 1.0, 0.0])

@@ -49,6 +49,23 @@ def test_quad9_meshes_are_condensed_with_a_narrower_band(system):
     assert isinstance(make_solver(K_tri, tri.doflocs, tri), BandedCholesky)
 
 
+def test_a_mesh_keeps_its_solver_while_its_pattern_and_nodes_are_the_same(system):
+    """make_solver on the same mesh, pattern and coordinates returns the solver it built, whose
+    factor solves like a new solver's to the last bit; moved nodes or another pattern build anew."""
+    mesh, K, free, du_fixed, _, rng = system
+    solver = make_solver(K, mesh.doflocs, mesh)
+    assert make_solver(K.copy(), mesh.doflocs.copy(), mesh) is solver
+    fresh = CondensedCholesky(K, mesh.doflocs, mesh, interior_nodes(mesh, K))
+    rhs = rng.normal(size=K.shape[0])
+    assert np.array_equal(solver.factor(K, free).solve(rhs, du_fixed), fresh.factor(K, free).solve(rhs, du_fixed))
+    assert make_solver(K, mesh.doflocs * 1.01, mesh) is not solver
+    assert make_solver(K, mesh.doflocs, mesh) is not solver            # the last call's is kept
+    n = K.shape[0]
+    other = sp.csr_matrix(K + sp.coo_matrix(([1.0, 1.0], ([0, n - 1], [n - 1, 0])), shape=K.shape))
+    assert other.nnz == K.nnz + 2                                      # one more coupling
+    assert make_solver(other, mesh.doflocs, mesh) is not make_solver(K, mesh.doflocs, mesh)
+
+
 @pytest.mark.parametrize("shift", [0.0, 1e-3])
 def test_condensed_solve_equals_the_full_factorization(system, shift):
     mesh, K, free, du_fixed, _, rng = system
@@ -128,3 +145,25 @@ def test_a_path_with_factor_reuse_equals_one_without(monkeypatch):
     assert reused.stats.factorizations < fresh.stats.factorizations
     assert np.array_equal(reused.u_m, fresh.u_m) and np.array_equal(reused.F0_N, fresh.F0_N)
     assert all(np.array_equal(a, b) for a, b in zip(reused.displacements, fresh.displacements))
+
+
+def test_free_block_solver_uses_the_cholesky_factor_where_it_can_and_lu_elsewhere(system, monkeypatch):
+    """K_ff^-1 b_f: by the mesh's Cholesky factor for a symmetric positive definite K_ff (no
+    sparse LU made), by LU for an indefinite or unsymmetric one; all equal a dense solve."""
+    import fem.condensation
+    from fem.condensation import free_block_solver
+    mesh, K, free, _, _, rng = system
+    b = rng.normal(size=(int(free.sum()), 3))
+    K_ff = K[free][:, free].toarray()
+    lu = fem.condensation.spla.splu
+    monkeypatch.setattr(fem.condensation.spla, "splu", lambda *a, **k: pytest.fail("LU of a definite K_ff"))
+    x = free_block_solver(K, free, mesh.doflocs, mesh, symmetric=True)(b)
+    assert _close(x, np.linalg.solve(K_ff, b))
+    made = []
+    monkeypatch.setattr(fem.condensation.spla, "splu", lambda A: made.append(A) or lu(A))
+    indefinite = sp.csr_matrix(K - 2.0 * abs(K).max() * sp.diags((np.arange(K.shape[0]) == 7).astype(float)))
+    x = free_block_solver(indefinite, free, mesh.doflocs, mesh, symmetric=True)(b[:, 0])
+    assert len(made) == 1 and _close(x, np.linalg.solve(indefinite[free][:, free].toarray(), b[:, 0]))
+    unsymmetric = sp.csr_matrix(K + 1e-3 * sp.triu(K, 1))
+    x = free_block_solver(unsymmetric, free, mesh.doflocs, mesh, symmetric=False)(b)
+    assert len(made) == 2 and _close(x, np.linalg.solve(unsymmetric[free][:, free].toarray(), b))

@@ -333,3 +333,35 @@ def test_the_validate_pareto_figure_reads(measured, tmp_path):
     print(m["log_ticks"])
     assert m["clipped"] == [] and not m["x_overlap"]
     assert len(m["log_ticks"]) == 4 and all(len(t) >= 3 for t in m["log_ticks"])
+
+
+def test_sweep_figures_name_the_base_design_law_mesh_route_and_surface(measured, tmp_path):
+    """A sweep's maps and Pareto figure carry the caption of what its designs share (the shipped
+    alpha x thickness sweep's base: cup A, sticking, coarse, paper route, pmma-1.89) and what they
+    vary, unclipped."""
+    from pathlib import Path
+
+    from validation.sweeps.figures import sweep_caption, sweep_figures
+    from validation.sweeps.spec import load_sweep
+
+    spec = load_sweep(Path(__file__).parents[1] / "scenes" / "sweep_alpha_thickness.toml")
+    caption = sweep_caption(spec.base, [a["name"] for a in spec.axes])
+    assert caption == ("base cup A; FEM sticking (coarse mesh); paper route; pmma-1.89"
+                       "\nvaried: cone angle \u03b1 (deg), wall thickness d0 at r0 (mm)")
+    assert "contact law varied" in sweep_caption({**spec.base, "contact": "coulomb"}, ["friction"])
+    table = _sweep_table(tmp_path, [(25.0, "frictionless"), (33.0, "sticking")], [600, 900])
+    seen = []
+    import matplotlib.figure
+    monkey = matplotlib.figure.Figure.suptitle
+
+    def recording(fig, text, **kw):
+        seen.append(text)
+        return monkey(fig, text, **kw)
+
+    matplotlib.figure.Figure.suptitle = recording
+    try:
+        paths = sweep_figures(table, ["alpha_deg", "contact"], tmp_path, caption)
+    finally:
+        matplotlib.figure.Figure.suptitle = monkey
+    assert len(paths) == 3 and seen == [caption] * 3
+    assert all(m["clipped"] == [] for m in measured)

@@ -263,3 +263,31 @@ def test_a_view_beyond_h1_exits_2_and_writes_nothing(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "u_mm must be in (0, h1] = (0, 9.092] mm, got 50" in err[0]
     assert not (tmp_path / "out").exists() and "fem_path" not in pipeline.COMPUTED
+
+
+def test_everything_a_figure_draws_is_in_its_data_table(tmp_path):
+    """The lifetime figure of a FEM study of cup A draws the FEM-fed lifetimes and, beside them,
+    the Appendix A-fed ones: its <name>_data.csv has both series, point by point, equal to the
+    lifetime table and to the Appendix A study's own lifetimes; the F0(u) figure's has the curve."""
+    import pandas as pd
+
+    scene = {"loads": {"F1_N": [10, 40]}, "outputs": [
+        {"kind": "lifetimes"}, {"kind": "figure", "figure": "lifetime_vs_force"}, {"kind": "curve"},
+        {"kind": "figure", "figure": "F0_vs_u"}]}
+    result = run_scene(scene, tmp_path / "out")
+    out = tmp_path / "out"
+    data = pd.read_csv(out / "lifetime_vs_force_data.csv")
+    assert set(data["series"]) == {"fem-fed, paper route", "appendix-a-fed, paper route"}
+    assert set(data["x_quantity"]) == {"pull force F_1 (N)"} and set(data["y_quantity"]) == {"lifetime (s)"}
+    fem = data[data["series"] == "fem-fed, paper route"]
+    table = pd.read_csv(out / "lifetimes.csv")
+    assert list(fem["x"]) == list(table["force_N"]) and list(fem["y"]) == pytest.approx(list(table["lifetime_s"]), rel=1e-9)
+    from validation.bridge.products import Products
+    reference = Products(scene_from_mapping(scene).study()).appendix_a().lifetimes()
+    appendix = data[data["series"] == "appendix-a-fed, paper route"]
+    assert list(appendix["y"]) == pytest.approx([r.lifetime_s for r in reference], rel=1e-9)
+    F0 = pd.read_csv(out / "F0_vs_u_data.csv")
+    curve = pd.read_csv(out / "curve.csv")
+    drawn = F0[F0["series"] == "fem"]
+    assert list(drawn["x"]) == pytest.approx(list(curve["u_mm"])) and list(drawn["y"]) == pytest.approx(list(curve["F0_N"]))
+    assert {f["path"].rsplit("/", 1)[-1] for f in result.files} >= {"lifetime_vs_force_data.csv", "F0_vs_u_data.csv"}

@@ -3,7 +3,8 @@ module (nor numpy); a reduced-model-only command (`lifetime --route paper`, `uc`
 machinery, no plotting, no dask, no pyvista, no scipy.signal; the paper route's lifetime on a preset
 surface imports no scipy at all (its u_c table is stored, its interpolants and roots are the
 project's own: scipy.interpolate and scipy.optimize cost ~0.5 s to import, more than the command);
-a stiffness curve without a mesh file imports no meshio. Each case is a fresh process (the modules
+the profile route's lifetime on an FEM curve's CSV imports no scipy either (its flow tables' spline
+is the project's own); a stiffness curve without a mesh file imports no meshio. Each case is a fresh process (the modules
 a test session has already loaded say nothing), its `sys.modules` read after the command ran.
 """
 
@@ -84,13 +85,30 @@ def test_the_paper_route_imports_no_scipy(argv, tmp_path):
     assert {"reduced.force_balance", "reduced.critical_gap", "reduced.roughness.stored"} <= modules
 
 
-def test_a_fem_command_does_import_the_fem(tmp_path):
+@pytest.fixture(scope="module")
+def coarse_curve(tmp_path_factory) -> tuple[Path, set[str]]:
+    """A coarse cup A curve (CSV and sidecar with its profiles) and the modules its command loaded."""
+    tmp = tmp_path_factory.mktemp("coarse")
+    modules = _modules_after(["stiffness", "--cup", "A", "--fidelity", "coarse", "--out", str(tmp / "c.csv")], tmp)
+    return tmp / "c.csv", modules
+
+
+def test_a_fem_command_does_import_the_fem(coarse_curve):
     """The checks above see imports: a command that runs the FEM shows skfem (and scipy); without
     a mesh file it reads none (no meshio)."""
-    modules = _modules_after(["stiffness", "--cup", "A", "--fidelity", "coarse", "--out",
-                              str(tmp_path / "c.csv")], tmp_path)
+    _, modules = coarse_curve
     assert {"skfem", "scipy"} <= _top(modules)
     assert "meshio" not in _top(modules)
+
+
+def test_the_profile_route_on_a_curve_imports_no_scipy(coarse_curve, tmp_path):
+    curve, _ = coarse_curve
+    modules = _modules_after(["lifetime", "--stiffness", str(curve), "--route", "profile", "--surface",
+                              "pmma-1.89", "--force", "10", "40"], tmp_path)
+    assert "scipy" not in _top(modules), sorted(m for m in modules if m.startswith("scipy"))[:10]
+    assert not _top(modules) & set(HEAVY)
+    # the test can fail: the lifetime went through the profile's flow tables
+    assert {"reduced.seal", "reduced.profile_leak", "reduced.fast_curve"} <= modules
 
 
 @pytest.mark.parametrize("name", COMMANDS)

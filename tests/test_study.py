@@ -92,9 +92,12 @@ def test_scene_tables_and_figures_name_what_they_were_computed_for(tmp_path):
     table = pd.read_csv(tmp_path / "out" / "life.csv", keep_default_na=False)
     assert list(table.columns[:7]) == ["preset", "design", "contact", "mesh", "route", "surface", "force_N"]
     assert list(table.design) == ["cup A", "cup A", "cup B", "cup B"] and set(table.route) == {"paper"}
-    assert {f["path"].rsplit(".", 1)[1] for f in result.files if f["kind"] == "figure"} == {"png", "svg"}
+    assert {f["path"].rsplit(".", 1)[1] for f in result.files if f["kind"] == "figure"} == {"png", "svg", "csv"}
     svg = (tmp_path / "out" / "lifetime_vs_force.svg").read_text()
     assert "cups A, B; Appendix A (d0 2 mm); paper route; pmma-1.89" in svg
+    data = pd.read_csv(tmp_path / "out" / "lifetime_vs_force_data.csv")     # what the figure draws
+    assert set(data.figure) == {"cups A, B; Appendix A (d0 2 mm); paper route; pmma-1.89"}
+    assert set(data.series) == {"cup A", "cup B"}
 
 
 def test_scene_figures_keep_their_captions_on_the_canvas(tmp_path, monkeypatch):

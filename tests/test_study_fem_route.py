@@ -43,7 +43,6 @@ def test_a_fem_scene_is_the_fem_routes_cup_and_press():
 
 @pytest.mark.parametrize("data,message", [
     (_fem(stiffness={"source": "appendix-a"}), "stiffness.route: 'fem' needs source = \"fem\""),
-    (_fem(fluid={"kind": "water"}), "fluid.kind: the fem route models a gas-filled cavity only"),
     (_fem(material={"relaxation": "default"}), "material.relaxation: the fem route's wall"),
     (_fem(loads={"kappa": 2}), "loads.kappa: the fem route's stiffness is the FEM's own"),
     (_fem(sweep={"key": "loads.kappa", "values": [1, 2]}), "sweep.key: the fem route's stiffness"),

@@ -71,6 +71,23 @@ def test_an_unchanged_rerun_writes_nothing(scene, capsys):
         assert len(entry["key"]) == 32 and len(entry["sha256"]) == 64
 
 
+def test_a_rerun_leaves_no_file_its_manifest_does_not_list(scene, capsys):
+    """A file put into the output directory after a run (an old figure) is not part of the run: the
+    unchanged rerun is then not up to date, keeps its intact outputs (same inodes) and replaces
+    the directory, so only what the manifest lists stays."""
+    out = scene / "out"
+    _run(scene, capsys)
+    first = _stamps(out)
+    (out / "old_figure.png").write_bytes(b"not this run's")
+    pipeline.COMPUTED.clear()
+    said = _run(scene, capsys)
+    assert "up to date" not in said and "3 unchanged kept" in said and not pipeline.COMPUTED
+    assert set(_stamps(out)) == set(first)
+    assert all(_stamps(out)[name][0] == first[name][0] for name in first if name != "manifest.json")
+    listed = {f["path"] for f in json.loads((out / "manifest.json").read_text())["files"]}
+    assert {p.name for p in out.iterdir()} == listed | {"manifest.json"}
+
+
 def test_an_edited_input_file_redraws_what_is_made_from_it(scene, capsys):
     out = scene / "out"
     _run(scene, capsys)

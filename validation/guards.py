@@ -12,7 +12,8 @@ exceed (a steep cone, a slender wall) can be overridden, by ``allow_unusual=True
 The command line, scene files, sweep files and design files call the same guards, before any FEM
 work: `check_modulus`, `check_forces`, `load_design` (the guarded reader of a design file: its raw
 lengths, then the built wall), `check_design`, `check_stiffness_curve` (a curve's displacements
-against the cup's height, its recorded modulus against the one given) and `check_uc_table`.
+against the cup's height, its recorded modulus against the one given), `check_plate_travel` (an
+FEM path's end within the cup's height) and `check_uc_table`.
 """
 
 from __future__ import annotations
@@ -27,13 +28,14 @@ if TYPE_CHECKING:
 
 __all__ = ["ImplausibleInput", "PLAUSIBLE", "check_modulus", "check_forces", "check_start_radius", "check_length",
            "check_design_data", "load_design", "check_design", "check_stiffness_curve", "check_uc_table",
-           "check_uc_file", "check_spectrum"]
+           "check_uc_file", "check_spectrum", "check_plate_travel"]
 
 #: (low, high) plausible range of each guarded quantity, in the unit its field name says
 PLAUSIBLE: dict[str, tuple[float, float]] = {
     "E_MPa": (0.01, 1e3),            # soft gels to stiff elastomers
     "r_mm": (0.5, 500.0),            # top-plate and rim radii
     "d_mm": (0.01, 50.0),            # wall thickness
+    "u_mm": (0.01, 500.0),           # an FEM path's plate displacement, before its cup is known (<= h1)
     "F_N": (1e-6, 1e5),              # pull force: below a micronewton p/E underflows, above 10 kN no cup holds
     "alpha_deg": (5.0, 80.0),        # cone angle: flatter is a disc, steeper a tube
     "slenderness": (0.0, 400.0),     # wall length / thinnest wall: beyond it the meshes cannot resolve the wall
@@ -46,6 +48,7 @@ _SLIPS = {
     "E_MPa": (("Pa", 1e-6), ("kPa", 1e-3), ("GPa", 1e3)),
     "r_mm": (("um", 1e-3), ("m", 1e3)),
     "d_mm": (("um", 1e-3), ("m", 1e3)),
+    "u_mm": (("um", 1e-3), ("m", 1e3)),
     "F_N": (("mN", 1e-3), ("kN", 1e3)),
     "u_c_m": (("um", 1e-6), ("nm", 1e-9)),
     "h_rms_m": (("um (C in um^4, q in 1/um)", 1e-6), ("nm", 1e-9)),
@@ -102,7 +105,7 @@ def check_start_radius(r_start_mm: float | None, radii_mm: tuple[float, float], 
 
 
 def check_length(value: Any, field: str, kind: str = "r_mm") -> None:
-    """A radius (kind "r_mm") or wall thickness ("d_mm") in mm; a value that is not a number is
+    """A radius (kind "r_mm"), wall thickness ("d_mm") or plate displacement ("u_mm") in mm; a value that is not a number is
     left to the reader that types it."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
         return
@@ -186,6 +189,23 @@ def check_design(design: Mapping[str, Any], allow_unusual: bool = False, source:
         raise ImplausibleInput(f"{source}: the wall is {length:.4g} mm long and {thinnest:.3g} mm thin "
                                f"(slenderness {ratio:.0f}, plausible <= {PLAUSIBLE['slenderness'][1]:g}): "
                                f"the FEM meshes cannot resolve it{override}")
+
+
+def check_plate_travel(u_mm: float, h1_mm: float, field: str) -> float:
+    """An FEM path's end, the plate displacement u [mm], in (h1 / 100, h1]: beyond the cup's height
+    h1 the plate would pass through the plane (a value in um runs far beyond it), and a path
+    shorter than 1 % of h1 reaches no state a lifetime reads (a value in m is that short)."""
+    if not (math.isfinite(u_mm) and u_mm > 0):
+        raise ValueError(f"{field}: plate displacement must be > 0 mm, got {u_mm:g}")
+    if u_mm > h1_mm * (1 + 1e-9):          # beyond the round-off of an mm -> m conversion
+        hint = ": did you give um?" if h1_mm / 100 <= u_mm * 1e-3 <= h1_mm else ""
+        raise ImplausibleInput(f"{field} = {u_mm:.9g}{hint} (the plate displacement must lie in (0, h1] = "
+                               f"(0, {h1_mm:.9g}] mm: at h1 the plate edge reaches the plane)")
+    if u_mm < h1_mm / 100:
+        hint = ": did you give m?" if h1_mm / 100 <= u_mm * 1e3 <= h1_mm else ""
+        raise ImplausibleInput(f"{field} = {u_mm:.4g}{hint} (plausible: {h1_mm / 100:.4g} .. {h1_mm:.9g} mm, "
+                               f"1 % of the cup's height h1 to h1)")
+    return min(float(u_mm), h1_mm)
 
 
 def check_stiffness_curve(curve: Any | None, h1_mm: float, field: str, E_MPa: float | None = None,

@@ -336,7 +336,7 @@ def atomic_file(path: str | os.PathLike) -> Iterator[Path]:
 #: columns whose infinite values mean something (an infinite lifetime: sealed or beyond the
 #: horizon; an unbounded strip pressure: a line contact; an unbounded leak rate: the gas holds the
 #: seal open; the time at which a sealed state is reached); NaN is refused everywhere
-INFINITE_OK = ("lifetime_s", "p_Pa", "N_dot_per_s", "t_s")
+INFINITE_OK = ("lifetime_s", "p_Pa", "N_dot_per_s", "Q_w_mm3_per_s", "t_s")
 
 
 def check_finite(name: str, values, stage: str, infinite_ok: bool = False) -> None:

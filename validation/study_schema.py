@@ -25,7 +25,7 @@ from validation.bridge.lifetimes import ROUTES
 from validation.bridge.pipeline import DEFAULT_SURFACE
 
 __all__ = ["Field", "FIELDS", "SPELLINGS", "field_of", "parse", "finite_number", "add_flags", "values_from_args",
-           "study_from_values", "check_route", "check_surface_preset"]
+           "study_from_values", "check_route", "check_surface_preset", "check_u_max"]
 
 #: the spellings of a study: a scene file, a sweep file's [base], the command line
 SPELLINGS = ("scene", "sweep", "cli")
@@ -38,7 +38,7 @@ _LEVELS = ("coarse", "medium", "fine")
 class Field:
     """One study field. key: the scene's key path; attr: the Study attribute it sets ("part.name"
     or a top-level name); type: "choice", "number", "numbers", "bool", "name" (a surface preset),
-    "file"; positive: numbers must be > 0; guard: "modulus" or "forces" (`validation.guards`);
+    "file"; positive: numbers must be > 0; guard: "modulus", "forces" or "plate_travel" (`validation.guards`);
     sweep: the sweep file's base key (None: not in sweep files); flag: the command-line flag
     (None: not on the command line); scene: whether scene files have it; spelled: per spelling,
     what differs ({"sweep": {"default": [10.0]}, "cli": {"choices": ROUTES, "dest": "force_N"}})."""
@@ -134,6 +134,11 @@ FIELDS: tuple[Field, ...] = (
           spelled={"cli": {"choices": ROUTES, "default": "profile"}}),
     Field("stiffness.fidelity", "fidelity", "choice", "coarse", "FEM mesh level", choices=_LEVELS,
           sweep="fidelity", flag="--fidelity", spelled={"cli": {"default": None}}),
+    Field("stiffness.u_max_mm", "u_max_mm", "number", None, "the FEM stiffness curve's end: the largest plate "
+          "displacement u [mm], in (0, h1] (default: 0.9 h1; at h1 the plate edge reaches the plane); in a scene "
+          "or `cupcheck example` a path that fails before it keeps its converged part, flagged partial (exit "
+          "status 3, naming the u_max that runs); in a sweep such a design is a failed row",
+          unit="mm", positive=True, guard="plate_travel", sweep="u_max_mm", flag="--u-max-mm"),
     Field("stiffness.du_mm", "loads.du_mm", "number", 0.25, "route fem: the plate step [mm] along the cup's "
           "equilibrium branch", unit="mm", positive=True, flag="--du-mm"),
 )
@@ -186,6 +191,8 @@ def parse(f: Field, value: Any, spelling: str, where: str | None = None) -> Any:
             guards.check_modulus(number, where)
         elif f.guard == "forces":
             guards.check_forces(number, where)
+        elif f.guard == "plate_travel":    # against h1 where the design is known: `check_plate_travel`
+            guards.check_length(number, where, "u_mm")
         return number
     if f.type == "name":
         if not isinstance(value, str):
@@ -195,6 +202,16 @@ def parse(f: Field, value: Any, spelling: str, where: str | None = None) -> Any:
     if not isinstance(value, str):                      # a file
         raise ValueError(f"{where}: expected a file name, got {value!r}")
     return value
+
+
+def check_u_max(u_max_mm: float | None, geometry: Any, spelling: str) -> float | None:
+    """The FEM curve's end `u_max_mm` (None: the default, 0.9 h1) against the design's height h1
+    (`validation.guards.check_plate_travel`), named as the user wrote it; h1 itself when given
+    one round-off above it."""
+    if u_max_mm is None:
+        return None
+    from validation.guards import check_plate_travel
+    return check_plate_travel(u_max_mm, 1e3 * geometry.h1_m, _BY_KEY["stiffness.u_max_mm"].name(spelling))
 
 
 def check_surface_preset(name: Any, where: str) -> None:
@@ -269,18 +286,24 @@ def check_route(values: Mapping[str, Any], given: Iterable[str], spelling: str,
                 swept: str | None = None) -> None:
     """The rules between the route and the other fields, in the names of `spelling`: the routes
     that need the FEM; the fem route's own fields (the press, the plate step) with it only, one
-    press, and what it does not model (water, relaxation, kappa, Appendix A). `values`: {key
+    press, and what it does not model (relaxation, kappa, Appendix A). `values`: {key
     path: value} with defaults; `given`: the key paths the user wrote; `swept`: a swept key path."""
     name = lambda key: _BY_KEY[key].name(spelling)                                   # noqa: E731
     route_is = lambda value: _BY_KEY["stiffness.route"].setting(spelling, value)    # noqa: E731
     route, given = values.get("stiffness.route", "paper"), set(given)
     source = values.get("stiffness.source", "fem")
+    if values.get("stiffness.u_max_mm") is not None and source != "fem":
+        raise ValueError(f"{name('stiffness.u_max_mm')}: ends the FEM stiffness curve; Appendix A's has no FEM path "
+                         f"(drop it or set source = \"fem\")")
     if route == "profile" and source != "fem":
         raise ValueError(f"{name('stiffness.route')}: 'profile' needs source = \"fem\" (the FEM's contact-pressure "
                          f"profiles)")
     for key in ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"):
         if key in given and route != "fem":
             raise ValueError(f"{name(key)}: only for {route_is('fem')} (the cup pressed and sealed in the FEM)")
+    if route == "coupled" and values.get("fluid.kind", "air") != "air":
+        raise ValueError(f"{name('fluid.kind')}: {route_is('coupled')} models a gas-filled cavity only; drop "
+                         f"{_BY_KEY['fluid.kind'].setting(spelling, values['fluid.kind'])}")
     if route != "fem":
         return
     press = [k for k in ("loads.r_start_mm", "loads.press_u_mm", "loads.press_force_N") if values.get(k) is not None]
@@ -289,8 +312,7 @@ def check_route(values: Mapping[str, Any], given: Iterable[str], spelling: str,
                          f"{', '.join(name(k) for k in press)}")
     if source != "fem":
         raise ValueError(f"{name('stiffness.route')}: 'fem' needs source = \"fem\" (the cup's whole life in the FEM)")
-    for key, default, why in (("fluid.kind", "air", " models a gas-filled cavity only"),
-                              ("material.relaxation", "none", "'s wall is the FEM's elastic one"),
+    for key, default, why in (("material.relaxation", "none", "'s wall is the FEM's elastic one"),
                               ("loads.kappa", 1.0, "'s stiffness is the FEM's own")):
         if values.get(key, default) != default:
             raise ValueError(f"{name(key)}: the fem route{why}; drop {_BY_KEY[key].setting(spelling, values[key])}")

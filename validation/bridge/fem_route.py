@@ -24,6 +24,15 @@ quadrature and branch error (benchmarks/bench_fem_route.py, docs/lifetime.md).
 
 The largest holdable force is the largest pull along the plate raised at fixed N0 from the sealed
 state (the branch at a larger F1 does not start: the cup lets go at once).
+
+Water (model.fluid = "water"): the cavity is full of incompressible water (`fem.water_cavity`:
+V_cav = V_w, the cavity pressure its multiplier, which may fall below zero: a metastable liquid,
+no cavitation). Pressed, the cup expels water (V_w follows V); sealed, V_w0 = V; under F1 it follows
+`fem.water_branch` (the same walk, V_w in place of N) to the fold (largest V_w held at F1) or the
+seal opening. The inflow Q_w [m^3/s] is eq (24) ring by ring in series through each state's profile
+(`reduced.profile_leak.profile_liquid_rate`, the model's liquid viscosity), the solid pressure as
+for the gas; t = int dV_w / Q_w by the same trapezoid. The largest holdable force is the largest
+pull along the plate raised at fixed V_w0 (`fem.water_branch.largest_pull`).
 """
 
 from __future__ import annotations
@@ -71,14 +80,19 @@ class FemCup:
         return {"geometry": geometry, "fidelity": self.fidelity, "E_Pa": self.E_Pa, "nu": self.nu,
                 **self.contact.describe()}
 
-    def build(self, T_K: float, p_a_Pa: float) -> CupWithGas:
+    def build(self, T_K: float, p_a_Pa: float, fluid: str = "air") -> CupWithGas:
+        """The FEM cup with gas (fluid "air") or water ("water") in its cavity."""
         from fem.gas_path import CupWithGas
+        from fem.water_cavity import CupWithWater
         from fem.geometry import cup_geometry
         from fem.mesh import cup_mesh
         from validation.bridge.pipeline import neo_hookean
 
         geometry = cup_geometry(self.geometry) if isinstance(self.geometry, str) else self.geometry
         mesh = cup_mesh(geometry, self.fidelity)
+        if fluid == "water":
+            return CupWithWater.of(mesh, neo_hookean(self.E_Pa, self.nu), self.contact.law,
+                                   self.contact.friction, p_a_Pa=p_a_Pa)
         return CupWithGas.of(mesh, neo_hookean(self.E_Pa, self.nu), self.contact.law,
                              self.contact.friction, T_K=T_K, p_a_Pa=p_a_Pa)
 
@@ -99,11 +113,13 @@ class Press:
 
 
 def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: str = "annulus") -> float:
-    """Molecules per second leaking into the cavity at one sealed FEM state (module docstring):
-    the solid pressure of `reduced.table_surface.solid_profile` on the state's own profile, at
-    the state's p_b, u_c read at p / E_Pa (the wall's modulus). inf where no solid contact is left
-    (the gas holds the seal open)."""
-    from reduced.profile_leak import ContactProfile, patch_average, profile_leak_rate, ring_gaps
+    """Molecules per second leaking into the cavity at one sealed FEM state (module docstring), or
+    for water the volume inflow [m^3/s] of eq (24): the solid pressure of
+    `reduced.table_surface.solid_profile` on the state's own profile, at the state's p_b, u_c read
+    at p / E_Pa (the wall's modulus). inf where no solid contact is left (the fluid holds the
+    seal open)."""
+    from reduced.profile_leak import (ContactProfile, patch_average, profile_leak_rate, profile_liquid_rate,
+                                      ring_gaps)
     from reduced.stiffness_curve import profiles_from_lists
 
     prof, = profiles_from_lists([1e3 * state.profile.r_m], [1e-3 * state.profile.p_Pa])
@@ -124,6 +140,9 @@ def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: s
     gaps = ring_gaps(solid, model.u_c, E_Pa)
     if np.all(np.isinf(gaps)):
         return math.inf
+    if model.fluid == "water":          # a liquid under tension keeps p_b < 0
+        return profile_liquid_rate(model.liquid_viscosity_Pa_s, model.p_a_Pa, min(state.p_b_Pa, model.p_a_Pa),
+                                   solid.r_m, gaps, radial)
     p_b = min(max(state.p_b_Pa, 0.0), model.p_a_Pa)
     return profile_leak_rate(model.gas, model.p_a_Pa, p_b, solid.r_m, gaps, radial)
 
@@ -168,8 +187,9 @@ class FemRoute:
             raise ValueError(f"radial: expected 'annulus' or 'strip', got {options['radial']!r}")
         if model.u_c is None:
             raise ValueError("u_c: the fem route needs a critical gap u_c(p/E) (e.g. a UcTable)")
-        if model.fluid != "air":
-            raise ValueError(f"fluid: the fem route models a gas-filled cavity only, got '{model.fluid}'")
+        if model.fluid == "water" and model.cavitation_pressure_Pa is not None:
+            raise ValueError("cavitation_pressure_Pa: the fem route's water is a metastable liquid (no "
+                             "cavitation); drop it")
         if model.relaxation is not None or model.kappa != 1.0:
             raise ValueError("relaxation, kappa: the fem route's wall is the FEM's elastic one; "
                              "drop relaxation and kappa")
@@ -178,11 +198,11 @@ class FemRoute:
              progress: Callable[[float, str], None] | None = None) -> Sealed:
         """The cup pressed with the gas escaping and sealed, once per (cup, press, gas)."""
         press = options["press"] or Press("r_start_m", model.cup.r_start_m)
-        key = (options["cup"], press, model.gas.T_K, model.p_a_Pa)
+        key = (options["cup"], press, model.gas.T_K, model.p_a_Pa, model.fluid)
         if key not in self._sealed:
             if progress:
                 progress(0.0, f"pressing the cup to {press.kind} = {press.value:g}")
-            cup = options["cup"].build(model.gas.T_K, model.p_a_Pa)
+            cup = options["cup"].build(model.gas.T_K, model.p_a_Pa, model.fluid)
             state = cup.press_to(**{press.kind: float(press.value)})[-1]
             self._sealed[key] = Sealed(cup, state, options["cup"].E_Pa)
         return self._sealed[key]
@@ -195,11 +215,15 @@ class FemRoute:
         sealed = self.seal(model, options)
         kept = self._largest.get(id(sealed))
         if kept is None or kept[0] is not sealed:
-            kept = self._largest[id(sealed)] = (sealed, *largest_pull_checked(sealed.cup, sealed.state))
+            from fem.water_branch import largest_pull as largest_pull_water
+
+            largest = largest_pull_water if model.fluid == "water" else largest_pull_checked
+            kept = self._largest[id(sealed)] = (sealed, *largest(sealed.cup, sealed.state))
         return kept[1], kept[2]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
-        from fem.gas_branch import equilibrium_branch
+        from fem.gas_branch import equilibrium_branch, state_between
+        from fem.water_branch import water_branch, water_state_between
         from reduced.lifetime import Lifetime
         from reduced.lifetime.paper import check_run
 
@@ -207,8 +231,10 @@ class FemRoute:
         if run.refine != 1:
             raise ValueError(f"refine: the fem route has no dense output, got {run.refine}")
         sealed = self.seal(model, options, run.progress)
-        branch = equilibrium_branch(sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
-                                    progress=_branch_progress(run.progress, force_N, sealed))
+        water = model.fluid == "water"
+        branch = (water_branch if water else equilibrium_branch)(
+            sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
+            progress=_branch_progress(run.progress, force_N, sealed, "V_w" if water else "N"))
         largest, partial = self._largest_checked(model, options)
         s0 = sealed.state
         provenance = {"route": self.name, "options": {**options, "cup": options["cup"].describe(),
@@ -216,7 +242,8 @@ class FemRoute:
                       "model": model.label, "t_max_s": run.t_max_s}
         common = dict(route=self.name, force_N=float(force_N), largest_force_N=largest,
                       provenance=provenance)
-        base = {"N0": s0.N, "u_sealed_mm": 1e3 * s0.u_m, "r_start_mm": 1e3 * s0.r_c_m,
+        content = {"V_w0_mm3": 1e9 * s0.N} if water else {"N0": s0.N}
+        base = {**content, "u_sealed_mm": 1e3 * s0.u_m, "r_start_mm": 1e3 * s0.r_c_m,
                 "seal_r_sealed_mm": 1e3 * s0.seal_r_m, "branch_reason": branch.reason}
         if partial is not None:       # the pull was still rising where the solver stopped
             base["largest_force_lower_bound"] = partial
@@ -229,11 +256,12 @@ class FemRoute:
                                 f"({branch.reason}) after {len(branch.states)} states")
         leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, options["radial"])  # noqa: E731
         states, q, added = refine_branch(sealed.cup, list(branch.states), [leak(s) for s in branch.states],
-                                         float(force_N), leak)
+                                         float(force_N), leak, water_state_between if water else state_between)
         N = np.array([s.N for s in states])
-        columns = _columns(states, q)
+        columns = _columns(states, q, water)
         stats = branch.stats
-        details = {**base, "N_max": branch.N_max, "states": len(states), "refined": added, "snaps": branch.snaps,
+        most = {"V_w_max_mm3": 1e9 * branch.N_max} if water else {"N_max": branch.N_max}
+        details = {**base, **most, "states": len(states), "refined": added, "snaps": branch.snaps,
                    "newton_iterations": stats.newton_iterations, "wall_time_s": stats.wall_time_s,
                    "seal_r_final_mm": 1e3 * states[-1].seal_r_m, "p_b_final_Pa": states[-1].p_b_Pa,
                    "u_final_mm": 1e3 * states[-1].u_m}
@@ -268,13 +296,16 @@ REFINE_RATIO, REFINE_SHARE, REFINE_DEPTH = 2.0, 0.01, 3
 
 
 def refine_branch(cup: CupWithGas, states: list, q: list, force_N: float,
-                  leak: Callable[[Any], float]) -> tuple[list, np.ndarray, int]:
+                  leak: Callable[[Any], float], between: Callable | None = None) -> tuple[list, np.ndarray, int]:
     """The branch's states with states added where the trapezoid of 1/Q in N is not resolved:
     between neighbours whose leak differs by more than REFINE_RATIO and whose interval carries
     more than REFINE_SHARE of the lifetime (where the seal's last contact ring narrows, Q falls
     several times within one plate step), a state midway (`fem.gas_branch.state_between`, from
-    the earlier state), up to REFINE_DEPTH halvings. (states, Q [1/s], states added)."""
+    the earlier state; `between`: its water counterpart), up to REFINE_DEPTH halvings. (states,
+    Q [1/s], states added)."""
     from fem.gas_branch import state_between
+
+    between = between or state_between
 
     states, q = list(states), list(q)
     added = 0
@@ -292,7 +323,7 @@ def refine_branch(cup: CupWithGas, states: list, q: list, force_N: float,
         if len(todo) == 0:
             break
         for k in todo[::-1]:                      # from the end: the indices before stay valid
-            mid = state_between(cup, states[k], states[k + 1], force_N)
+            mid = between(cup, states[k], states[k + 1], force_N)
             if mid is not None:
                 states.insert(k + 1, mid)
                 q.insert(k + 1, leak(mid))
@@ -300,7 +331,8 @@ def refine_branch(cup: CupWithGas, states: list, q: list, force_N: float,
     return states, np.array(q), added
 
 
-def _branch_progress(report: Callable[[float, str], None] | None, force_N: float, sealed: Sealed):
+def _branch_progress(report: Callable[[float, str], None] | None, force_N: float, sealed: Sealed,
+                     content: str = "N"):
     """One progress line per branch state: the fraction is the plate's travel from the sealed
     position towards -h1 (the branch's end is not known before it is reached)."""
     if report is None:
@@ -310,7 +342,7 @@ def _branch_progress(report: Callable[[float, str], None] | None, force_N: float
 
     def on_state(k: int, u_m: float, N: float) -> None:
         report(0.1 + 0.85 * min(max((u0 - u_m) / (u0 + h1), 0.0), 1.0),
-               f"F1 = {force_N:g} N: branch state {k}, u = {1e3 * u_m:.3f} mm, N = {N / N0:.4g} N0")
+               f"F1 = {force_N:g} N: branch state {k}, u = {1e3 * u_m:.3f} mm, {content} = {N / N0:.4g} {content}0")
     return on_state
 
 
@@ -321,9 +353,13 @@ def lifetime_integral(N: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(N))])
 
 
-def _columns(states: list, q: np.ndarray) -> dict[str, np.ndarray]:
+def _columns(states: list, q: np.ndarray, water: bool = False) -> dict[str, np.ndarray]:
     def col(name: str, scale: float = 1.0) -> np.ndarray:
         return scale * np.array([getattr(s, name) for s in states])
+    if water:
+        return {"V_w_mm3": col("N", 1e9), "p_b_Pa": col("p_b_Pa"), "u_mm": col("u_m", 1e3),
+                "F_plate_N": col("F1_N"), "V_mm3": col("V_m3", 1e9), "r_c_mm": col("r_c_m", 1e3),
+                "seal_r_mm": col("seal_r_m", 1e3), "r_out_mm": col("cut_r_m", 1e3), "Q_w_mm3_per_s": 1e9 * q}
     return {"N": col("N"), "p_b_Pa": col("p_b_Pa"), "u_mm": col("u_m", 1e3), "F_plate_N": col("F1_N"),
             "V_mm3": col("V_m3", 1e9), "r_c_mm": col("r_c_m", 1e3), "seal_r_mm": col("seal_r_m", 1e3),
             "r_out_mm": col("cut_r_m", 1e3), "N_dot_per_s": q}

@@ -35,7 +35,8 @@ if TYPE_CHECKING:                          # importing this module imports no fe
     from reduced.stiffness_curve import StiffnessCurve
 
 __all__ = ["LOCKING_NU", "DEFAULT_SURFACE", "neo_hookean", "surface_uc_table",
-           "mesh_record", "fem_path", "fem_curve", "fem_stiffness", "PathStop", "converged_part", "partial_note"]
+           "mesh_record", "fem_path", "fem_curve", "fem_stiffness", "PathStop", "converged_part", "partial_note",
+           "runnable_u_max_mm"]
 
 #: above this Poisson's ratio the displacement (Q2) formulation locks (F0 stiffens)
 LOCKING_NU = 0.495
@@ -133,6 +134,15 @@ def partial_note(provenance: Mapping[str, Any]) -> str | None:
     if not isinstance(runs, (int, float)) or not isinstance(failed, (int, float)):
         return "a partial curve (its FEM path stopped before its u_max)"
     return f"a partial curve: converged to u = {runs:.4g} mm, its FEM path stopped at {failed:.4g} mm"
+
+
+def runnable_u_max_mm(u_mm: float, digits: int = 4) -> float:
+    """A partial path's last converged u [mm] rounded down to `digits` significant digits: the
+    u_max, as a user types it, that stays within the converged part (and so runs)."""
+    import math
+
+    scale = 10.0 ** (math.floor(math.log10(u_mm)) - digits + 1)
+    return math.floor(u_mm / scale) * scale
 
 
 def fem_curve(response: CupResponse, geometry: Mapping[str, Any], fidelity: str | None,

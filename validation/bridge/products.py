@@ -12,17 +12,18 @@ run of the same study computes none).
 
 from __future__ import annotations
 
+import math
 import time
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import asdict, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from validation.bridge.cache import Cache, file_digest, source_hash
 from validation.bridge.study import Contact, Study
 
-__all__ = ["Products", "COMPUTED", "fem_route_options"]
+__all__ = ["Products", "COMPUTED", "Refused", "fem_route_options"]
 
 #: products computed (not taken from the cache) in this process, by name
 COMPUTED: Counter = Counter()
@@ -58,22 +59,32 @@ def _uc_table(surface_key: dict, code: str, surface=None):
 
 def _fem_path(design_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
               design=None, progress=None):
-    """The FEM path: the design pressed onto the plane to u_max_m (a `fem.cup.CupResponse`, every
-    converged step). Keyed only by what it depends on, so a curve, a render, a footprint and a
-    squeeze ending at the same u share one run."""
+    """The FEM path: the design pressed onto the plane to u_max_m, as (a `fem.cup.CupResponse`, every
+    converged step; None), or, for a path that failed after some converged steps, (its converged
+    part, its `validation.bridge.pipeline.PathStop`). Keyed only by what it depends on, so a curve,
+    a render, a footprint and a squeeze ending at the same u share one run."""
     COMPUTED["fem_path"] += 1
-    from validation.bridge.pipeline import fem_path, neo_hookean
-    return fem_path(design.cup_geometry(), neo_hookean(material["E_MPa"] * 1e6, material["nu"]),
-                    Contact(**contact).contact_law(), fidelity, u_max_m, progress)
+    from fem.solver import ConvergenceError
+    from validation.bridge.pipeline import converged_part, fem_path, neo_hookean
+    try:
+        return fem_path(design.cup_geometry(), neo_hookean(material["E_MPa"] * 1e6, material["nu"]),
+                        Contact(**contact).contact_law(), fidelity, u_max_m, progress), None
+    except ConvergenceError as exc:
+        kept = converged_part(exc)
+        if kept is None:                   # nothing beyond u = 0 converged
+            raise
+        return kept
 
 
 def _fem_curve(design_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, code: str,
                contact_source: str, design=None, path=None):
-    """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`, not part of the key);
-    its provenance says who chose the contact law."""
+    """The stiffness curve (hand-off) of the FEM path to u_max_m (`path()`: the response and its
+    stop, not part of the key); its provenance says who chose the contact law and, for the
+    converged part of a failed path, where and why it stopped (flagged partial)."""
     COMPUTED["fem_curve"] += 1
     from validation.bridge.pipeline import fem_curve
-    return fem_curve(path(), design.cup_geometry().describe(), fidelity, contact_source)
+    response, stop = path()
+    return fem_curve(response, design.cup_geometry().describe(), fidelity, contact_source, stop=stop)
 
 
 def _fem_frames(design_key: dict, material: dict, contact: dict, fidelity: str, u_max_m: float, n_frames: int,
@@ -86,24 +97,51 @@ def _fem_frames(design_key: dict, material: dict, contact: dict, fidelity: str, 
 
     from validation.render.frames import frame_from_response
 
-    response = path()
+    response = path()[0]
     targets = [u_max_m] if n_frames == 1 else np.linspace(0.0, u_max_m, n_frames)
     steps = [int(np.argmin(np.abs(response.u_m - t))) for t in targets]
     return [frame_from_response(response, k) for k in steps]
 
 
 def _lifetimes(study_key: dict, stiffness, uc, cup, code: str, study=None, progress=None):
-    """The study's lifetimes (`validation.bridge.lifetimes.Lifetimes`) on its route."""
+    """The study's lifetimes on its route, as (`validation.bridge.lifetimes.Lifetimes`, the
+    `Refused` forces): on a partial curve (the converged part of a failed FEM path) a force whose
+    lifetime needs a state beyond the curve is refused, the others computed."""
     COMPUTED["lifetimes"] += 1
-    from validation.bridge.lifetimes import lifetimes, route_options
+    from validation.bridge.lifetimes import Lifetimes, lifetimes, route_options
+    from validation.bridge.pipeline import partial_note
     forces = study.loads.forces_N
 
     def each(fraction: float, message: str) -> None:
         if progress is not None:
             progress(f"lifetime {round(fraction * len(forces))} of {len(forces)} done ({message})")
     options = fem_route_options(study) if study.route == "fem" else route_options(study.route, study.cup_laws)
-    return lifetimes(_model(study, stiffness, uc, cup), forces, study.route, progress=each,
-                     refine=1 if study.route in ("coupled", "fem") else study.refine, **options)
+    model = _model(study, stiffness, uc, cup)
+    run = lambda fs, report=None: lifetimes(model, fs, study.route, progress=report,         # noqa: E731
+                                           refine=1 if study.route in ("coupled", "fem") else study.refine, **options)
+    try:
+        return run(forces, each), ()
+    except ValueError:
+        if partial_note(getattr(stiffness, "provenance", {})) is None:
+            raise
+    done, refused = [], []                 # the reduced model never extrapolates the curve: force by force
+    for i, force in enumerate(forces):
+        try:
+            done.append(run([force]))
+        except ValueError as exc:
+            refused.append(Refused(float(force), " ".join(str(exc).split())))
+        each((i + 1) / len(forces), f"F1 = {force:g} N")
+    largest = done[0].largest_force_N if done else math.nan
+    return Lifetimes(study.route, tuple(r for d in done for r in d), largest), tuple(refused)
+
+
+@dataclass(frozen=True)
+class Refused:
+    """A pull force [N] whose lifetime was not computed: on a partial stiffness curve it needs a
+    state beyond the curve's range (`message`: the reduced model's words)."""
+
+    force_N: float
+    message: str
 
 
 def fem_route_options(study: Study) -> dict[str, Any]:
@@ -143,12 +181,15 @@ class Products:
 
     progress(message): a line per product, FEM step and force; fem_progress(fraction, message):
     the FEM's and suction table's own progress instead (a terminal's status line); suction_cache_dir:
-    where the coupled route's suction tables are kept (`validation.bridge.coupled.build`; None: not kept)."""
+    where the coupled route's suction tables are kept (`validation.bridge.coupled.build`; None: not kept);
+    keep_partial: a stiffness curve whose FEM path fails after some converged steps is their
+    converged part, flagged partial (`path_stop` says where and why; else the failure is raised)."""
 
     def __init__(self, study: Study, cache_dir: str | Path | None = None,
                  progress: Callable[[str], None] | None = None, suction_cache_dir: str | Path | None = None,
-                 fem_progress: Callable[[float, str], None] | None = None):
+                 fem_progress: Callable[[float, str], None] | None = None, keep_partial: bool = False):
         self.study, self.timings, self._done, self._memos = study, {}, {}, {}
+        self.keep_partial = keep_partial
         self._progress = progress or (lambda message: None)
         self._fem_report = fem_progress
         self._cache = Cache(cache_dir)
@@ -193,17 +234,21 @@ class Products:
             {**asdict(surface), "uc_table": file_digest(surface.uc_table)}, source_hash("reduced"), surface=surface))
 
     def curve(self):
-        """The stiffness curve: the FEM's to 0.9 h1 (or the study's curve file), or Appendix A's
-        (d0 = 2 mm) of the study's cup."""
+        """The stiffness curve: the FEM's to the study's u_max (default 0.9 h1; the converged part
+        of a failed path with `keep_partial`), or the study's curve file, or Appendix A's (d0 = 2 mm)
+        of the study's cup."""
         if self.study.stiffness == "appendix-a":
             return self._get("curve", self._appendix_a_curve)
         if self.study.stiffness_file is not None:
             from reduced.stiffness_curve import StiffnessCurve
             return self._get("curve", lambda: StiffnessCurve.from_csv(self.study.stiffness_file))
-        return self._get("curve", lambda: self._cached(_fem_curve, ignore=["design", "path"])(
+        curve = self._get("curve", lambda: self._cached(_fem_curve, ignore=["design", "path"])(
             *self._fem_args(self._u_max_m(None)), source_hash("fem", "validation"), self.study.contact.source,
             design=self.study.design,
-            path=lambda: self.fem_path(None)))
+            path=lambda: self._path(None)))
+        if curve.provenance.get("partial") is True and not self.keep_partial:
+            self.fem_path(None)            # raises the path's failure
+        return curve
 
     def _appendix_a_curve(self):
         from reduced.appendix_a import appendix_a_curve
@@ -239,20 +284,38 @@ class Products:
         return self._memo("cup", compute)
 
     def _u_max_m(self, u_mm: float | None) -> float:
-        """The path's end [m]: u_mm, or 0.9 h1 for the stiffness curve; checked against h1."""
+        """The path's end [m]: u_mm, or for the stiffness curve the study's u_max (default 0.9 h1);
+        checked against h1."""
         h1_m = self.study.design.cup_geometry().h1_m
         if u_mm is None:
-            return 0.9 * h1_m
+            if self.study.u_max_mm is None:
+                return 0.9 * h1_m
+            from validation.guards import check_plate_travel      # each spelling checked it against h1
+            return 1e-3 * check_plate_travel(self.study.u_max_mm, 1e3 * h1_m, "u_max_mm")
         if not 0 < u_mm * 1e-3 <= h1_m:
             raise ValueError(f"outputs: u_mm must be in (0, h1] = (0, {1e3 * h1_m:.4g}] mm, got {u_mm:g}")
         return u_mm * 1e-3
 
-    def fem_path(self, u_mm: float | None):
-        """The FEM path to u_mm (None: 0.9 h1), computed once per end point and study (`_fem_path`)."""
+    def _path(self, u_mm: float | None) -> tuple:
+        """(the FEM path to u_mm (None: the curve's end), its `PathStop` or None), computed once per
+        end point and study (`_fem_path`)."""
         u_max_m = self._u_max_m(u_mm)
         return self._get(f"fem_path_{1e3 * u_max_m:.6g}mm", lambda: self._cached(_fem_path, ignore=["design", "progress"])(
             *self._fem_args(u_max_m), source_hash("fem", "validation/bridge/pipeline.py"), design=self.study.design,
             progress=self._fem_progress))
+
+    def fem_path(self, u_mm: float | None):
+        """The FEM path to u_mm (None: the curve's end, its converged part with `keep_partial`); a
+        path that stopped short of it raises its `fem.solver.ConvergenceError`."""
+        response, stop = self._path(u_mm)
+        if stop is not None and not (u_mm is None and self.keep_partial):
+            raise stop.error
+        return response
+
+    def path_stop(self):
+        """Where and why the stiffness curve's FEM path stopped short of its u_max (a
+        `validation.bridge.pipeline.PathStop`; None: it reached it)."""
+        return self._path(None)[1]
 
     def fem_frames(self, u_mm: float, n_frames: int = 1) -> list:
         """The deformed states at n_frames plate displacements up to u_mm (`_fem_frames`), drawn from
@@ -260,7 +323,8 @@ class Products:
         u_max_m = self._u_max_m(u_mm)
         name = f"fem_state_{u_mm:g}mm" + (f"_{n_frames}frames" if n_frames > 1 else "")
         return self._get(name, lambda: self._cached(_fem_frames, ignore=["path"])(
-            *self._fem_args(u_max_m), n_frames, source_hash("fem", "validation"), path=lambda: self.fem_path(u_mm)))
+            *self._fem_args(u_max_m), n_frames, source_hash("fem", "validation"),
+            path=lambda: (self.fem_path(u_mm), None)))
 
     def suction_table(self):
         """The coupled route's FEM suction table: the study's file, or built for the design at its
@@ -282,20 +346,41 @@ class Products:
         return self._get("suction_table", compute)
 
     def lifetimes(self):
-        """The lifetimes (`validation.bridge.lifetimes.Lifetimes`) of the study's forces on its route."""
+        """The lifetimes (`validation.bridge.lifetimes.Lifetimes`) of the study's forces on its route
+        (on a partial curve: of the forces not `refused`)."""
         s = self.study
         def compute():
             feed = {"coupled": self.suction_table, "fem": lambda: None}.get(s.route, self.curve)()
             code = source_hash("fem", "reduced", "validation") if s.route == "fem" else source_hash("reduced", "validation")
-            return self._cached(_lifetimes, ignore=["study", "progress"])(
+            results, self._memos["refused"] = self._cached(_lifetimes, ignore=["study", "progress"])(
                 _study_key(s), feed, self.uc_table(), self.cup(), code, study=s, progress=self._progress)
+            return results
         return self._get("lifetimes", compute)
+
+    def refused(self) -> tuple[Refused, ...]:
+        """The forces whose lifetimes need a state beyond a partial stiffness curve (none on a complete one)."""
+        self.lifetimes()
+        return self._parent.refused() if "lifetimes" in self._inherit else self._memos["refused"]
+
+    def partial(self) -> dict[str, Any] | None:
+        """A partial stiffness curve's record (where and why its FEM path stopped, the u_max that
+        runs, the forces refused), or None: no curve computed, or a complete one. Computes nothing."""
+        owner = self
+        while "curve" in owner._inherit:
+            owner = owner._parent
+        curve = owner._done.get("curve")
+        prov = getattr(curve, "provenance", {})
+        if prov.get("partial") is not True:
+            return None
+        record = {k: prov.get(k) for k in ("failed_at_u_mm", "u_max_mm_that_runs", "failure_reason")}
+        refused = [{"force_N": r.force_N, "message": r.message} for r in self._memos.get("refused", ())]
+        return {"partial": True, **record, "refused": refused}
 
     def derived(self, study: Study, inherit: tuple[str, ...] = ()) -> Products:
         """The products of another study sharing this one's cache, and taking the products named
         in `inherit` (e.g. "uc_table", "cup", "curve") from this one."""
         child = Products(study, progress=self._progress, suction_cache_dir=self._suction_cache_dir,
-                         fem_progress=self._fem_report)
+                         fem_progress=self._fem_report, keep_partial=self.keep_partial)
         child._cache, child._parent, child._inherit = self._cache, self, inherit
         return child
 

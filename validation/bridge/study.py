@@ -136,7 +136,8 @@ class Study:
     step of the lifetimes; suction_table: the coupled route's table file (None: built from the
     design at `fidelity`); stiffness_file: a stiffness curve file (`cupcheck stiffness`) used as
     the FEM curve instead of running the FEM (its design, law, mesh level and material are then
-    the study's: `cupcheck example --stiffness`); outputs: what to write (the scene's [[outputs]])."""
+    the study's: `cupcheck example --stiffness`); u_max_mm: the FEM curve's end, the plate
+    displacement [mm] (None: 0.9 h1); outputs: what to write (the scene's [[outputs]])."""
 
     design: CupDesign = CupDesign()
     material: Material = Material()
@@ -150,6 +151,7 @@ class Study:
     refine: int = 2
     suction_table: str | None = None
     stiffness_file: str | None = None
+    u_max_mm: float | None = None
     outputs: tuple[Mapping[str, Any], ...] = field(default=(), compare=False)
     sweep: Sweep | None = None
 

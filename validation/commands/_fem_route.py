@@ -18,7 +18,7 @@ DEFAULT_FIDELITY = "coarse"
 
 #: lifetime options the fem route replaces or does not model: (option, attribute, default)
 _NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--suction-table", "suction_table", None),
-             ("--fluid", "fluid", "air"), ("--cavitation-kPa", "cavitation_kPa", None),
+             ("--cavitation-kPa", "cavitation_kPa", None),
              ("--cup-laws", "cup_laws", None), ("--d0-mm", "d0_mm", 2.0), ("--l0-mm", "l0_mm", None),
              ("--l1-mm", "l1_mm", None), ("--kappa", "kappa", 1.0), ("--relaxation", "relaxation", "none"),
              ("--phi0-s", "phi0_s", None))
@@ -46,7 +46,7 @@ def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, 
     from validation.study_schema import check_route, parse, values_from_args
 
     refuse_other_options(args, "fem", _NOT_HERE, "computes the cup's mechanics, volume and contact profile "
-                         "in the FEM (elastic wall, gas-filled cavity)")
+                         "in the FEM (elastic wall, a cavity of gas or of water without cavitation)")
     check_run_options(args)
     E_MPa = check_modulus(args.E_MPa, "--E-MPa")
     if not (math.isfinite(args.du_mm) and args.du_mm > 0):
@@ -67,7 +67,8 @@ def fem_route_case(args: argparse.Namespace) -> tuple[Any, dict[str, Any], Any, 
     fidelity = args.fidelity or DEFAULT_FIDELITY
     fem_cup = FemCup(geometry, fidelity, E_Pa=1e6 * E_MPa, contact=contact.contact)
     model = LeakageModel(cup=choice.cup, u_c=build_uc(args), gas=Gas(T_K=args.T_K), p_a_Pa=args.p_a_Pa,
-                         E_Pa=1e6 * E_MPa, interface=args.interface, label=choice.label)
+                         E_Pa=1e6 * E_MPa, interface=args.interface, label=choice.label,
+                         fluid=args.fluid, liquid_viscosity_Pa_s=args.liquid_viscosity)
     route = register()
     options = {**route.options, "cup": fem_cup, "press": press, "du_m": 1e-3 * args.du_mm}
     route.check(model, options)
@@ -118,10 +119,10 @@ def run_fem_route(args: argparse.Namespace) -> int:
     fem = cup["fem_cup"]
     s0 = results[0].details
     print(f"cup: {choice.label}; {_pressed(args, cup, s0)} and sealed (u = "
-          f"{s0['u_sealed_mm']:.4g} mm, N0 = {s0['N0']:.4e}); route fem: {fem['fidelity']} mesh, E "
+          f"{s0['u_sealed_mm']:.4g} mm, {_content(s0)}); route fem: {fem['fidelity']} mesh, E "
           f"{fem['E_Pa'] / 1e6:g} MPa, nu {fem['nu']:g}, contact {_law(cup['contact'])} "
           f"({cup['contact']['source']}), plate step {cup['du_mm']:g} mm; largest holdable force "
-          f"{results.largest_force_N:.4g} N")
+          f"{'at least ' if 'largest_force_lower_bound' in s0 else ''}{results.largest_force_N:.4g} N")
     print(f"{'F1_N':>8} {'lifetime_s':>12} {'reason':>11} {'u_end_mm':>8} {'p_b_end_kPa':>11} {'seal_r_mm':>9}")
     for r in results:
         life = f"{r.lifetime_s:.6g}" if math.isfinite(r.lifetime_s) else "inf"
@@ -138,7 +139,8 @@ def _trajectory(r) -> dict[str, Any]:
     tr = r.trajectory_columns()
     if not tr:
         d = r.details
-        return {"t_s": [0.0], "N": [d["N0"]], "u_mm": [d["u_sealed_mm"]], "seal_r_mm": [d["seal_r_sealed_mm"]]}
+        content = {"V_w_mm3": [d["V_w0_mm3"]]} if "V_w0_mm3" in d else {"N": [d["N0"]]}
+        return {"t_s": [0.0], **content, "u_mm": [d["u_sealed_mm"]], "seal_r_mm": [d["seal_r_sealed_mm"]]}
     return {"t_s": tr["t_s"], **{k: v for k, v in tr.items() if k != "t_s"}}
 
 
@@ -152,6 +154,13 @@ def _pressed(args: argparse.Namespace, cup: dict[str, Any], sealed: dict[str, An
         return f"pressed to r_start {cup['r_start_mm']:.4g} mm"
     how = f"to u = {args.press_u_mm:g} mm" if args.press_u_mm is not None else f"with {args.press_force_N:g} N"
     return f"pressed {how} (r_c {sealed['r_start_mm']:.4g} mm)"
+
+
+def _content(sealed: dict[str, Any]) -> str:
+    """What the sealed cavity holds: the water volume, or the gas's molecules."""
+    if "V_w0_mm3" in sealed:
+        return f"water V_w0 = {sealed['V_w0_mm3']:.4g} mm^3"
+    return f"N0 = {sealed['N0']:.4e}"
 
 
 def _law(contact: dict[str, Any]) -> str:

@@ -20,7 +20,10 @@ the lifetime against the pull force F1 = 5, 10, ..., 80 N.
      table takes ~3 min (coarse) to ~8 min (medium) once per design and law.
    - fem: the cup's whole life in the FEM (`validation.bridge.fem_route`): pressed to r_start (or
      --press-u-mm, --press-force-N) with the gas escaping, sealed, held at F1 along its equilibrium
-     branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse).
+     branch while the gas leaks in through each state's own profile (~10-20 s per force, coarse);
+     with --fluid water the cavity holds incompressible water that flows in by eq (24) (~10 s per
+     force, coarse; no cavitation: the water may go into tension).
+   --fluid water fills the cavity with water on the paper, profile and fem routes (eq 24).
    Another design (--geometry FILE) runs the same chain on its own geometry (`validation.bridge.design`).
    A curve of `cupcheck stiffness` (--stiffness CURVE.csv) replaces step 1: its design, contact law,
    mesh level and material are the example's; a --cup, --geometry, --contact, --friction or
@@ -32,17 +35,25 @@ Writes to DIR, atomically:
                           ballistic_share, r_final_mm (paper, profile) or u_final_mm (coupled), and
                           p_b_final_Pa
   lifetime_vs_force.png   lifetime against F1 (FEM-fed, and Appendix A-fed for comparison), F0(u)
+  lifetime_vs_force_data.csv  what the figure draws, point by point (series, quantities, x, y)
   stiffness_fem.csv       the FEM stiffness curve u_mm,h_mm,F0_N,r_c_mm,l_mm,V_mm3 (+ .json sidecar)
   suction_table.json      coupled route: the FEM suction table the lifetimes used
-  trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N, p_b, u, plate force, V, r_c,
-                          seal radius, r_out, leak rate)
+  trajectory_F1_<F>N.csv  fem route: each force's FEM states (t, N or the water volume V_w, p_b, u,
+                          plate force, V, r_c, seal radius, r_out, leak rate or water inflow)
   manifest.json           the files and the study (`validation.bridge.study.Study`) they were computed for
+
+An FEM path that fails after some converged steps (before --u-max-mm, default 0.9 h1) keeps them,
+as in `cupcheck stiffness`: the curve is its converged part, flagged partial (its sidecar, a
+curve_partial_to_u_mm column, the manifest's "partial"); a force whose lifetime needs a state beyond
+it is refused (reason beyond_partial_curve), the others computed; one line names the --u-max-mm
+that runs, the record goes to DIR.failure.json, and the exit status is 3.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -51,6 +62,7 @@ from typing import TYPE_CHECKING, Any
 from validation.bridge.cache import user_cache_dir
 from validation.commands._cup import (add_contact_arguments, add_cup_arguments, add_cup_law_arguments,
                                       contact_choice, cup_laws, load_cup_design)
+from validation.commands._example_inputs import check_suction_table, curve_inputs
 from validation.study_schema import add_flags, check_route, field_of, parse, values_from_args
 
 if TYPE_CHECKING:
@@ -63,8 +75,10 @@ HELP = "main job: cup A FEM stiffness -> lifetime against pull force on pmma-1.8
 FORCES_N = tuple(float(f) for f in range(5, 85, 5))
 #: the study's fields `example` spells as flags (`validation.study_schema`; contact: `contact_choice`)
 KEYS = ("cup.preset", "cup.geometry", "cup.allow_unusual_design", "cup.l0_mm", "cup.l1_mm", "stiffness.route",
-        "loads.r_start_mm", "stiffness.fidelity", "surface.preset", "surface.uc_table", "loads.press_u_mm",
-        "loads.press_force_N", "stiffness.du_mm")
+        "loads.r_start_mm", "stiffness.fidelity", "stiffness.u_max_mm", "surface.preset", "surface.uc_table",
+        "loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm", "fluid.kind")
+#: exit status of a run whose FEM curve is the converged part of a failed path (as `cupcheck stiffness`)
+PARTIAL_EXIT = 3
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -80,9 +94,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                           "lifetimes on soap-cleaned surfaces, Sec. 5.3-5.5; sticking is Appendix A's "
                           "no-slip bound, whose contact-pressure profile is singular at the stick "
                           "edges and not mesh-converged")
-    add_flags(p, ("stiffness.fidelity",), helps={
+    add_flags(p, ("stiffness.fidelity", "stiffness.u_max_mm"), helps={
         "stiffness.fidelity": "FEM mesh level (default: medium, F0 within 1 %% of the converged curve; "
-                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)"})
+                              "coarse ~2 %%, 4x faster; see `cupcheck validate` for the errors)",
+        "stiffness.u_max_mm": "the FEM curve's largest plate displacement u [mm], in (0, h1] (default: 0.9 h1); "
+                              "a path that fails before it keeps its converged part (exit status 3)"})
     c = p.add_argument_group("coupled route")
     c.add_argument("--suction-table", dest="suction_table", default=None, metavar="FILE.json",
                    help="the design's table from `cupcheck suction` (default: built at --fidelity "
@@ -92,6 +108,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "$CUPCHECK_CACHE_DIR moves it)")
     c.add_argument("--no-cache", action="store_true", help="build the suction table afresh, keep nothing")
     add_flags(p.add_argument_group("fem route"), ("loads.press_u_mm", "loads.press_force_N", "stiffness.du_mm"))
+    add_flags(p, ("fluid.kind",))
     add_flags(p.add_mutually_exclusive_group(), ("surface.preset", "surface.uc_table"), helps={
         "surface.preset": "calibrated surface preset for u_c(p/E) (default: pmma-1.89)",
         "surface.uc_table": "critical gap table instead, columns p_over_E,u_c_m (u_c in m)"},
@@ -105,12 +122,15 @@ def _inputs(args: argparse.Namespace, geometry=None):
 
     from validation.guards import check_design, check_uc_table
 
+    from validation.study_schema import check_u_max
+
     contact = None
     if geometry is None:
         design = load_cup_design(args)
         contact = contact_choice(args, design)
         geometry = design.geometry
     check_design(geometry.describe(), args.allow_unusual_design, source=geometry.name)
+    check_u_max(args.u_max_mm, geometry, "cli")
     if args.uc_table is not None:
         if not os.path.isfile(args.uc_table):
             raise ValueError(f"uc-table: no such file {args.uc_table!r}")
@@ -124,20 +144,26 @@ def _inputs(args: argparse.Namespace, geometry=None):
     return geometry, contact, name
 
 
-def write_table(results, path: Path, cup: str, study: Study) -> None:
-    """The lifetimes, one row per force: the cup, what they were computed for (`Study.record`), the outcome."""
+def write_table(results, path: Path, cup: str, study: Study, partial: dict[str, Any] | None = None) -> None:
+    """The lifetimes, one row per force: the cup, what they were computed for (`Study.record`), the
+    outcome; on a partial curve (`Products.partial`) a refused force's row has the reason
+    beyond_partial_curve and blank values, and every row says where the curve ends."""
     from validation.output import write_table as write_csv
 
     route = study.route
-    s = [r.summary() for r in results]
+    refused = {r["force_N"] for r in (partial or {}).get("refused", [])}
+    s = {r.force_N: r.summary() for r in results}
+    forces = [f for f in study.loads.forces_N if f in s or f in refused]
+    rows = [s.get(f, {"lifetime_s": "", "reason": "beyond_partial_curve"}) for f in forces]
     own = {"coupled": ("u_final_mm",), "fem": ("u_final_mm", "seal_r_final_mm")}.get(
         route, ("ballistic_share", "r_final_mm"))
     largest = {"largest_force_N": results.largest_force_N} if route == "fem" else {}
     record = {k: v for k, v in study.record().items() if k not in ("design", "route")}
-    write_csv(path, {"cup": cup, "route": route, **record, "force_N": [r.force_N for r in results],
-                     "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in s],
-                     "reason": [r.reason for r in results], **largest,
-                     **{key: [_blank(x.get(key)) for x in s] for key in (*own, "p_b_final_Pa")}},
+    ends = {"curve_partial_to_u_mm": partial["u_max_mm_that_runs"]} if partial else {}
+    write_csv(path, {"cup": cup, "route": route, **record, "force_N": forces,
+                     "lifetime_s": [x["lifetime_s"] if x["lifetime_s"] is not None else math.inf for x in rows],
+                     "reason": [x["reason"] for x in rows], **largest,
+                     **{key: [_blank(x.get(key)) for x in rows] for key in (*own, "p_b_final_Pa")}, **ends},
               stage="example lifetimes")
 
 
@@ -187,54 +213,6 @@ def check_fields(args: argparse.Namespace) -> None:
     check_route(values, given, "cli")
 
 
-def _curve_inputs(args: argparse.Namespace) -> tuple[Any, ContactChoice, dict[str, Any]]:
-    """(the FEM geometry, the contact law, the Study's fields) of a --stiffness curve: the design,
-    law, mesh level and material its sidecar records. An option that contradicts them, or a curve
-    that names no FEM design or law, is refused (ValueError naming the option)."""
-    from fem.design_file import geometry_from_mapping
-    from fem.interface import ContactChoice, ContactLaw
-    from reduced.stiffness_curve import StiffnessCurve
-    from validation.bridge.design import preset_design, resolve_cup, shape_of
-    from validation.bridge.study import CupDesign, Material
-
-    path = Path(args.stiffness)
-    if not path.is_file():
-        raise ValueError(f"--stiffness: no such file '{path}'")
-    curve = StiffnessCurve.from_csv(path)
-    shape, law, prov = curve.design, curve.contact, curve.provenance
-    if shape is None or law is None or not isinstance(prov.get("material"), dict):
-        raise ValueError(f"--stiffness: '{path.name}' records no FEM design, contact law or material (a measured "
-                         f"or Appendix A curve); give --cup or --geometry and the example computes the FEM curve")
-    label = f"the stiffness curve '{path.name}'"
-    resolve_cup(curve, cup=args.cup, geometry_file=args.geometry, curve_label=label, laws="curve")
-    was = law.law + (f" mu = {law.friction:g}" if law.law == "coulomb" else "")
-    if args.contact is not None and args.contact != law.law:
-        raise ValueError(f"--contact: {label} was computed with {was} contact; drop --contact {args.contact} "
-                         f"(the curve's law is used) or derive a {args.contact} curve")
-    if args.friction is not None and (law.law != "coulomb" or args.friction != law.friction):
-        raise ValueError(f"--friction: {label} was computed with {was} contact; drop --friction")
-    fidelity = prov.get("fidelity")
-    if args.fidelity is not None and fidelity is not None and args.fidelity != fidelity:
-        raise ValueError(f"--fidelity: {label} was computed at the {fidelity} level; drop --fidelity "
-                         f"{args.fidelity} or derive a curve at that level")
-    args.fidelity = args.fidelity or fidelity
-    preset = next((name for name in ("A", "B") if shape.same_cup(preset_design(name))), None)
-    record = prov["geometry"]                           # the wall as written, its thickness profile included
-    data = {k: record[k] for k in ("name", "r0_mm", "r1_mm", "alpha_deg", "thickness_convention") if k in record}
-    thickness = record.get("thickness_profile", {})
-    if thickness.get("kind") in ("linear", "table"):
-        data["thickness"] = {"r_mm": thickness["r_mm"], "d_mm": thickness["d_mm"]}
-    geometry = geometry_from_mapping(data, source=path.name)
-    if not shape_of(geometry).same_cup(shape):
-        raise ValueError(f"--stiffness: {label} records a wall this example cannot rebuild; give --geometry")
-    contact = ContactChoice(ContactLaw(law.law, law.friction),
-                            f"stiffness curve {path.name}" + (f", from its {law.source}" if law.source else ""))
-    material = Material(E_MPa=prov["material"]["E_Pa"] / 1e6, nu=prov["material"]["nu"])
-    design = CupDesign(preset=preset) if preset else CupDesign(preset=args.cup or "A", geometry=geometry)
-    return geometry, contact, {"design": replace(design, l0_mm=args.l0_mm, l1_mm=args.l1_mm),
-                               "material": material, "stiffness_file": str(path)}
-
-
 def _steps(response, curve) -> Any:
     """The FEM path's load steps: the run's, or those a given curve's sidecar records."""
     if response is not None:
@@ -242,30 +220,10 @@ def _steps(response, curve) -> Any:
     return curve.provenance.get("solver", {}).get("steps", len(curve.u_m) - 1)
 
 
-def _check_suction_table(args: argparse.Namespace, geometry, contact: ContactChoice) -> None:
-    """--suction-table: only with the coupled route, an existing table of this very design."""
-    if args.suction_table is None:
-        return
-    if args.route != "coupled":
-        raise ValueError("--suction-table: applies to --route coupled only")
-    from reduced.suction_table import SuctionTable
-    if not Path(args.suction_table).is_file():
-        raise ValueError(f"--suction-table: no such file '{args.suction_table}'")
-    prov = SuctionTable.from_json(args.suction_table).provenance
-    if prov.get("geometry") != geometry.describe():
-        raise ValueError(f"--suction-table: '{args.suction_table}' was built for another design than "
-                         f"{geometry.name}; build it with `cupcheck suction` on the same --cup/--geometry")
-    law = contact.contact
-    built = (prov.get("contact"), float(prov.get("friction", 0.0)))
-    if built != (law.law, law.friction):
-        raise ValueError(f"--suction-table: '{args.suction_table}' was built with {built[0]} contact"
-                         f"{f' mu = {built[1]:g}' if built[0] == 'coulomb' else ''}, the example runs "
-                         f"{law.label()}; give the same --contact (and --friction)")
-
-
-def plot(series: dict, curve, cup, path: Path, title: str) -> None:
+def plot(series: dict, curve, cup, path: Path, title: str, table: Path | None = None) -> None:
     """Lifetime against F1 per series and the FEM's F0(u) beside Appendix A's, in the toolkit's
-    style; `title` names the design, contact law, mesh level, route and surface."""
+    style; `title` names the design, contact law, mesh level, route and surface; `table`: what
+    is drawn, point by point (`validation.scenes.figures.figure_table`)."""
     import matplotlib.pyplot as plt
 
     from reduced.appendix_a import appendix_a_force
@@ -287,6 +245,9 @@ def plot(series: dict, curve, cup, path: Path, title: str) -> None:
                    label="Appendix A")
         ax[1].set(xlabel="plate displacement u (mm)", ylabel="stiffness force $F_0$ (N)")
         ax[1].legend(fontsize=6)
+        if table is not None:
+            from validation.scenes.figures import write_figure_table
+            write_figure_table(fig, table, title)
         save_figure(fig, path)
 
 
@@ -302,7 +263,7 @@ def run(args: argparse.Namespace) -> int:
     check_outputs(directories={"--out": args.out}, stores={"--cache-dir": args.cache_dir}, inputs=command_inputs(args))
     given = curve_study = None
     if args.stiffness is not None:
-        given = _curve_inputs(args)                    # the curve's design, law, level, material
+        given = curve_inputs(args)                    # the curve's design, law, level, material
         geometry, contact, curve_study = given
     args.fidelity = args.fidelity or DEFAULT_FIDELITY
     laws = cup_laws(args, coupled=True, fem=True)
@@ -311,14 +272,14 @@ def run(args: argparse.Namespace) -> int:
         geometry, contact, uc_label = _inputs(args)
     else:
         uc_label = _inputs(args, geometry)[2]
-    _check_suction_table(args, geometry, contact)
+    check_suction_table(args, geometry, contact)
     study = study_of(args, contact)
     if curve_study is not None:
         study = replace(study, **curve_study)
     products = Products(study, suction_cache_dir=None if args.no_cache else args.cache_dir,
-                        fem_progress=terminal_progress("FEM"))
+                        fem_progress=terminal_progress("FEM"), keep_partial=True)
     from fem.solver import ConvergenceError
-    from validation.commands._failure import solver_failure
+    from validation.commands._failure import failure_record, solver_failure
 
     with atomic_directory(args.out) as tmp:
         try:
@@ -342,13 +303,18 @@ def run(args: argparse.Namespace) -> int:
             series["FEM F0, paper route (strip, eqs 3-7)"] = products.derived(
                 paper, inherit=("uc_table", "curve", "cup")).lifetimes()
         series["Appendix A-fed, paper route (d0 2 mm)"] = products.appendix_a(refine=1).lifetimes()
-        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, study)
+        partial = products.partial()
+        write_table(results, tmp / "lifetime_vs_force.csv", choice.cup.name, study, partial)
         if args.route == "fem":
             _write_trajectories(results, tmp, choice.cup.name)
         plot(series, curve, choice.cup, tmp / "lifetime_vs_force.png",
-             f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}")
-        _write_manifest(tmp, study)
+             f"{choice.label}, FEM {contact.contact.label()} ({args.fidelity}), {args.route} route, {uc_label}",
+             tmp / "lifetime_vs_force_data.csv")
+        _write_manifest(tmp, study, partial)
     wall = time.perf_counter() - t0
+    failure = Path(f"{Path(args.out)}.failure.json")
+    if partial is not None and response is not None:   # after the directory, which removed an earlier record
+        failure_record(products.path_stop().error, failure)
     slope = float(curve.force(curve.h1_m - 1e-3))
     patch = getattr(products.uc_table(), "patch_length_m", None)
     crossed = {"profile": "the FEM's contact-pressure profiles" + (f", averaged over patches of {1e6 * patch:.0f} um"
@@ -359,31 +325,48 @@ def run(args: argparse.Namespace) -> int:
                       f"(largest holdable force {holdable:.4g} N)",
                "strip": "one strip at eq (6)'s pressure" + (f" (l0, l1: {choice.l_source})"
                                                             if laws == "cone" else "")}[_seal(args.route)]
+    end = "0.9 h1" if study.u_max_mm is None and partial is None else f"{1e3 * curve.u_m[-1]:.4g} mm"
     print(f"{choice.label}: FEM {contact.contact.label()} stiffness (from the "
           f"{contact.source}; {args.fidelity}, {_steps(response, curve)} steps), "
-          f"F0(1 mm) = {slope:.3g} N, F0(0.9 h1) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
+          f"F0(1 mm) = {slope:.3g} N, F0({end}) = {curve.F0_N[-1]:.3g} N; u_c from {uc_label}; "
           f"r_start {1e3 * choice.cup.r_start_m:.4g} mm; r, V from the "
           f"{_rv_source(args.route, laws)}; {args.route} route: the leak "
           f"crosses {crossed}")
     names = list(series)
     print(f"  {'F1 (N)':>7} " + " ".join(f"{n.split(',')[0] + ', ' + n.split(', ')[1].split(' ')[0]:>24}"
                                          for n in names) + "  end")
-    for i, r in enumerate(results):
-        print(f"  {r.force_N:7g} " + " ".join(f"{series[n][i].lifetime_s:24.4g}" for n in names) + f"  {r.reason}")
+    at = [{r.force_N: r for r in series[n]} for n in names]
+    for r in results:
+        print(f"  {r.force_N:7g} " + " ".join(f"{s[r.force_N].lifetime_s:24.4g}" if r.force_N in s else f"{'':>24}"
+                                              for s in at) + f"  {r.reason}")
     extra = {"coupled": ", suction_table.json", "fem": ", trajectory_F1_*.csv"}.get(args.route, "")
-    print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png, stiffness_fem.csv"
+    print(f"wrote {Path(args.out) / 'lifetime_vs_force.csv'}, lifetime_vs_force.png (its data: "
+          f"lifetime_vs_force_data.csv), stiffness_fem.csv"
           f"{extra} in {wall:.1f} s")
-    return 0
+    if partial is None:
+        return 0
+    if response is None:                                # a given partial curve: used within its range
+        from validation.bridge.pipeline import partial_note
+        refused = ", ".join(f"{r['force_N']:g}" for r in partial["refused"])
+        print(f"note: --stiffness '{args.stiffness}' is {partial_note(curve.provenance)}; used within that range"
+              + (f"; lifetimes refused at F1 = {refused} N, beyond the curve" if refused else ""), file=sys.stderr)
+        return 0
+    from validation.scenes.outputs import partial_lines
+    for line in partial_lines({"study": partial}, "cli"):
+        print(f"cupcheck example: {line}; the record is in {failure}", file=sys.stderr)
+    return PARTIAL_EXIT
 
 
-def _write_manifest(tmp: Path, study: Study) -> None:
-    """manifest.json: the files written and the study they were computed for."""
+def _write_manifest(tmp: Path, study: Study, partial: dict[str, Any] | None = None) -> None:
+    """manifest.json: the files written, the study they were computed for and, for a partial FEM
+    curve, its record (`Products.partial`)."""
     import json
 
     from validation.output import MANIFEST, software_versions
 
     files = sorted(p.name for p in tmp.iterdir() if p.is_file())
     (tmp / MANIFEST).write_text(json.dumps({"files": [{"path": f} for f in files], "study": study.describe(),
+                                            **({"partial": partial} if partial else {}),
                                             "versions": software_versions()}, indent=1, default=str) + "\n")
 
 

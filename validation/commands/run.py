@@ -8,6 +8,12 @@ computes nothing. A rerun into the same DIR draws only the outputs whose inputs 
 files were edited or deleted (the manifest records what each file was made from and its sha256);
 one that changes nothing writes nothing. --no-cache computes and draws everything afresh.
 
+An FEM stiffness curve whose path fails after some converged steps keeps them: the outputs drawn
+from it use the converged part, flagged partial (the curve's sidecar, a curve_partial_to_u_mm
+column in the lifetime tables, "partial" in the manifest); a lifetime that needs a state beyond it
+is refused for its force (reason beyond_partial_curve), the others computed; one line says where
+the path stopped and which stiffness.u_max_mm runs, and the exit status is 3.
+
 examples:
   cupcheck run scenes/lifetime_vs_force_cupA.toml --out out/lifetime
   cupcheck run scenes/uc_presets.toml --out out/uc --no-cache
@@ -23,6 +29,8 @@ from validation.bridge.cache import CACHE_ENV, user_cache_dir
 
 NAME = "run"
 HELP = "run a scene file: the curves, lifetimes and figures it asks for (cached)"
+#: exit status of a run whose stiffness curve is the converged part of a failed FEM path
+PARTIAL_EXIT = 3
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -73,8 +81,11 @@ def run(args: argparse.Namespace) -> int:
     timing = ", ".join(f"{k} {v:.2f} s" for k, v in result.timings.items())
     if result.up_to_date:
         print(f"run: the {len(result.files)} files in {args.out} are up to date (nothing written)")
-        return 0
-    kept = f", {len(result.kept)} unchanged kept" if result.kept else ""
-    print(f"run: wrote {len(result.files) - len(result.kept)} files{kept} and manifest.json to {args.out} "
-          f"({timing or 'nothing computed'})")
-    return 0
+    else:
+        kept = f", {len(result.kept)} unchanged kept" if result.kept else ""
+        print(f"run: wrote {len(result.files) - len(result.kept)} files{kept} and manifest.json to {args.out} "
+              f"({timing or 'nothing computed'})")
+    from validation.scenes.outputs import partial_lines
+    for line in partial_lines(result.partial):         # a curve that stopped short: exit 3, as stiffness
+        print(f"run: {line}", file=sys.stderr)
+    return PARTIAL_EXIT if result.partial else 0

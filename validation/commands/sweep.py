@@ -40,7 +40,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from validation.sweeps.execute import pending_designs, run_sweep
-    from validation.sweeps.figures import sweep_figures
+    from validation.sweeps.figures import sweep_caption, sweep_figures
     from validation.sweeps.spec import load_sweep, lock_store
     import dask
     from validation.sweeps.worker import PRELOAD
@@ -74,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
         bar.close()
     if result.dashboard:
         print(f"sweep: dask dashboard was at {result.dashboard}", file=sys.stderr)
-    figures = sweep_figures(result.table, [a["name"] for a in spec.axes], args.out)
+    names = [a["name"] for a in spec.axes]
+    figures = sweep_figures(result.table, names, args.out, sweep_caption(spec.base, names))
     print(f"sweep: {result.designs} designs ({result.computed} computed, {result.reused} reused, "
           f"{result.failed} failed) in {result.wall_s:.1f} s; wrote {result.table}, results.csv and "
           f"{len(figures)} figures")

@@ -3,7 +3,9 @@
 Each takes the scene's `validation.bridge.products.Products` and returns a figure (drawn inside
 `cupcheck_style()`; `draw` writes it with `save_figure`). Every figure's title names what it was
 computed for: the design, the stiffness (the FEM's contact law and mesh level, or Appendix A), the
-route and the surface (`caption`); a swept parameter gives one line per value.
+route and the surface (`caption`); a swept parameter gives one line per value. Everything drawn is
+also a table: `figure_table` reads every line back from the figure, point by point, so the table
+is what the figure shows (e.g. the Appendix A-fed lifetimes drawn beside the FEM-fed ones).
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from pathlib import Path
 
 from validation.bridge.products import Products
 
-__all__ = ["FIGURES", "caption", "draw"]
+__all__ = ["FIGURES", "caption", "draw", "figure_table", "write_figure_table"]
 
 
 def caption(products: Products) -> str:
@@ -32,14 +34,17 @@ def caption(products: Products) -> str:
     return "; ".join(parts)
 
 
-def draw(name: str, products: Products, paths: list[Path]) -> None:
-    """Draw the figure `name` (one of `FIGURES`) and write it to each of `paths` (none: only draw)."""
+def draw(name: str, products: Products, paths: list[Path], table: Path | None = None) -> None:
+    """Draw the figure `name` (one of `FIGURES`) and write it to each of `paths` (none: only draw),
+    and what it draws to `table` (`figure_table`)."""
     from validation.style import cupcheck_style, readable_log_axes, save_figure
 
     with cupcheck_style():
         fig = FIGURES[name](products)
         fig.suptitle(caption(products), fontsize=6)
         readable_log_axes(fig)
+        if table is not None:
+            write_figure_table(fig, table, caption(products))
         for path in paths[:-1]:
             fig.savefig(path)
         if paths:
@@ -47,6 +52,30 @@ def draw(name: str, products: Products, paths: list[Path]) -> None:
         else:
             import matplotlib.pyplot as plt
             plt.close(fig)
+
+
+def figure_table(fig) -> dict[str, list]:
+    """Every labelled line of `fig`, one row per point: its panel (the axes' quantities with their
+    units, TeX marks dropped), its legend label, and x, y as drawn."""
+    plain = lambda text: text.replace("$", "").replace("\\", "")                  # noqa: E731
+    rows: dict[str, list] = {"series": [], "x_quantity": [], "x": [], "y_quantity": [], "y": []}
+    for ax in fig.axes:
+        for line in ax.get_lines():
+            label = line.get_label()
+            x, y = line.get_xdata(), line.get_ydata()
+            rows["series"] += [plain(label) if not label.startswith("_") else ""] * len(x)
+            rows["x_quantity"] += [plain(ax.get_xlabel())] * len(x)
+            rows["y_quantity"] += [plain(ax.get_ylabel())] * len(x)
+            rows["x"] += [float(v) for v in x]
+            rows["y"] += [float(v) for v in y]
+    return rows
+
+
+def write_figure_table(fig, path: Path, title: str) -> Path:
+    """`figure_table` of `fig` as a CSV, its first column the figure's title (what it was computed for)."""
+    from validation.output import write_table
+
+    return write_table(path, {"figure": title, **figure_table(fig)}, stage=f"figure data {Path(path).name}")
 
 
 def _axes(xlabel: str, ylabel: str):

@@ -30,12 +30,12 @@ from validation.bridge.products import Products
 from validation.bridge.study import Study
 from validation.scenes.schema import STATE_KINDS, Scene, load_scene, scene_from_mapping
 
-__all__ = ["run_scene", "SceneResult", "made_from"]
+__all__ = ["run_scene", "SceneResult", "made_from", "partial_records", "partial_lines"]
 
 #: the manifest's name in a scene's output directory
 MANIFEST = "manifest.json"
 #: what an FEM state (render, footprint, squeeze) is made from; an FEM curve adds the stiffness
-#: source; every other output (tables, figures) depends on the whole study
+#: source and its end (u_max); every other output (tables, figures) depends on the whole study
 _FEM_PARTS = ("design", "material", "contact", "fidelity")
 
 
@@ -50,6 +50,7 @@ class SceneResult:
     timings: dict[str, float] = field(default_factory=dict)
     kept: list[dict[str, str]] = field(default_factory=list)
     up_to_date: bool = False        # the directory was left as it was: nothing written
+    partial: dict[str, dict[str, Any]] = field(default_factory=dict)   # partial curves, by study (`partial_records`)
 
 
 def made_from(output: Mapping[str, Any], study: Study) -> dict[str, Any]:
@@ -64,7 +65,7 @@ def made_from(output: Mapping[str, Any], study: Study) -> dict[str, Any]:
     if output["kind"] in STATE_KINDS:
         parts = _FEM_PARTS
     elif output["kind"] == "curve" and study.stiffness == "fem":
-        parts = (*_FEM_PARTS, "stiffness")
+        parts = (*_FEM_PARTS, "stiffness", "u_max_mm")
     else:
         parts = tuple(record)
     sources = source_hash("fem", "reduced", "validation")
@@ -89,21 +90,22 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
     t0 = time.perf_counter()
     n = len(scene.outputs)
     if out is None:
-        products = Products(study, cache_dir=cache_dir, progress=progress)
+        products = Products(study, cache_dir=cache_dir, progress=progress, keep_partial=True)
         for k, o in enumerate(scene.outputs):
             if progress is not None:
                 progress(f"output {k + 1} of {n}: {o['name']}")
             _write(o, products, None)
-        return SceneResult(scene, products.computed(), [], dict(products.timings))
+        return SceneResult(scene, products.computed(), [], _timings(products), partial=partial_records(products))
 
     out = Path(out)
     made = [made_from(o, study) for o in scene.outputs]
     previous = _manifest(out) if reuse else None
     intact = [_intact_files(o, m["key"], previous, out) for o, m in zip(scene.outputs, made)]
-    if previous is not None and _up_to_date(previous, scene, intact):
+    if previous is not None and _up_to_date(previous, scene, intact, out):
         files = [{**f, "path": str(out / f["path"])} for kept in intact for f in kept]
-        return SceneResult(scene, {}, files, {}, kept=list(files), up_to_date=True)
-    products = Products(study, cache_dir=cache_dir, progress=progress)
+        return SceneResult(scene, {}, files, {}, kept=list(files), up_to_date=True,
+                           partial=previous.get("partial") or {})
+    products = Products(study, cache_dir=cache_dir, progress=progress, keep_partial=True)
     with atomic_directory(out) as tmp:
         files, kept = [], []
         for k, (o, origin, old) in enumerate(zip(scene.outputs, made, intact)):
@@ -115,14 +117,56 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
                 files += linked
                 continue
             files += [{**f, **origin, "sha256": file_digest(f["path"])} for f in _write(o, products, Path(tmp))]
+        partial = partial_records(products)
+        if any(old for old in intact):     # an output kept from the previous run keeps its partial record
+            partial = {**(previous or {}).get("partial", {}), **partial}
         manifest = {"files": [{**f, "path": Path(f["path"]).name} for f in files],
-                    "scene": scene.resolved(), "source": scene.source,
+                    "scene": scene.resolved(), "source": scene.source, **({"partial": partial} if partial else {}),
                     "versions": software_versions(),
-                    "timings_s": {**products.timings, "total": time.perf_counter() - t0}}
+                    "timings_s": {**_timings(products), "total": time.perf_counter() - t0}}
         (Path(tmp) / MANIFEST).write_text(json.dumps(manifest, indent=1, default=str) + "\n")
     rename = lambda f: {**f, "path": str(out / Path(f["path"]).name)}    # noqa: E731
-    return SceneResult(scene, products.computed(), [rename(f) for f in files], dict(products.timings),
-                       kept=[rename(f) for f in kept])
+    return SceneResult(scene, products.computed(), [rename(f) for f in files], _timings(products),
+                       kept=[rename(f) for f in kept], partial=partial)
+
+
+def _timings(products: Products) -> dict[str, float]:
+    """The time [s] of each product computed, a swept value's own as "<value>: <product>" (the
+    sweep's "variants" only gathers them)."""
+    timings = {k: v for k, v in products.timings.items() if k != "variants"}
+    if "variants" in products.computed():
+        for value, p in products.variants():
+            timings.update({f"{value}: {k}": v for k, v in p.timings.items()})
+    return timings
+
+
+def partial_records(products: Products) -> dict[str, dict[str, Any]]:
+    """The partial stiffness curves the scene's outputs used (`Products.partial`), by study: "study"
+    for the scene's own, "<sweep key> = <value>" for a swept one; {} when every curve is complete."""
+    records = {"study": products.partial()}
+    if products.study.sweep is not None and "variants" in products.computed():
+        records.update({f"{products.study.sweep.key} = {value}": p.partial() for value, p in products.variants()})
+    return {k: v for k, v in records.items() if v is not None}
+
+
+def partial_lines(records: Mapping[str, Mapping[str, Any]], spelling: str = "scene") -> list[str]:
+    """One line per partial curve: where and why its FEM path stopped, what it converged to, the
+    u_max that runs (the setting as `spelling` writes it) and the forces refused."""
+    from validation.bridge.pipeline import runnable_u_max_mm
+    from validation.study_schema import field_of
+
+    lines = []
+    for study, r in records.items():
+        where = "" if study == "study" else f" ({study})"
+        runs = field_of("stiffness.u_max_mm").setting(spelling, runnable_u_max_mm(r["u_max_mm_that_runs"]))
+        line = (f"partial{where}: the FEM path stopped at u = {r['failed_at_u_mm']:.4g} mm ({r['failure_reason']}); "
+                f"the stiffness curve is its converged part, u = 0 to {r['u_max_mm_that_runs']:.4g} mm (flagged "
+                f"partial); {runs} runs")
+        if r.get("refused"):
+            forces = ", ".join(f"{x['force_N']:g}" for x in r["refused"])
+            line += f"; lifetimes refused at F1 = {forces} N, beyond the curve: {r['refused'][0]['message']}"
+        lines.append(line)
+    return lines
 
 
 def _manifest(out: Path) -> dict | None:
@@ -155,10 +199,13 @@ def _same_bytes(directory: Path, entry: Mapping[str, Any]) -> bool:
     return path.is_file() and not path.is_symlink() and file_digest(path) == digest
 
 
-def _up_to_date(manifest: dict, scene: Scene, intact: list[list[dict]]) -> bool:
-    """Every output intact, the manifest lists no other file and records this very scene: nothing to write."""
+def _up_to_date(manifest: dict, scene: Scene, intact: list[list[dict]], out: Path) -> bool:
+    """Every output intact, the manifest lists no other file, `out` holds no file it does not list
+    and it records this very scene: nothing to write."""
     if not all(intact) or sum(map(len, intact)) != len(manifest["files"]):
         return False
+    if {p.name for p in out.iterdir()} != {f["path"] for f in manifest["files"]} | {MANIFEST}:
+        return False                       # a file the manifest does not list: the rerun replaces the directory
     resolved = json.loads(json.dumps(scene.resolved(), default=str))
     return manifest.get("scene") == resolved and manifest.get("source") == scene.source
 
@@ -210,13 +257,14 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
         return write_view(output, products, tmp)
     from validation.scenes.figures import draw
     paths = [] if tmp is None else [tmp / f"{name}.{suffix}" for suffix in ("svg", "png")]
-    draw(output["figure"], products, paths)
-    return [_file(name, "figure", path) for path in reversed(paths)]
+    table = None if tmp is None else tmp / f"{name}_data.csv"
+    draw(output["figure"], products, paths, table)
+    return [_file(name, "figure", path) for path in (*reversed(paths), *([table] if table else []))]
 
 
 #: the files of each output kind, by suffix (as `_write` and `write_view` name them)
-_SUFFIXES = {"curve": (".csv", ".json"), "lifetimes": (".csv",), "figure": (".png", ".svg"), "render": (".png",),
-             "footprint": (".png", ".json"), "squeeze": (".gif",)}
+_SUFFIXES = {"curve": (".csv", ".json"), "lifetimes": (".csv",), "figure": (".png", ".svg", "_data.csv"),
+             "render": (".png",), "footprint": (".png", ".json"), "squeeze": (".gif",)}
 
 
 def planned_files(scene: Scene) -> dict[str, list[str]]:
@@ -242,32 +290,54 @@ def _file(name: str, kind: str, path: Path) -> dict[str, str]:
 def _lifetime_table(results, products: Products, path: Path) -> Path:
     from validation.output import write_table
 
-    from validation.bridge.lifetimes import end_state_columns
-
     s = products.study
     return write_table(path, {
         "route": s.route, "stiffness": s.stiffness, **{k: v for k, v in s.record().items() if k != "route"},
-        "force_N": [r.force_N for r in results],
-        "lifetime_s": [r.lifetime_s for r in results], "reason": [r.reason for r in results],
-        **end_state_columns(results)})
+        **_force_columns(products)})
+
+
+def _force_columns(products: Products) -> dict[str, Any]:
+    """The lifetime columns of one study, a row per force in the study's order: the force, the
+    lifetime, the reason, the route's end state (`end_state_columns`); a force refused on a
+    partial curve has the reason "beyond_partial_curve" and blank values, and every row of a
+    partial curve says where the curve ends (``curve_partial_to_u_mm``)."""
+    from validation.bridge.lifetimes import end_state_columns
+
+    results, refused = products.lifetimes(), {r.force_N for r in products.refused()}
+    at = {r.force_N: i for i, r in enumerate(results)}
+    forces = [f for f in products.study.loads.forces_N if f in at or f in refused]
+    rows = [at.get(f) for f in forces]
+    pick = lambda values: [values[i] if i is not None else "" for i in rows]          # noqa: E731
+    columns = {"force_N": forces, "lifetime_s": pick([r.lifetime_s for r in results]),
+               "reason": [results[i].reason if i is not None else "beyond_partial_curve" for i in rows],
+               **{k: pick(v) for k, v in end_state_columns(results).items()}}
+    partial = products.partial()
+    if partial is not None:
+        columns["curve_partial_to_u_mm"] = partial["u_max_mm_that_runs"]
+    return columns
 
 
 def _sweep_table(products: Products, path: Path) -> Path:
     from validation.output import write_table
 
     key = products.study.sweep.key.split(".")[1]
-    rows = [(value, p.study.record(), r) for value, p in products.variants() for r in p.lifetimes()]
-    record = {k: [c[k] for _, c, _ in rows] for k in products.study.record()}
-    rows = [(v, r) for v, _, r in rows]
-    if products.study.route == "fem":      # the largest holdable force of each value's cup
-        from validation.bridge.lifetimes import end_state_columns
-        own = {k: [x for _, p in products.variants() for x in end_state_columns(p.lifetimes())[k]]
-               for k in ("largest_force_N", "u_final_mm", "p_b_final_Pa", "seal_r_final_mm")}
-    else:
-        own = {"ballistic_share": [r.details["ballistic_share"] for _, r in rows]}
-    return write_table(path, {key: [v for v, _ in rows], **record, "force_N": [r.force_N for _, r in rows],
-                              "lifetime_s": [r.lifetime_s for _, r in rows], "reason": [r.reason for _, r in rows],
-                              **own}, stage="scene sweep")
+    parts = [(value, p.study.record(), _force_columns(p)) for value, p in products.variants()]
+    own = ("largest_force_N", "u_final_mm", "p_b_final_Pa", "seal_r_final_mm") if products.study.route == "fem" \
+        else ("ballistic_share",)
+    names = ["force_N", "lifetime_s", "reason", *own]
+    if any("curve_partial_to_u_mm" in c for _, _, c in parts):
+        names.append("curve_partial_to_u_mm")
+    table = {key: [v for v, _, c in parts for _ in c["force_N"]]}
+    table.update({k: [r[k] for _, r, c in parts for _ in c["force_N"]] for k in products.study.record()})
+    for name in names:
+        table[name] = [x for _, _, c in parts for x in _column(c, name)]
+    return write_table(path, table, stage="scene sweep")
+
+
+def _column(columns: Mapping[str, Any], name: str) -> list:
+    """A column of `_force_columns` as a list of its rows (a value for every row repeated; blank if absent)."""
+    value = columns.get(name, "")
+    return value if isinstance(value, list) else [value] * len(columns["force_N"])
 
 
 def _trajectory(result, path: Path) -> Path:

@@ -27,8 +27,8 @@ from typing import Any
 
 from validation.bridge.study import Study, Sweep
 from validation.study_schema import FIELDS as STUDY_FIELDS
-from validation.study_schema import (check_route, check_surface_preset, field_of, finite_number, parse,
-                                     study_from_values)
+from validation.study_schema import (check_route, check_surface_preset, check_u_max, field_of, finite_number,
+                                     parse, study_from_values)
 
 __all__ = ["Scene", "load_scene", "scene_from_mapping", "OUTPUT_KINDS", "FIGURES", "key_rows"]
 
@@ -58,7 +58,8 @@ MEANING: dict[str, str] = {
                       "(render, footprint, squeeze: drawn from FEM states at u_mm)",
     "outputs[].name": "file stem (default: the figure's name, else the kind)",
     "outputs[].figure": "with kind = \"figure\": which figure (lifetime_vs_parameter needs [sweep]; "
-                        "uc_vs_pressure and F0_vs_u draw one line per swept surface or cup)",
+                        "uc_vs_pressure and F0_vs_u draw one line per swept surface or cup); written as "
+                        "PNG and SVG, and what it draws, point by point, as <name>_data.csv",
     "outputs[].u_mm": "with render, footprint, squeeze (and only them): the plate displacement shown [mm]",
     "outputs[].field": "with render, squeeze: the colouring",
     "outputs[].frames": "with squeeze: the number of frames from u = 0 to u_mm",
@@ -232,10 +233,12 @@ def _paths(tables: dict[str, dict[str, Any]], base: Path) -> None:
 
 def _guards(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
     """The plausibility guards every entry point shares (`validation.guards`), named by key path:
-    the modulus, the pull forces, the design file's lengths and wall, the u_c table's gaps."""
+    the modulus, the pull forces, the design file's lengths and wall, the FEM curve's end within
+    the height of each cup, the u_c table's gaps."""
     from validation import guards
 
     cup = tables["cup"]
+    design = None
     if cup["geometry"]:
         design = guards.load_design(cup["geometry"], cup=cup["preset"], field="cup.geometry",
                                     allow_unusual=cup["allow_unusual_design"],
@@ -244,6 +247,13 @@ def _guards(tables: dict[str, dict[str, Any]], sweep: Any = None) -> None:
     else:
         from reduced.cup import CUPS
         radii = (CUPS[cup["preset"]].r0_m * 1e3, CUPS[cup["preset"]].r1_m * 1e3)
+    u_max = tables["stiffness"]["u_max_mm"]
+    if u_max is not None:                  # within the height of each cup the scene runs
+        from fem.geometry import cup_geometry
+        swept = isinstance(sweep, Mapping) and sweep.get("key") == "cup.preset" and isinstance(sweep.get("values"), list)
+        presets = [v for v in sweep["values"] if v in ("A", "B")] if swept else [cup["preset"]]
+        for geometry in [design] if design is not None else [cup_geometry(p) for p in presets]:
+            check_u_max(u_max, geometry, "scene")
     guards.check_start_radius(tables["loads"]["r_start_mm"], radii, "loads.r_start_mm")
     if isinstance(sweep, Mapping) and sweep.get("key") == "loads.r_start_mm" and isinstance(sweep.get("values"), list):
         for j, value in enumerate(sweep["values"]):

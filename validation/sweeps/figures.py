@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["pareto_front", "map_figure", "pareto_figure", "sweep_figures", "axis_label", "AXIS_LABELS"]
+__all__ = ["pareto_front", "map_figure", "pareto_figure", "sweep_figures", "sweep_caption", "axis_label",
+           "AXIS_LABELS"]
 
 MAP_QUANTITIES = {"lifetime_s": "lifetime (s)", "small_u_stiffness_N_per_mm": "small-u stiffness (N/mm)",
                   "appendix_a_ratio": "FEM / Appendix A small-u stiffness"}
@@ -36,6 +37,17 @@ def axis_label(key: str) -> str:
         if key.endswith("_" + suffix):
             return f"{key[:-len(suffix) - 1].replace('_', ' ')} ({unit})"
     return key.replace("_", " ")
+
+
+def sweep_caption(base: dict, axes: list[str]) -> str:
+    """What every design of a sweep shares and what it varies, in the scenes' wording: "base cup A;
+    FEM sticking (coarse mesh); paper route; pmma-1.89; varied: cone angle α (deg), ..."."""
+    varied = set(axes)
+    law = "contact law varied" if varied & {"contact", "friction"} else (
+        f"coulomb mu = {base.get('friction') or 0:g}" if base["contact"] == "coulomb" else base["contact"])
+    parts = [f"base cup {base['cup']}", f"FEM {law} ({base['fidelity']} mesh)",
+             f"{base.get('route') or 'paper'} route", "surface varied" if "surface" in varied else base["surface"]]
+    return "; ".join(parts) + "\nvaried: " + ", ".join(axis_label(a) for a in axes)
 
 
 def pareto_front(benefit: np.ndarray, cost: np.ndarray) -> np.ndarray:
@@ -72,7 +84,7 @@ def _positions(column, names: list[str] | None) -> np.ndarray:
     return np.array([names.index(str(v)) for v in column], float)
 
 
-def map_figure(frame, x: str, y: str, quantity: str, force_N: float, path: Path) -> Path:
+def map_figure(frame, x: str, y: str, quantity: str, force_N: float, path: Path, caption: str = "") -> Path:
     """One map: designs at (x, y) coloured by `quantity` at pull force `force_N` (log colour for
     lifetimes); a categorical axis (contact law, surface) places its categories at 0, 1, ..."""
     import matplotlib.pyplot as plt
@@ -103,10 +115,11 @@ def map_figure(frame, x: str, y: str, quantity: str, force_N: float, path: Path)
                 getattr(ax, f"set_{axis}lim")(-0.5, len(names[key]) - 0.5)
         ax.set(xlabel=axis_label(x), ylabel=axis_label(y),
                title=f"F1 = {force_N:g} N" if quantity == "lifetime_s" else "")
+        fig.suptitle(caption, fontsize=6)
         return style.save_figure(fig, path)
 
 
-def pareto_figure(frame, force_N: float, path: Path) -> Path:
+def pareto_figure(frame, force_N: float, path: Path, caption: str = "") -> Path:
     """Lifetime at `force_N` against material volume, the Pareto front joined."""
     import matplotlib.pyplot as plt
 
@@ -123,12 +136,13 @@ def pareto_figure(frame, force_N: float, path: Path) -> Path:
         style.log_axis(ax, "both")
         ax.set(xlabel=axis_label("volume_mm3"), ylabel=axis_label("lifetime_s"), title=f"F1 = {force_N:g} N")
         ax.legend()
+        fig.suptitle(caption, fontsize=6)
         return style.save_figure(fig, path)
 
 
-def sweep_figures(table_path: Path, axes: list[str], out: Path) -> list[Path]:
+def sweep_figures(table_path: Path, axes: list[str], out: Path, caption: str = "") -> list[Path]:
     """Maps over the first two axes (numeric or categorical; one axis against the material volume)
-    and the Pareto front, for the first pull force."""
+    and the Pareto front, for the first pull force; `caption` (`sweep_caption`) heads each figure."""
     frame = _frame(table_path)
     if frame.empty:
         return []
@@ -140,7 +154,7 @@ def sweep_figures(table_path: Path, axes: list[str], out: Path) -> list[Path]:
     paths = []
     for q in MAP_QUANTITIES:
         if q in frame:
-            paths.append(map_figure(frame, x, y, q, force, out / f"map_{q}.png"))
+            paths.append(map_figure(frame, x, y, q, force, out / f"map_{q}.png", caption))
     if "lifetime_s" in frame and "volume_mm3" in frame:
-        paths.append(pareto_figure(frame, force, out / "pareto_lifetime_volume.png"))
+        paths.append(pareto_figure(frame, force, out / "pareto_lifetime_volume.png", caption))
     return paths

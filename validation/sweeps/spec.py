@@ -70,7 +70,7 @@ CATEGORICAL_AXES = ("contact", "surface")
 #: the study's fields a sweep file spells in [base] (`validation.study_schema.FIELDS`), by base key
 _STUDY = {f.sweep: f for f in FIELDS if f.sweep}
 #: optional base keys, absent unless given (a design's hash is that of its given keys)
-_OPTIONAL = ("friction", "route")
+_OPTIONAL = ("friction", "route", "u_max_mm")
 #: the sweep's own base keys (the design's geometry, what it reports) and their meaning
 _OWN: dict[str, tuple[Any, str]] = {
     "alpha_deg": (None, "cone angle [deg] (default: the cup's)"),
