@@ -27,13 +27,19 @@ minimization at given (u, N).
 
 Slips and snaps: the pull can jump as N rises at the held plate (or as the plate moves at fixed
 N): a sticking node whose normal reaction reaches zero while it carries a tangential one is
-released and slips (mu -> infinity has no continuous transition), or the wall snaps. Where the
-bracket of the root closes to 1e-3 of the trial's move with the pull still on both sides of F1,
-the pull jumps across F1 there; the cup crosses the jump at that N and is then restored to F1
-by the physical response of a held pull: the plate rises at fixed N where the pull fell, gas
-enters at the held plate where it rose (`Branch.snaps` counts them; the slip's dissipation is
-in the branch's stats). The sticking law's slips land where the load step puts them, so its
-moves between states are taken in STICKING_STEPS load steps.
+released and slips (mu -> infinity has no continuous transition), a Coulomb seal slips where its
+quasi-static step has no solution (crossed by damped motion, `fem.newton.relax_step`), or the
+wall snaps. Where the bracket of the root closes to 1e-3 of the trial's move with the pull still
+on both sides of F1, or a Coulomb trial's path crosses an instability (the state after it is
+taken: the cup jumped there), or no state is found on the line even with 1/16 of a step, the cup
+moves as the held pull and the leak move it, each move continuing the last state's path
+(`fem.branch_jumps`: the plate rises at fixed N where the pull fell, gas enters at the held plate
+where it rose, in turn, across the slips this releases; `Branch.snaps` counts the crossings, the
+slips' dissipation is in the branch's stats). The sticking law's slips land where its load steps
+put them, and the pull reached from the last state on a line jumps at many places (a cascade of
+releases); its whole branch is therefore walked that way: gas let in at the held plate by a step
+of the branch, then the plate's response, each state the first holding F1 (its moves in
+STICKING_STEPS load steps).
 
 Detachment (the criterion): with the pull F1 held, the leak raises N, and the cup follows the
 branch while N can still rise along it. Where N(u) has its maximum, dN/du = 0 (the fold of the
@@ -43,7 +49,8 @@ state, dN/du = -(dF1/du)/(dF1/dN), and the fold located by a secant on it). The 
 where the seal opens, no node of the cavity chain being on the plane any more: the detachment is
 then the last state with the seal closed, bisected to 1/64 of a step ("seal opened"). It ends
 without a detachment where the plate reaches u_min_m ("u_min"), or where no state holds F1 even
-with 1/16 of a step ("stopped: why").
+with 1/16 of a step ("stopped: why"). Where the cup moves by the leak and the held pull, it lets go
+(a "fold") where the pull is below F1 and falls as the plate rises (`fem.branch_jumps`).
 """
 
 from __future__ import annotations
@@ -56,15 +63,14 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .branch_jumps import LetGo, leak_to_hold, settle
 from .gas_path import CupWithGas, GasState
-from .solver import SolverStats, StepResult
+from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
 __all__ = ["Branch", "equilibrium_branch", "pull_sensitivities", "state_between"]
 
-SNAP_DN = 1e-6      # relative rise of N at the held plate that tests for a snap
-SNAP_DROP = 1e-3    # ... and the relative fall of F1 that makes it one
 STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
 
 
@@ -80,7 +86,7 @@ class Branch:
     detachment: GasState | None       # the fold (largest N) or the state where the seal opened
     reason: str                       # "fold", "seal opened", "u_min", "not held", "stopped: why"
     stats: SolverStats
-    snaps: int = 0                    # snaps crossed (the plate rose at fixed N to restore F1)
+    snaps: int = 0                    # jumps of the pull crossed (`fem.branch_jumps`)
 
     @property
     def N_max(self) -> float:
@@ -181,6 +187,24 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     h = 1.0
     while len(trials) < max_states:
         prev = trials[-1]
+        if walk.staircase:        # sticking: the leak and the held pull in turn (`fem.branch_jumps`)
+            try:
+                s, why, part = leak_to_hold(walk, prev, h * N_ref * max(abs(tangent[1]), 0.25), du_m, u_min,
+                                          lambda t: _open(cup, t))
+            except RuntimeError as err:
+                if h > 1.0 / 16.0 * (1 + 1e-9):
+                    h *= 0.5
+                    continue
+                return walk.result(None, f"stopped: {err}", trials, slopes)
+            if s is None:
+                return walk.result(prev if why != "u_min" else None, why, trials, slopes)
+            h = min(1.0, 2.0 * h) if part == 1.0 else h * part
+            trials.append(s)
+            if progress:
+                progress(len(trials) - 1, s.u_m, s.N)
+            slopes.append(walk.slope(s))
+            tangent = walk.tangent(s, du_m, N_ref, tangent)
+            continue
         u_pred, N_pred = prev.u_m + h * tangent[0] * du_m, prev.N + h * tangent[1] * N_ref
         if u_pred < u_min:
             return walk.result(None, "u_min", trials, slopes)
@@ -191,13 +215,16 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
                 s = walk.hold_u(prev, u_pred, N_pred)
         except _Jump as jump:
             # the pull jumps across F1 (a slip): the cup crosses it at the jump's N, then the
-            # plate rises (the pull fell) or gas enters (it rose) until the pull is F1 again
+            # plate rises (the pull fell) or gas enters (it rose) until the pull is F1 again,
+            # crossing the slips this releases (`fem.branch_jumps.settle`)
             try:
-                restored = walk.restore(jump.after, du_m, u_min)
+                restored, why = settle(walk, jump.after, du_m, N_ref, u_min)
+            except LetGo:
+                return walk.result(prev, "fold", trials, slopes)
             except RuntimeError as err:
                 return walk.result(None, f"stopped: {jump}; then {err}", trials, slopes)
             if restored is None:
-                return walk.result(None, "u_min", trials, slopes)
+                return walk.result(None, why, trials, slopes)
             if _open(cup, restored):
                 return walk.result(prev, "seal opened", trials, slopes)
             tangent, h = crossed(restored), 1.0
@@ -206,16 +233,15 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             if h > 1.0 / 16.0 * (1 + 1e-9):
                 h *= 0.5
                 continue
-            # a snap? F1 falls by a finite amount as N rises at the held plate (a seal slips):
-            # under the held pull the plate then rises at that N until F1 is restored
+            # no state on the line from prev (a jump the trials cannot cross: a slip, a snap):
+            # the cup moves as the leak and the held pull move it (`fem.branch_jumps`)
+            dN = h * N_ref * max(abs(tangent[1]), 0.25)
             try:
-                after = walk.solve(prev, prev.u_m, prev.N * (1.0 + SNAP_DN))
-                restored = after.F1_N < walk.F1 - SNAP_DROP * abs(walk.F1) and \
-                    walk.pull_to_force(after, du_m, u_min)
-            except RuntimeError:
-                restored = None
-            if not restored:
-                return walk.result(None, f"stopped: {err}", trials, slopes)
+                restored, why, _ = leak_to_hold(walk, prev, dN, du_m, u_min, lambda t: _open(cup, t))
+            except RuntimeError as again:
+                return walk.result(None, f"stopped: {err}; then {again}", trials, slopes)
+            if restored is None:
+                return walk.result(prev if why != "u_min" else None, why, trials, slopes)
             tangent, h = crossed(restored), 1.0
             continue
         h = min(1.0, 2.0 * h)
@@ -240,14 +266,18 @@ def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float,
                   walk: type | None = None) -> GasState | None:
     """A state holding F1_N between two consecutive states a and b of a branch, reached from a
     (its history): N the unknown at the plate midway, or where that fails, the plate at N
-    midway. None where neither is found between them (a jump of the pull between a and b).
-    walk: as `equilibrium_branch`'s."""
+    midway. None where neither is found between them, or where the way there crosses an
+    instability (a jump of the pull between a and b). walk: as `equilibrium_branch`'s."""
     walk = (walk or _Walk)(cup, float(F1_N))
     prev = _Trial(a.u_m, a.N, a.F1_N, a.state)
     u, N = 0.5 * (a.u_m + b.u_m), 0.5 * (a.N + b.N)
     for find in (walk.hold, walk.hold_u):
         try:
             s = find(prev, u, N)
+        except _Jump as jump:
+            if jump.instability:        # the cup jumps between a and b: no state midway
+                return None
+            continue
         except RuntimeError:
             continue
         if min(a.N, b.N) < s.N < max(a.N, b.N) and not _open(cup, s):
@@ -261,12 +291,16 @@ def _open(cup: CupWithGas, s: "_Trial") -> bool:
     return not np.any(x[1, cup.cavity.nodes] <= cup.cavity.tolerance_m)
 
 
+class _Crossed(ConvergenceError):
+    """Stops a trial's path at the first instability it crosses (`_Walk.solve`)."""
+
+
 class _Jump(RuntimeError):
     """The pull jumps across F1 between two states close together in N or u (module docstring)."""
 
-    def __init__(self, before: "_Trial", after: "_Trial", message: str):
+    def __init__(self, before: "_Trial", after: "_Trial", message: str, instability: bool = False):
         super().__init__(message)
-        self.before, self.after = before, after
+        self.before, self.after, self.instability = before, after, instability
 
 
 @dataclass(frozen=True, eq=False)
@@ -277,6 +311,7 @@ class _Trial:
     N: float
     F1_N: float
     step: StepResult
+    crossed: "_Trial | None" = None   # the state after the first instability its path crossed
 
 
 class _Walk:
@@ -295,8 +330,17 @@ class _Walk:
                                    max_step=1.0 / STICKING_STEPS)
             self.trial_options = replace(self.trial_options, initial_step=1.0 / STICKING_STEPS,
                                          max_step=1.0 / STICKING_STEPS, min_step=1.0 / (16 * STICKING_STEPS))
+        # a move of `fem.branch_jumps` (the leak, the plate's response): given up after a step of
+        # 1/16 of its length fails in 100 iterations (the move is then shortened)
+        self.move_options = replace(self.options, min_step=max(self.options.min_step, 1.0 / 16.0),
+                                    max_iterations=min(self.options.max_iterations, 100))
         self.stats: SolverStats | None = None
         self.snaps = 0
+        # an incremental friction law crosses instabilities by damped motion: a trial whose path
+        # crosses one has jumped (the state after it is the jump's far side, `_root`)
+        self.relaxes = bool(getattr(cup.cup.plane.law, "relaxes", False))
+        self.stop_at_crossing = False
+        self.staircase = cup.cup.plane.law.name == "sticking"
         self.slopes: dict[_Trial, tuple[float, float]] = {}     # by identity
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
@@ -323,21 +367,48 @@ class _Walk:
         return float(t[0]), float(t[1])
 
     def solve(self, start: _Trial, u_m: float, N: float, options=None) -> _Trial:
-        """The state at (u_m, N), reached from `start` with the plate and N on a line."""
+        """The state at (u_m, N), reached from `start` with the plate and N on a line; its
+        `crossed` is the state after the first instability the path crossed by damped motion
+        (a law that `relaxes`), where the path stops while `stop_at_crossing` is set (`_root`)."""
+        stop_at_crossing = self.stop_at_crossing
         u0, N0 = start.u_m, start.N
         mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
-                            schedule=lambda t: N0 + t * (N - N0))
+                            schedule=lambda t: N0 + t * (N - N0), relaxes=True)
         top = self.cup.cup.top
         dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
 
         def plate(t):
             return dofs, np.concatenate([zeros, np.full(top.size, -(u0 + t * (u_m - u0)))])
-        last = []
-        stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
-                                options=options or self.options, on_step=last.append)
-        self.stats = stats if self.stats is None else _joined(self.stats, stats)
-        end = last[-1]
-        return _Trial(float(u_m), float(N), float(np.sum(end.r_int[2 * top + 1])), end)
+        last: list[StepResult] = []
+
+        def on_step(step: StepResult) -> None:
+            last.append(step)
+            if stop_at_crossing and self.relaxes and step.unstable:
+                raise _Crossed("the path crossed an instability")
+        try:
+            stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
+                                    options=options or self.options, on_step=on_step)
+        except _Crossed as stop:
+            stats = stop.stats
+        except ConvergenceError as err:         # the cost of a failed trial counts too
+            self._count(err.stats)
+            raise
+        self._count(stats)
+
+        def trial(step: StepResult, f: float) -> _Trial:
+            at_end = f >= 1.0
+            return _Trial(float(u_m if at_end else u0 + f * (u_m - u0)),
+                          float(N if at_end else N0 + f * (N - N0)),
+                          float(np.sum(step.r_int[2 * top + 1])), step)
+        crossed = next((st for st in last if st.unstable), None) if self.relaxes else None
+        end = trial(last[-1], last[-1].t)
+        if crossed is not None:
+            return replace(end, crossed=end if crossed is last[-1] else trial(crossed, crossed.t))
+        return end
+
+    def _count(self, stats: SolverStats | None) -> None:
+        if stats is not None:
+            self.stats = stats if self.stats is None else _joined(self.stats, stats)
 
     def hold(self, prev: _Trial, u_m: float, N_guess: float) -> _Trial:
         """The state at plate position u_m whose pull is F1 (N by Newton on F1(N), module
@@ -353,12 +424,20 @@ class _Walk:
         """F1(x) = F1 for x = N at the plate u_m (k = 0) or x = u at N (k = 1), every trial
         reached from prev: Newton with the exact dF1/dx, the secant where it does not halve the
         mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`)."""
-        if k == 0:
-            def at(x): return self.solve(prev, u_m, x, self.trial_options)
-            x0, x_prev, name = N, prev.N, "N"
-        else:
-            def at(x): return self.solve(prev, x, N, self.trial_options)
-            x0, x_prev, name = u_m, prev.u_m, "the plate position"
+        name = "N" if k == 0 else "the plate position"
+
+        def at(x):
+            self.stop_at_crossing = True
+            try:
+                s = self.solve(prev, u_m, x, self.trial_options) if k == 0 else \
+                    self.solve(prev, x, N, self.trial_options)
+            finally:
+                self.stop_at_crossing = False
+            if s.crossed is not None:       # the cup meets an instability on the way: it jumps
+                raise _Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
+                            f"crossed on the way to {name} {x:.6g}", instability=True)
+            return s
+        x0, x_prev = (N, prev.N) if k == 0 else (u_m, prev.u_m)
         s = at(x0)
         tried: list[tuple[float, float, _Trial]] = [(x0, s.F1_N - self.F1, s)]
         for _ in range(12):
@@ -411,18 +490,6 @@ class _Walk:
                 a = (xa, 0.5 * fa if side == -1 else fa, sa)
                 side = -1
         raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (bracket not closed)")
-
-    def restore(self, after: _Trial, du_m: float, u_min: float) -> _Trial | None:
-        """The state holding F1 again after a jump of the pull (`_Jump`): the plate raised at
-        fixed N where the pull fell, gas let in at the held plate where it rose. None if the
-        plate reaches u_min first."""
-        if after.F1_N < self.F1:
-            return self.pull_to_force(after, du_m, u_min)
-        dF1_dN = self.derivatives(after)[0]
-        if not dF1_dN < 0.0:
-            raise RuntimeError(f"F1_N = {self.F1:g} N: the pull jumped to {after.F1_N:.4g} N and "
-                               f"more gas does not lower it")
-        return self.hold(after, after.u_m, after.N - (after.F1_N - self.F1) / dF1_dN)
 
     def pull_to_force(self, sealed: _Trial, du_m: float, u_min: float) -> _Trial | None:
         """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m

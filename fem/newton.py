@@ -161,7 +161,9 @@ def largest_slip(plane, state, u1: np.ndarray, u0: np.ndarray) -> float:
 class _Damped:
     """The body with a viscous term of one pseudo-time step: Pi(u) + (u - u_k) . C (u - u_k) / 2,
     C = diag(weight). Its minimizer is backward Euler's step of the damped motion C du/ds =
-    -grad Pi from u_k; the tangent gains C on its diagonal (the pattern is K's)."""
+    -grad Pi from u_k; the tangent gains C on its diagonal (the pattern is K's). A tangent with a
+    rank-one term (the trapped gas's `fem.trapped_gas.GasTangent`) keeps it: C is added to its
+    sparse part."""
 
     def __init__(self, mech, u_k: np.ndarray, weight: np.ndarray):
         self.mech, self.kin, self.material, self.u_k, self.weight = mech, mech.kin, mech.material, u_k, weight
@@ -169,9 +171,12 @@ class _Damped:
     def evaluate(self, u):
         W, r, K = self.mech.evaluate(u)
         d = u - self.u_k
-        K = K.copy()
-        K.setdiag(K.diagonal() + self.weight)
-        return W + 0.5 * d @ (self.weight * d), r + self.weight * d, K
+        rank_one = getattr(K, "rank_one", None)
+        D = K.copy() if rank_one is None else K.plain().copy()
+        D.setdiag(D.diagonal() + self.weight)
+        if rank_one is not None:
+            D = type(K).of(D, D.data, *rank_one)
+        return W + 0.5 * d @ (self.weight * d), r + self.weight * d, D
 
     def energy(self, u):
         d = u - self.u_k

@@ -152,8 +152,9 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         on_step(StepResult(0.0, u0, r0, W0, state, 0))
     dt = dt_ok = options.initial_step * t_max
     steps = iterations = cutbacks = unstable = jumps = 0
-    # damped motion needs the tangent as a sparse matrix (not a mech's own solver, `fem.trapped_gas`)
-    relaxes = plane is not None and getattr(plane.law, "relaxes", False) and build is make_solver
+    # damped motion (`fem.newton.relax_step`): a mech with its own solver opts in (`fem.trapped_gas`)
+    relaxes = plane is not None and getattr(plane.law, "relaxes", False) and \
+        getattr(m0, "relaxes", build is make_solver)
     bound = options.max_step * t_max     # the largest move of a node in a relaxed sub-step
     short = SLIP * bound * (1 + 1e-9)     # the longest step across an instability, the largest slip
     dissipated = 0.0

@@ -264,6 +264,9 @@ class GasMechanics:
     cavity: CavitySurface
     gas: TrappedGas
     schedule: Callable[[float], float] | None = None
+    # an incremental friction law's instabilities crossed by damped motion on this path
+    # (`fem.newton.relax_step`): the held branch's short moves opt in (`fem.gas_branch`)
+    relaxes: bool = False
     _load: PressurizedMechanics | None = field(default=None, repr=False)   # CSR positions, shared
 
     def __post_init__(self) -> None:
