@@ -61,3 +61,38 @@ def test_profile_lifetimes_do_not_depend_on_u_max(setting):
 def test_a_shorter_path_keeps_its_resolution():
     short = _curve(0.3 * GEOMETRY.h1_m, max_step=0.1)
     assert short.u_m.size - 1 >= 10           # at least 1 / max_step steps of its own travel
+
+
+def test_non_increasing_fit_is_scipys_isotonic_regression():
+    from scipy.optimize import isotonic_regression
+
+    from reduced.stiffness_curve import non_increasing_fit
+
+    rng = np.random.default_rng(7)
+    for n in (1, 2, 5, 40, 300):
+        y = np.cumsum(rng.normal(-0.1, 1.0, n))
+        w = rng.uniform(0.1, 2.0, n)
+        expected = isotonic_regression(y, weights=w, increasing=False).x
+        np.testing.assert_allclose(non_increasing_fit(y, w), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_the_contact_edge_keeps_a_monotone_r_c_and_the_force_balance_of_a_refined_curve(setting):
+    """The FEM's r_c moves outwards between fine load steps (its edge jumps by node spacings); the
+    force balance takes the monotone fit, and the largest force a refined curve holds is the default
+    curve's (the rim, not a fold, limits both) where r_c itself put folds in (58 N instead of 111 N
+    at a quarter of the default step)."""
+    study, uc, cup = setting
+    default, refined = _curve(None), _curve(None, max_step=0.0125)
+    assert default.contact_edge_m is default.r_c_m      # monotone already: taken as it is
+    strip = refined.l_m > 0
+    assert np.any(np.diff(refined.r_c_m[strip]) > 0)
+    edge = refined.contact_edge_m[strip]
+    assert np.all(np.diff(edge) <= 0)
+    # the fit keeps r_c's weighted mean over the strip phase (a least-squares projection onto a cone
+    # that holds the constants)
+    u = refined.u_m[strip]
+    w = 0.5 * (np.diff(u, prepend=u[0]) + np.diff(u, append=u[-1]))
+    assert np.sum(w * edge) == pytest.approx(np.sum(w * refined.r_c_m[strip]), rel=1e-12)
+    forces = [solve_lifetime(_model(study, c, uc, cup), 50.0, route="profile") for c in (default, refined)]
+    assert [f.reason for f in forces] == ["reached_r1", "reached_r1"]
+    assert forces[1].largest_force_N == pytest.approx(forces[0].largest_force_N, rel=0.01)
