@@ -41,7 +41,7 @@ Per converged step `CupResponse` holds (SI; the measures are the pure functions 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -143,7 +143,8 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
     that violates contact between the nodes or crosses itself (module docstring); False follows
     the solver's path regardless (for studies of the solver itself).
     solver_opts: fields of `fem.solver.SolverOptions` (rtol, etol, max_iterations, initial_step,
-    max_step, min_step, growth). Raises ValueError for bad input, `fem.solver.ConvergenceError`
+    max_step, min_step, growth); the step fractions are of the default travel 0.9 h1, or of u_max
+    when that is shorter (`_step_schedule`: a longer path takes the default path's steps). Raises ValueError for bad input, `fem.solver.ConvergenceError`
     (a RuntimeError) if a step cannot be converged; it carries the converged part as
     ``exc.partial`` (a `CupResponse` flagged partial, up to u = exc.t_from).
     """
@@ -156,7 +157,7 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
         raise ValueError(f"u_max_m: plate displacement must be in (0, h1] = (0, "
                          f"{h1 * 1e3:.4g} mm] (at u = h1 the plate reaches the plane), "
                          f"got {u_max * 1e3:.4g} mm")
-    options = SolverOptions(**solver_opts)
+    options = _step_schedule(SolverOptions(**solver_opts), u_max, h1)
     mech, plane, top, path = cup.mech, cup.plane, cup.top, cup.path
     steps: list[_StepOutputs] = []
 
@@ -177,6 +178,23 @@ def compress_cup(mesh: Mesh, material: NeoHookean = NeoHookean(),
             exc.partial = _response(steps, h1, plane, material, exc.stats, mesh, partial=True)
         raise
     return _response(steps, h1, plane, material, stats, mesh)
+
+
+#: the travel whose fractions the load steps are (the default u_max): `_step_schedule`
+REFERENCE_TRAVEL = 0.9
+
+
+def _step_schedule(options: SolverOptions, u_max: float, h1: float) -> SolverOptions:
+    """`options` with its step fractions (initial, largest, smallest, of a judged jump) taken of
+    REFERENCE_TRAVEL h1 instead of u_max when u_max is longer: every path to u_max >= 0.9 h1 then
+    converges the same states as the default one up to its end (the steps fall at the same u), so
+    a stiffness curve's samples, and what is interpolated between them, do not move with u_max. A
+    shorter path keeps its fractions of u_max (at least 1 / max_step steps)."""
+    scale = min(1.0, REFERENCE_TRAVEL * h1 / u_max)
+    if scale == 1.0:
+        return options
+    return replace(options, **{name: getattr(options, name) * scale
+                               for name in ("initial_step", "max_step", "min_step", "jump_min_step")})
 
 
 def _response(steps: list["_StepOutputs"], h1: float, plane: RigidPlane, material: NeoHookean,

@@ -55,7 +55,8 @@ class ConeGeometry:
 
 
 class CurveGeometry:
-    """r_c(h), V(h), l(h) from a stiffness curve that carries them (PCHIP in u = h1 - h)."""
+    """r_c(h), V(h), l(h) from a stiffness curve that carries them (PCHIP in u = h1 - h; r_c as
+    `StiffnessCurve.contact_edge_m`, monotone once a strip has formed)."""
 
     name = "curve"
 
@@ -68,7 +69,7 @@ class CurveGeometry:
         self.cup = cup
         self.line_contact = bool(np.any(curve.l_m <= 0))     # somewhere l = 0: sealed there
         self.h1 = self.h_ref_m = curve.h1_m
-        self._r = ScalarPchip(curve.u_m, curve.r_c_m, "stiffness curve (u for r_c)")
+        self._r = ScalarPchip(curve.u_m, curve.contact_edge_m, "stiffness curve (u for r_c)")
         self._V = ScalarPchip(curve.u_m, curve.V_m3, "stiffness curve (u for V)")
         self._l = ScalarPchip(curve.u_m, curve.l_m, "stiffness curve (u for l)")
         self.h_detach_m = curve.h1_m - float(curve.u_m[0])

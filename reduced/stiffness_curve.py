@@ -41,7 +41,7 @@ from reduced.curve_files import (CSV_COLUMNS, OPTIONAL_COLUMNS, profiles_from_li
 from reduced.design import ContactRecord, CupShape, recorded_contact, recorded_design
 from reduced.profile_leak import ContactProfile
 
-__all__ = ["StiffnessCurve", "CSV_COLUMNS", "read_profiles_csv", "profiles_from_lists"]
+__all__ = ["StiffnessCurve", "CSV_COLUMNS", "read_profiles_csv", "profiles_from_lists", "non_increasing_fit"]
 
 @dataclass(frozen=True)
 class StiffnessCurve:
@@ -118,6 +118,26 @@ class StiffnessCurve:
         (`reduced.design.ContactRecord`: law, Coulomb's mu, who chose the law), or None when the
         curve names no law (a measured curve, Appendix A)."""
         return recorded_contact(self.provenance)
+
+    @cached_property
+    def contact_edge_m(self) -> np.ndarray | None:
+        """The inner contact radius r_c [m] at the samples as the force balance takes it: from the
+        first sample with a strip (l > 0) on, the weighted least-squares non-increasing fit of r_c
+        (weights: each sample's share of u). Once a strip has formed, pressing the cup only spreads
+        its contact inwards; an outward move of the FEM's r_c between two load steps is its edge
+        estimator's jump as the contact front passes a node, and an r(h) that falls with h puts
+        folds into the equilibrium branch that the cup does not have (their number and place then
+        follow the load steps). None without r_c; r_c itself where it is already monotone."""
+        if self.r_c_m is None:
+            return None
+        strip = np.flatnonzero(self.l_m > 0) if self.l_m is not None else np.zeros(0, int)
+        if strip.size == 0 or np.all(np.diff(self.r_c_m[strip[0]:]) <= 0):
+            return self.r_c_m
+        start = int(strip[0])
+        edge = self.r_c_m.copy()
+        edge[start:] = non_increasing_fit(self.r_c_m[start:], _shares(self.u_m[start:]))
+        edge.flags.writeable = False
+        return edge
 
     def has(self, name: str) -> bool:
         """True if the optional column `name` ('r_c_m', 'l_m' or 'V_m3') is present."""
@@ -196,6 +216,33 @@ class StiffnessCurve:
         (`reduced.curve_files.read_curve_csv`: h1 from the `h_mm` column, else `h1_m` must be
         given; the provenance from the JSON sidecar when there is one)."""
         return cls(**read_curve_csv(path, h1_m))
+
+
+def non_increasing_fit(y: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The non-increasing sequence nearest to y in the w-weighted least-squares sense, by pooling
+    adjacent violators (each pooled run takes its weighted mean; isotonic regression, as
+    scipy.optimize.isotonic_regression(y, weights=w, increasing=False), without its import)."""
+    means: list[float] = []
+    weights: list[float] = []
+    counts: list[int] = []
+    for yi, wi in zip(np.asarray(y, dtype=float).tolist(), np.asarray(w, dtype=float).tolist()):
+        means.append(yi)
+        weights.append(wi)
+        counts.append(1)
+        while len(means) > 1 and means[-2] < means[-1]:
+            m, wt, n = means.pop(), weights.pop(), counts.pop()
+            total = weights[-1] + wt
+            means[-1] = (means[-1] * weights[-1] + m * wt) / total
+            weights[-1], counts[-1] = total, counts[-1] + n
+    return np.repeat(means, counts)
+
+
+def _shares(u: np.ndarray) -> np.ndarray:
+    """Each sample's share of the range of u (the trapezoid rule's weights)."""
+    if u.size < 2:
+        return np.ones(u.size)
+    gaps = np.diff(u)
+    return 0.5 * (np.concatenate([[0.0], gaps]) + np.concatenate([gaps, [0.0]]))
 
 
 def _frozen_array(value: Any, name: str, size: int | None = None) -> np.ndarray:

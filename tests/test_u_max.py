@@ -5,8 +5,8 @@ state beyond it, name the u_max that runs and exit with status 3, as `cupcheck s
 
 Real failing runs, no mocks (the same two as tests/test_partial_curve.py):
 
-* cup A, sticking, coarse mesh, pressed to u = h1: the wall folds into the plate at u = 8.921 mm,
-  after 21 converged steps (partial to 8.467 mm);
+* cup A, sticking, coarse mesh, pressed to u = h1: the wall folds into the plate at u = 8.847 mm,
+  after 23 converged steps (partial to 8.438 mm);
 * a thin 45-degree cone (0.5 -> 0.06 mm wall), coarse, frictionless, to its default 0.9 h1: the
   wall turns over at u = 2.371 mm, far short of the u its r_start needs.
 """
@@ -100,10 +100,10 @@ def test_example_keeps_a_late_failures_converged_part_and_names_the_u_max_that_r
     code, stdout, err = run_cli(capsys, *STICKING, "--u-max-mm", f"{H1_MM:.9g}", "--out", out)
     assert code == 3, err
     line = err.strip().splitlines()[-1]
-    assert line.startswith("cupcheck example: partial: the FEM path stopped at u = 8.921 mm (the wall folds")
-    assert line.endswith(f"the stiffness curve is its converged part, u = 0 to 8.467 mm (flagged partial); "
-                         f"--u-max-mm 8.466 runs; the record is in {record}")
-    assert "F0(8.467 mm) = " in stdout
+    assert line.startswith("cupcheck example: partial: the FEM path stopped at u = 8.847 mm (the wall folds")
+    assert line.endswith(f"the stiffness curve is its converged part, u = 0 to 8.438 mm (flagged partial); "
+                         f"--u-max-mm 8.438 runs; the record is in {record}")
+    assert "F0(8.438 mm) = " in stdout
     curve = StiffnessCurve.from_csv(out / "stiffness_fem.csv")
     prov = curve.provenance
     assert prov["partial"] is True and "folds onto itself" in prov["failure_reason"]
@@ -118,13 +118,12 @@ def test_example_keeps_a_late_failures_converged_part_and_names_the_u_max_that_r
     assert json.loads(record.read_text())["u_to_mm"] == pytest.approx(prov["failed_at_u_mm"])
 
     # the u_max it names runs to the end; that complete run removes the stale failure record
-    code, stdout, err = run_cli(capsys, *STICKING, "--u-max-mm", "8.466", "--out", out)
-    assert code == 0 and not record.exists() and "F0(8.466 mm) = " in stdout
+    code, stdout, err = run_cli(capsys, *STICKING, "--u-max-mm", "8.438", "--out", out)
+    assert code == 0 and not record.exists() and "F0(8.438 mm) = " in stdout
     complete = pd.read_csv(out / "lifetime_vs_force.csv")
     assert "curve_partial_to_u_mm" not in complete and "partial" not in json.loads((out / "manifest.json").read_text())
-    # the same cup states by other load steps: where the lifetimes read the curves (u <= 4.5 mm)
-    # their F0 differ by the step placement (sticking is path dependent; measured <= 0.48 %), and
-    # the paper route's lifetimes by as much (measured 0.02 % at 5 N to 0.48 % at 80 N)
+    # the same cup states by the same load steps (a path beyond 0.9 h1 takes the default path's):
+    # where the lifetimes read the curves (u <= 4.5 mm) F0 and the lifetimes agree
     u = np.linspace(0.5e-3, 4.5e-3, 9)
     steps = StiffnessCurve.from_csv(out / "stiffness_fem.csv")                  # the complete curve
     assert curve.force(curve.h1_m - u) == pytest.approx(steps.force(steps.h1_m - u), rel=1e-2)
@@ -149,8 +148,8 @@ def test_a_scene_keeps_the_converged_part_and_exits_3_also_when_up_to_date(tmp_p
         assert code == 3
         assert ("up to date" in stdout) == rerun
         line = err.strip().splitlines()[-1]
-        assert line.startswith("run: partial: the FEM path stopped at u = 8.921 mm (the wall folds")
-        assert line.endswith("u = 0 to 8.467 mm (flagged partial); stiffness.u_max_mm = 8.466 runs")
+        assert line.startswith("run: partial: the FEM path stopped at u = 8.847 mm (the wall folds")
+        assert line.endswith("u = 0 to 8.438 mm (flagged partial); stiffness.u_max_mm = 8.438 runs")
     side = json.loads((out / "curve.json").read_text())
     assert side["provenance"]["partial"] is True
     table = pd.read_csv(out / "lifetimes.csv")
