@@ -72,7 +72,9 @@ class CoupledCavity:
     with E the table's modulus (with relaxation E_eff(phi), `reduced.coupled_relax`).
     relaxation: E_eff(t), or None (kappa fixed); phi0_s: with relaxation, the contact time [s] of
     the stiffness measurement the table stands for (`reduced.viscoelastic.measurement_contact_time`,
-    13 s for cup A)."""
+    13 s for cup A). conductances: None, or a dict of node conductances by the node's (u, dp) in
+    table units, read and filled here, that cavities of the same model on tables of the same
+    states share (a builder's rounds on a growing table with holes)."""
 
     table: SuctionTable
     u_c: Callable[[float], float]
@@ -85,6 +87,7 @@ class CoupledCavity:
     along_u: str = "pchip"
     relaxation: RelaxationModulus | None = None
     phi0_s: float | None = None
+    conductances: dict | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.kappa) and self.kappa > 0):
@@ -182,20 +185,28 @@ class CoupledCavity:
         at dp = 0 its limit, from a 1 Pa difference (nan beyond p_a and at a hole)."""
         E = self.table.E_Pa
         out = np.full((self._u.size, self._dp.size), np.nan)
-        built = self.table.built
+        built, memo = self.table.built, self.conductances
         for i in range(self._u.size):
             for j, dp in enumerate(self._dp):
                 if dp > self.p_a_Pa or not built[i, j]:
                     continue
-                prof = self._solid_profile(i, j)
-                drive = max(dp, 1.0)
-                gaps = ring_gaps(prof, self.u_c, E)
-                if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
-                    out[i, j] = np.inf           # open): no resistance, see _rate_surface
+                key = (float(self._u[i]), float(self.table.dp_Pa[j]))
+                if memo is not None and key in memo:
+                    out[i, j] = memo[key]
                     continue
-                out[i, j] = profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - drive, prof.r_m, gaps,
-                                              self.radial) / drive
+                out[i, j] = self._conductance(i, j, dp, E)
+                if memo is not None:
+                    memo[key] = out[i, j]
         return out
+
+    def _conductance(self, i: int, j: int, dp: float, E: float) -> float:
+        """Ndot / dp at node (i, j) (`_node_conductance`)."""
+        prof = self._solid_profile(i, j)
+        drive = max(dp, 1.0)
+        gaps = ring_gaps(prof, self.u_c, E)
+        if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
+            return np.inf                # open): no resistance, see _rate_surface
+        return profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - drive, prof.r_m, gaps, self.radial) / drive
 
     def _solid_profile(self, i: int, j: int) -> ContactProfile:
         """The solid contact pressure at node (i, j) of the kappa-times-stiffer cup (`solid_profile`)."""

@@ -37,9 +37,9 @@ class AroundSpec:
     """The seed's sub-grid (every `u_every`-th u and `dp_every`-th dp of the lattice), the cells
     added around each path point and each missing state, and a bound on the rounds."""
 
-    u_every: int = 8
-    dp_every: int = 10
-    margin: int = 1
+    u_every: int = 24
+    dp_every: int = 5
+    margin: int = 0
     max_rounds: int = 100
 
     def __post_init__(self) -> None:
@@ -82,14 +82,19 @@ def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goa
     asked[np.ix_(U, D)] = True
     lattice = table_on(asked)
     reads = _Reads(lattice.u_m, goal.model.kappa * lattice.dp_Pa)
+    memo: dict = {}                                   # node conductances, shared by the rounds
     built = np.zeros_like(asked)
-    for u, dp in _path_points(goal, _compressed(lattice, U, D)):
+    for u, dp in _path_points(goal, _compressed(lattice, U, D), memo):
         _widen(built, reads(u, dp), spec.margin)
     rounds = []
+    pending = list(range(len(goal.forces_N) + 1))     # the lifetimes, then the largest force
     for _ in range(spec.max_rounds):
         asked |= built
         table = table_on(built)
-        missing = _missing(goal, table)
+        missing, pending = _missing(goal, table, memo, pending)
+        if not missing and len(pending) < len(goal.forces_N) + 1:
+            pending = list(range(len(goal.forces_N) + 1))       # all of them once more, on the last table
+            missing, pending = _missing(goal, table, memo, pending)
         rounds.append((int(built.sum()), len(missing)))
         if not missing:
             return AroundBuild(table, asked, tuple(rounds))
@@ -123,19 +128,19 @@ def _compressed(table, U: list[int], D: list[int]):
     return lattice_subtable(table, U, D)
 
 
-def _cavity(goal: SuctionGoal, table):
+def _cavity(goal: SuctionGoal, table, memo: dict):
+    """The route's cavity of the goal on `table`, sharing the node conductances in `memo`."""
     from reduced.lifetime.routes import ROUTES
 
     route = ROUTES["coupled"]
-    model = replace(goal.model, suction=table)
-    cavity, u_start, _ = route.cavity(model, dict(route.options))
-    return model, cavity, u_start
+    cavity, u_start, _ = route.cavity(replace(goal.model, suction=table), dict(route.options))
+    return replace(cavity, conductances=memo), u_start
 
 
-def _path_points(goal: SuctionGoal, table) -> list[tuple[float, float]]:
+def _path_points(goal: SuctionGoal, table, memo: dict) -> list[tuple[float, float]]:
     """Every (u, dp) the goal's paths visit on a complete table: the lifetimes' trajectories, the
     start and the largest holdable force's end."""
-    model, cavity, u_start = _cavity(goal, table)
+    cavity, u_start = _cavity(goal, table, memo)
     points = [(u_start, cavity.start(u_start)[0])]
     for F in goal.forces_N:
         r = cavity._lifetime(F, u_start)
@@ -145,17 +150,21 @@ def _path_points(goal: SuctionGoal, table) -> list[tuple[float, float]]:
     return points
 
 
-def _missing(goal: SuctionGoal, table) -> list[tuple[int, int]]:
-    """The states the goal's lifetimes and largest holdable force read and the table lacks
-    (each computed on its own, so that one round finds the holes of all of them)."""
+def _missing(goal: SuctionGoal, table, memo: dict, pending: list[int]) -> tuple[list[tuple[int, int]], list[int]]:
+    """(the states the pending computations (index k < len(forces): the k-th lifetime, else the
+    largest holdable force) read and the table lacks, the computations that lacked some). Each is
+    computed on its own, so that one round finds the holes of all of them; one that ran through
+    reads only built states, which added states do not change."""
     from reduced.suction_table import MissingStates
 
-    _, cavity, u_start = _cavity(goal, table)
+    cavity, u_start = _cavity(goal, table, memo)
+    forces = goal.forces_N
     missing: set[tuple[int, int]] = set()
-    for work in [lambda F=F: cavity._lifetime(F, u_start) for F in goal.forces_N] + \
-            [lambda: cavity._largest_force(u_start)]:
+    failed = []
+    for k in pending:
         try:
-            work()
+            cavity._lifetime(forces[k], u_start) if k < len(forces) else cavity._largest_force(u_start)
         except MissingStates as err:
             missing |= set(err.nodes)
-    return sorted(missing)
+            failed.append(k)
+    return sorted(missing), failed

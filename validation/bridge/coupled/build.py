@@ -131,7 +131,9 @@ def _build_around(geometry, fidelity, contact, E_Pa, nu, grid, goal, spec, code,
     from validation.bridge.coupled.table import holed_suction_table
 
     mesh = cup_mesh(geometry, fidelity)
-    states = SuctionStates(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), contact)
+    # a new row is pressed from the kept row below it in one step (cut where Newton needs it): the
+    # rows are close, and a frictionless state does not depend on the path that reached it
+    states = SuctionStates(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), contact, initial_step=1.0, max_step=1.0)
     u, dp = grid.u_m(cup_height(mesh)), grid.dp_Pa
     provenance = {"geometry": geometry.describe(), "fidelity": fidelity}
 
