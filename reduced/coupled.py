@@ -54,12 +54,13 @@ from functools import cached_property
 import numpy as np
 from scipy.optimize import brentq
 
+from reduced import coupled_holes as holes
 from reduced.coupled_holes import Holes
 from reduced.coupled_relax import RelaxedParts, relaxed_lifetime, relaxed_parts
 from reduced.coupled_result import _CoupledRecord
 from reduced.gas import AIR, Gas
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
-from reduced.suction_table import MissingStates, SuctionTable
+from reduced.suction_table import SuctionTable
 from reduced.table_surface import INTERFACES, TableSurface, solid_profile
 from reduced.viscoelastic import RelaxationModulus
 
@@ -221,7 +222,7 @@ class CoupledCavity:
     def u_at(self, F1: float, dp: float) -> float:
         """u with F1(u, dp) = F1 (F1 falls with u); ValueError where the table ends."""
         if self._holes is not None:
-            return self._u_at_holed(F1, dp)
+            return holes.u_at(self, F1, dp)
         lo, hi = self.F1(self._u[-1], dp), self.F1(self._u[0], dp)
         slack = 1e-9 * max(abs(lo), abs(hi), 1.0)       # the bracket ends, found by brentq on dp
         if lo - slack <= F1 < lo:
@@ -233,18 +234,6 @@ class CoupledCavity:
                              f"[{lo:.4g}, {hi:.4g}] N over u = {1e3 * self._u[0]:.4g} ... "
                              f"{1e3 * self._u[-1]:.4g} mm")
         return brentq(lambda u: self.F1(u, dp) - F1, self._u[0], self._u[-1], xtol=1e-15, rtol=1e-13)
-
-    def _u_at_holed(self, F1: float, dp: float) -> float:
-        """`u_at` on a table with holes: bracketed in the built cell F1 crosses (`Holes.root_cell`)."""
-        found = self._holes.root_cell("u", dp, lambda u: self.F1(u, dp), F1, rising=False)
-        if isinstance(found, tuple):
-            return brentq(lambda u: self.F1(u, dp) - F1, *found, xtol=1e-15, rtol=1e-13)
-        end = self._u[0] if found == "below" else self._u[-1]
-        edge = self.F1(end, dp)
-        if abs(F1 - edge) <= 1e-9 * max(abs(edge), 1.0):
-            return float(end)
-        raise ValueError(f"F1 = {F1:.4g} N at dp = {dp / 1e3:.4g} kPa lies {found} the table's "
-                         f"{edge:.4g} N at u = {1e3 * end:.4g} mm")
 
     def content(self, F1: float, dp: float) -> tuple[float, float]:
         """(u, N) of the state on the F1 branch at dp."""
@@ -261,11 +250,7 @@ class CoupledCavity:
         table with holes: (the low end, nan))."""
         top = self._dp_top
         if self._holes is not None:
-            u0 = self._u[0]
-            found = self._holes.root_cell("dp", u0, lambda d: self.F1(u0, d), F1, rising=True, top=top)
-            if isinstance(found, tuple):
-                return brentq(lambda d: self.F1(u0, d) - F1, *found, xtol=1e-9), math.nan
-            return (0.0 if found == "below" else math.nan), math.nan
+            return holes.dp_low(self, F1), math.nan
         if F1 > self.F1(self._u[0], top):
             return math.nan, math.nan
         lo = 0.0 if F1 <= self.F1(self._u[0], 0.0) else brentq(
@@ -281,13 +266,7 @@ class CoupledCavity:
                              f"{1e3 * self._u[-1]:.4g}] mm, got {1e3 * u_start_m:.4g} mm")
         top = self._dp_top
         if self._holes is not None:
-            found = self._holes.root_cell("dp", u_start_m, lambda d: self.F1(u_start_m, d), 0.0, rising=True,
-                                          top=top)
-            if not isinstance(found, tuple):
-                raise ValueError(f"u_start: the table's dp <= {top / 1e3:.4g} kPa cannot hold the cup "
-                                 f"released at u = {1e3 * u_start_m:.4g} mm" if found == "above" else
-                                 f"u_start: the cup released at u = {1e3 * u_start_m:.4g} mm pulls at dp = 0")
-            dp = brentq(lambda d: self.F1(u_start_m, d), *found, xtol=1e-9)
+            dp = holes.start_dp(self, u_start_m)
             return dp, (self.p_a_Pa - dp) * self.V(u_start_m, dp) / self.gas.kT_J
         if self.F1(u_start_m, top) < 0:
             raise ValueError(f"u_start: the table's dp <= {top / 1e3:.4g} kPa cannot hold the cup "
@@ -304,23 +283,11 @@ class CoupledCavity:
         if not np.isfinite(lo) or N0 > self.content(F1, lo)[1]:
             return N0, None, lo
         if self._holes is not None:
-            return N0, self._start_dp_holed(F1, N0, lo), lo
+            return N0, holes.holding_dp(self, F1, N0, lo), lo
         if N0 < self.content(F1, hi)[1]:
             raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
                              f"{1e3 * self._u[-1]:.4g} mm; extend the table")
         return N0, brentq(lambda d: self.content(F1, d)[1] - N0, lo, hi, xtol=1e-10 * max(hi, 1.0)), lo
-
-    def _start_dp_holed(self, F1: float, N0: float, lo: float) -> float:
-        """On a table with holes: the dp of the F1 branch's state holding N0, bracketed between
-        the grid's dp values from lo up (N falls with dp above the fold, rises below it)."""
-        top = self._dp_top
-        prev = lo
-        for d in [float(d) for d in self._dp if lo < d < top] + [top]:
-            if self.content(F1, d)[1] < N0:
-                return brentq(lambda x: self.content(F1, x)[1] - N0, prev, d, xtol=1e-10 * max(top, 1.0))
-            prev = d
-        raise ValueError(f"F1 = {F1:g} N: the branch holds more than the start content up to the "
-                         f"table's top dp = {top / 1e3:.4g} kPa; extend the table")
 
     def _largest_force(self, u_start_m: float) -> float:
         """The largest F1 [N] the cup released at u_start holds at t = 0: the branch at that F1
@@ -335,7 +302,7 @@ class CoupledCavity:
             lo, _ = self._dp_range(F1)
             return bool(np.isfinite(lo)) and N0 <= self.content(F1, lo)[1]
         if self._holes is not None:
-            found = self._force_cell_holed(holds)
+            found = holes.force_cell(self, holds)
             if not isinstance(found, tuple):
                 return found
             lo, hi = found
@@ -347,35 +314,6 @@ class CoupledCavity:
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if holds(mid) else (lo, mid)
         return lo
-
-    def _force_cell_holed(self, holds: Callable[[float], bool]) -> tuple[float, float] | float:
-        """On a table with holes: the pulls (F_a, F_b) at the ends of the built cell of the
-        smallest u's row between which `holds` turns false (the largest force lies there), or
-        the force itself where it is the table's top; MissingStates where that cell is not built."""
-        u0, top, holes = self._u[0], self._dp_top, self._holes
-        last, ok, nodes = holes.line("dp", u0, top)
-        force = lambda k: self.F1(u0, min(float(self._dp[k]), top))     # noqa: E731
-        if not nodes:
-            raise MissingStates(holes.cell_missing("dp", 0, u0), self._u, self._dp, "on the smallest u's row")
-        a, b = 0, len(nodes) - 1
-        if holds(force(nodes[b])):
-            if nodes[b] == last:
-                return force(nodes[b])
-            gap = (nodes[b], last - 1, "up")
-        elif not holds(force(nodes[a])):
-            if nodes[a] == 0:
-                return (0.0, force(0)) if force(0) > 0 else 0.0
-            gap = (0, nodes[a] - 1, "down")
-        else:
-            while b - a > 1:
-                mid = (a + b) // 2
-                a, b = (mid, b) if holds(force(nodes[mid])) else (a, mid)
-            k = nodes[a]
-            if nodes[b] == k + 1 and ok[k]:
-                return force(k), force(k + 1)
-            gap = (k, nodes[b] - 1, "")
-        raise MissingStates(holes.gap_missing("dp", u0, *gap), self._u, self._dp,
-                            "where the largest holdable force lies")
 
     def _lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
                   rtol: float = 1e-6) -> _CoupledRecord:

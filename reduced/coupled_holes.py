@@ -7,21 +7,26 @@ cubic: each node's slope is Fritsch-Carlson's of its two neighbours' secants); o
 only its row. Where all of them are built the value is the full table's to the last bit; where
 one is missing `Holes.need` raises `MissingStates` naming the missing nodes, so that a builder
 can add them, instead of reading a hole. `Holes.root_cell` finds, along one line of the grid,
-the built cell in which a monotone quantity crosses a target (the root finders of
-`reduced.coupled` bracket there instead of across the whole table).
+the built cell in which a monotone quantity crosses a target; the functions below are the root
+finders of `reduced.coupled.CoupledCavity` (`cc`) on a table with holes, bracketed there instead
+of across the whole table, with its tolerances.
 """
 
 from __future__ import annotations
 
 import bisect
+import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
+
+from scipy.optimize import brentq
 
 from reduced.suction_table import MissingStates
 from reduced.table_surface import cell
 
-__all__ = ["Holes"]
+__all__ = ["Holes", "dp_low", "force_cell", "holding_dp", "start_dp", "u_at"]
 
 
 class Holes:
@@ -84,9 +89,9 @@ class Holes:
                   rising: bool, top: float = np.inf) -> tuple[float, float] | str:
         """Along `axis` ('u' or 'dp', the other coordinate `fixed`), with value(x) monotone (rising
         or falling) and read only at built cells: the interval [x_a, x_b] of one built cell (x_b
-        at most `top`) whose ends bracket `target`; 'below' or 'above' if the target lies beyond
-        the axis' first node or its last one (at most `top`); MissingStates naming the cell the
-        crossing lies in when that cell is not built."""
+        at most `top`; x_a = x_b where a node hits `target`) whose ends bracket `target`; 'below'
+        or 'above' if the target lies beyond the axis' first node or its last one (at most `top`);
+        MissingStates (`gap_missing`) where the crossing lies in cells not built."""
         xs = self._u_list if axis == "u" else self._dp_list
         last, ok, nodes = self.line(axis, fixed, top)
         if not nodes:
@@ -127,3 +132,81 @@ class Holes:
         end: only b, or only a, is) and the middle one (a builder bisects a long gap)."""
         cells = {(a + b) // 2} | ({b} if runs == "down" else {a} if runs == "up" else {a, b})
         return sorted({n for k in cells for n in self.cell_missing(axis, k, fixed)})
+
+
+def u_at(cc: Any, F1: float, dp: float) -> float:
+    """`CoupledCavity.u_at`: u with F1(u, dp) = F1 (F1 falls with u)."""
+    found = cc._holes.root_cell("u", dp, lambda u: cc.F1(u, dp), F1, rising=False)
+    if isinstance(found, tuple):
+        return brentq(lambda u: cc.F1(u, dp) - F1, *found, xtol=1e-15, rtol=1e-13)
+    end = cc._u[0] if found == "below" else cc._u[-1]
+    edge = cc.F1(end, dp)
+    if abs(F1 - edge) <= 1e-9 * max(abs(edge), 1.0):
+        return float(end)
+    raise ValueError(f"F1 = {F1:.4g} N at dp = {dp / 1e3:.4g} kPa lies {found} the table's "
+                     f"{edge:.4g} N at u = {1e3 * end:.4g} mm")
+
+
+def dp_low(cc: Any, F1: float) -> float:
+    """The low-dp end of the F1 branch (`CoupledCavity._dp_range`): F1(u_min, dp) = F1; 0 if
+    the branch reaches dp = 0, nan if F1 is more than the table's top dp holds."""
+    u0 = cc._u[0]
+    found = cc._holes.root_cell("dp", u0, lambda d: cc.F1(u0, d), F1, rising=True, top=cc._dp_top)
+    if isinstance(found, tuple):
+        return brentq(lambda d: cc.F1(u0, d) - F1, *found, xtol=1e-9)
+    return 0.0 if found == "below" else math.nan
+
+
+def start_dp(cc: Any, u_start_m: float) -> float:
+    """dp of the cup released at u_start with F1 = 0 (`CoupledCavity.start`)."""
+    top = cc._dp_top
+    found = cc._holes.root_cell("dp", u_start_m, lambda d: cc.F1(u_start_m, d), 0.0, rising=True, top=top)
+    if not isinstance(found, tuple):
+        raise ValueError(f"u_start: the table's dp <= {top / 1e3:.4g} kPa cannot hold the cup "
+                         f"released at u = {1e3 * u_start_m:.4g} mm" if found == "above" else
+                         f"u_start: the cup released at u = {1e3 * u_start_m:.4g} mm pulls at dp = 0")
+    return brentq(lambda d: cc.F1(u_start_m, d), *found, xtol=1e-9)
+
+
+def holding_dp(cc: Any, F1: float, N0: float, lo: float) -> float:
+    """dp of the F1 branch's state holding N0 (`CoupledCavity.loaded`), bracketed between the
+    grid's dp values from lo up (N falls with dp above the fold and rises below it, so the first
+    value under N0 closes the bracket of the one crossing)."""
+    top = cc._dp_top
+    prev = lo
+    for d in [float(d) for d in cc._dp if lo < d < top] + [top]:
+        if cc.content(F1, d)[1] < N0:
+            return brentq(lambda x: cc.content(F1, x)[1] - N0, prev, d, xtol=1e-10 * max(top, 1.0))
+        prev = d
+    raise ValueError(f"F1 = {F1:g} N: the branch holds more than the start content up to the "
+                     f"table's top dp = {top / 1e3:.4g} kPa; extend the table")
+
+
+def force_cell(cc: Any, holds: Callable[[float], bool]) -> tuple[float, float] | float:
+    """For `CoupledCavity._largest_force`: the pulls (F_a, F_b) at the ends of the built cell of
+    the smallest u's row between which `holds` turns false (the largest force lies there), or the
+    force itself where it is the table's top (0 where nothing holds); MissingStates where that
+    cell is not built."""
+    u0, top, holes = cc._u[0], cc._dp_top, cc._holes
+    last, ok, nodes = holes.line("dp", u0, top)
+    force = lambda k: cc.F1(u0, min(float(cc._dp[k]), top))          # noqa: E731
+    if not nodes:
+        raise MissingStates(holes.cell_missing("dp", 0, u0), cc._u, cc._dp, "on the smallest u's row")
+    a, b = 0, len(nodes) - 1
+    if holds(force(nodes[b])):
+        if nodes[b] == last:
+            return force(nodes[b])
+        gap = (nodes[b], last - 1, "up")
+    elif not holds(force(nodes[a])):
+        if nodes[a] == 0:
+            return (0.0, force(0)) if force(0) > 0 else 0.0
+        gap = (0, nodes[a] - 1, "down")
+    else:
+        while b - a > 1:
+            mid = (a + b) // 2
+            a, b = (mid, b) if holds(force(nodes[mid])) else (a, mid)
+        k = nodes[a]
+        if nodes[b] == k + 1 and ok[k]:
+            return force(k), force(k + 1)
+        gap = (k, nodes[b] - 1, "")
+    raise MissingStates(holes.gap_missing("dp", u0, *gap), cc._u, cc._dp, "where the largest holdable force lies")

@@ -87,14 +87,15 @@ def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goa
     for u, dp in _path_points(goal, _compressed(lattice, U, D), memo):
         _widen(built, reads(u, dp), spec.margin)
     rounds = []
-    pending = list(range(len(goal.forces_N) + 1))     # the lifetimes, then the largest force
+    every = list(range(len(goal.forces_N) + 1))       # the lifetimes, then the largest force
+    pending = every
     for _ in range(spec.max_rounds):
         asked |= built
         table = table_on(built)
-        missing, pending = _missing(goal, table, memo, pending)
-        if not missing and len(pending) < len(goal.forces_N) + 1:
-            pending = list(range(len(goal.forces_N) + 1))       # all of them once more, on the last table
-            missing, pending = _missing(goal, table, memo, pending)
+        ran = pending
+        missing, pending = _missing(goal, table, memo, ran)
+        if not missing and ran != every:              # all of them once more, on the last table
+            missing, pending = _missing(goal, table, memo, every)
         rounds.append((int(built.sum()), len(missing)))
         if not missing:
             return AroundBuild(table, asked, tuple(rounds))
@@ -143,7 +144,10 @@ def _path_points(goal: SuctionGoal, table, memo: dict) -> list[tuple[float, floa
     cavity, u_start = _cavity(goal, table, memo)
     points = [(u_start, cavity.start(u_start)[0])]
     for F in goal.forces_N:
-        r = cavity._lifetime(F, u_start)
+        try:
+            r = cavity._lifetime(F, u_start)
+        except ValueError:          # the coarse table fails where the lattice may not: no seed
+            continue
         points += list(zip(r.u_m.tolist(), r.dp_Pa.tolist()))
     largest = cavity._largest_force(u_start)
     points.append((float(table.u_m[0]), cavity._dp_range(largest)[0]))
