@@ -91,6 +91,17 @@ def test_table_around_the_paths_gives_the_full_tables_lifetimes(lattice, around)
     assert all(np.all(later[earlier]) for earlier, later in zip(asked[1:], asked[2:]))
 
 
+def test_stiffer_cup_reads_its_own_paths(lattice):
+    """kappa = 2: the cup answers dp as the table's does dp / 2, and its top dp (p_a) falls inside
+    the table's last cell; built around its paths the table still gives the full one's results."""
+    table, goal = lattice
+    stiff = SuctionGoal(replace(goal.model, kappa=2.0), (5.0, 60.0))
+    build = around_paths(lambda built: holed_subtable(table, built), table.u_m.size, table.dp_Pa.size, stiff,
+                         AroundSpec(u_every=8, dp_every=8))
+    np.testing.assert_allclose(_results(stiff, build.table), _results(stiff, table), rtol=1e-9, atol=0)
+    assert build.asked.sum() < 0.5 * table.built.size
+
+
 def test_holed_table_json_round_trip_and_checks(lattice, tmp_path):
     """Holes are null in the JSON and come back as holes; a hole must be one in every grid, with
     no profile, and relaxation refuses a table with holes."""
