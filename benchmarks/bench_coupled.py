@@ -3,6 +3,7 @@ of several grids and meshes, beside the paper route, and beta as the FEM sees it
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled.py [--tables DIR]
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled.py --adaptive [--tables DIR]
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled.py --around [--tables DIR]
 
 Tables (frictionless cup A, `fem.suction`; built once and kept as JSON in --tables, default
 out/bench_coupled): the default grid of `cupcheck suction` (u = 0.001 ... 0.8 h1, 105 values;
@@ -16,6 +17,10 @@ largest holdable force, the lifetime cost, and eq 6's beta from the medium table
 --adaptive: the coarse default grid's table against the adaptive one built for F1 = 5, 10, 20,
 40 N (`validation.bridge.coupled.adaptive`): states solved and CPU seconds of each, the lifetimes,
 the largest holdable force and their differences (the adaptive table's interpolation error).
+
+--around: the same for the table with holes built around the paths of those forces
+(`validation.bridge.coupled.around`): states solved, rounds, CPU seconds of the build (the FEM
+and the lifetimes it runs), the lifetimes and largest holdable force against the full table's.
 """
 
 from __future__ import annotations
@@ -74,11 +79,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tables", type=Path, default=Path("out/bench_coupled"))
     parser.add_argument("--adaptive", action="store_true", help="the adaptive table against the full one")
+    parser.add_argument("--around", action="store_true", help="the table around the paths against the full one")
     args = parser.parse_args()
     cli = build_parser().parse_args(["lifetime", "--surface", "pmma-1.89", "--force", "5"])
     uc, paper = build_uc(cli), build_model(cli).model
-    if args.adaptive:
-        adaptive_against_full(paper, uc, args.tables)
+    if args.adaptive or args.around:
+        adaptive_against_full(paper, uc, args.tables, "around" if args.around else "adaptive")
         return
     u_start = paper.cup.h1_m - paper.cup.h_start_m
     print(f"paper route: " + ", ".join(f"{solve_lifetime(paper, F, route='paper').lifetime_s:.4g}" for F in FORCES_N)
@@ -112,18 +118,23 @@ def main() -> None:
 ADAPTIVE_FORCES_N = (5.0, 10.0, 20.0, 40.0)
 
 
-def adaptive_against_full(paper, uc, folder: Path) -> None:
-    """Lifetimes, largest holdable force and cost of the full coarse table and the adaptive one."""
-    from validation.bridge.coupled.build import SuctionGoal, suction_table_for
+def adaptive_against_full(paper, uc, folder: Path, kind: str = "adaptive") -> None:
+    """Lifetimes, largest holdable force and cost of the full coarse table and the adaptive one
+    (kind 'adaptive': a tensor sub-grid; 'around': the table with holes around the paths)."""
+    from validation.bridge.coupled.build import AdaptiveSpec, AroundSpec, SuctionGoal, suction_table_for
 
     goal = SuctionGoal(LeakageModel(cup=paper.cup, u_c=uc, gas=paper.gas, p_a_Pa=paper.p_a_Pa), ADAPTIVE_FORCES_N)
     u, dp = np.array(U_FRACTIONS), np.array(DP_KPA)
     full, _ = table("coarse", "coarse", u, dp, folder)
     cpu = time.process_time()
-    adaptive = suction_table_for("A", fidelity="coarse", goal=goal)
+    adaptive = suction_table_for("A", fidelity="coarse", goal=goal,
+                                 adaptive=AroundSpec() if kind == "around" else AdaptiveSpec())
     adaptive_cpu = time.process_time() - cpu
+    if kind == "around":
+        print(f"around the paths: {int(adaptive.built.sum())} states in the table, rounds (states, missing): "
+              f"{adaptive.provenance['rounds']}")
     rows = {}
-    for name, t in (("full", full), ("adaptive", adaptive)):
+    for name, t in (("full", full), (kind, adaptive)):
         model = replace(goal.model, suction=t)
         cpu = time.process_time()
         life = [solve_lifetime(model, F, route="coupled") for F in ADAPTIVE_FORCES_N]
@@ -132,14 +143,14 @@ def adaptive_against_full(paper, uc, folder: Path) -> None:
         states = t.provenance.get("states_solved", t.u_m.size * t.dp_Pa.size)
         built = t.provenance["solver"]["wall_time_s"]
         print(f"{name:>8}: {t.provenance.get('grid', f'{t.u_m.size} u x {t.dp_Pa.size} dp')}, {states} states solved, "
-              f"FEM {built:.1f} s wall" + (f", {adaptive_cpu:.1f} s CPU to build the product" if name == "adaptive" else "")
-              + f"; lifetimes " + ", ".join(f"{x:.5g} ({r})" for x, r in zip(rows[name][0], rows[name][2]))
-              + f" s at {', '.join(f'{F:g}' for F in ADAPTIVE_FORCES_N)} N; largest holdable {largest:.5g} N; "
+              f"FEM {built:.1f} s wall" + (f", {adaptive_cpu:.1f} s CPU to build the product" if name == kind else "")
+              + f"; lifetimes " + ", ".join(f"{x:.8g} ({r})" for x, r in zip(rows[name][0], rows[name][2]))
+              + f" s at {', '.join(f'{F:g}' for F in ADAPTIVE_FORCES_N)} N; largest holdable {largest:.8g} N; "
               f"lifetimes and largest force {time.process_time() - cpu:.1f} s CPU")
-    (a, fa, _), (b, fb, _) = rows["adaptive"], rows["full"]
+    (a, fa, _), (b, fb, _) = rows[kind], rows["full"]
     diff = np.where(b > 0, 100 * (a / np.where(b > 0, b, 1) - 1), 0.0)
-    print("adaptive against full: " + ", ".join(f"{d:+.3f} %" for d in diff)
-          + f"; largest holdable force {100 * (fa / fb - 1):+.4f} %")
+    print(f"{kind} against full: " + ", ".join(f"{d:+.2e} %" for d in diff)
+          + f"; largest holdable force {100 * (fa / fb - 1):+.2e} %")
 
 
 if __name__ == "__main__":

@@ -28,6 +28,11 @@ u_c is read, as on the profile route (`reduced.profile_leak.patch_average`): the
 of rough-contact theory, which makes the leak independent of the mesh where the rim corner alone
 touches.
 
+A table with holes (`SuctionTable.built`: states only where the paths go) is read only where
+every state the interpolation reads is built (`reduced.coupled_holes`); the root finders bracket
+inside built cells, and a value that would read a hole raises `MissingStates` naming the states
+to add. Where they are built the values are the full table's; without relaxation only.
+
 The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a dp
 grid of `samples` points. A stiffness factor kappa makes the cup kappa times stiffer, as the
 paper's kappa multiplies F0 (Fig. 1stiffnessFactor): a neo-Hookean body in frictionless contact
@@ -49,6 +54,8 @@ from functools import cached_property
 import numpy as np
 from scipy.optimize import brentq
 
+from reduced import coupled_holes as holes
+from reduced.coupled_holes import Holes
 from reduced.coupled_relax import RelaxedParts, relaxed_lifetime, relaxed_parts
 from reduced.coupled_result import _CoupledRecord
 from reduced.gas import AIR, Gas
@@ -66,7 +73,9 @@ class CoupledCavity:
     with E the table's modulus (with relaxation E_eff(phi), `reduced.coupled_relax`).
     relaxation: E_eff(t), or None (kappa fixed); phi0_s: with relaxation, the contact time [s] of
     the stiffness measurement the table stands for (`reduced.viscoelastic.measurement_contact_time`,
-    13 s for cup A)."""
+    13 s for cup A). conductances: None, or a dict of node conductances by the node's (u, dp) in
+    table units, read and filled here, that cavities of the same model on tables of the same
+    states share (a builder's rounds on a growing table with holes)."""
 
     table: SuctionTable
     u_c: Callable[[float], float]
@@ -79,6 +88,7 @@ class CoupledCavity:
     along_u: str = "pchip"
     relaxation: RelaxationModulus | None = None
     phi0_s: float | None = None
+    conductances: dict | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.kappa) and self.kappa > 0):
@@ -96,6 +106,9 @@ class CoupledCavity:
         if self.relaxation is None and self.phi0_s is not None:
             raise ValueError("phi0_s: the measurement contact time is used only with relaxation; "
                              "give relaxation or drop phi0_s")
+        if self.relaxation is not None and not self.table.complete:
+            raise ValueError("suction table: relaxation needs a table without holes (its paths "
+                             "follow the contact time, not the built states)")
         if self.relaxation is not None and self.phi0_s is None:
             raise ValueError("phi0_s: with relaxation give the contact time of the stiffness "
                              "measurement in s (> 0), e.g. reduced.viscoelastic.measurement_contact_time(cup)")
@@ -121,17 +134,32 @@ class CoupledCavity:
 
     def F1(self, u: float, dp: float) -> float:
         """Pull on the handle [N] at (u, dp)."""
+        if self._holes is not None:
+            self._holes.need(u, dp)
         return self.kappa * self._mechanics["F1"](u, dp)
 
     def V(self, u: float, dp: float) -> float:
         """Cavity volume [m^3] at (u, dp)."""
+        if self._holes is not None:
+            self._holes.need(u, dp)
         return self._mechanics["V"](u, dp)
+
+    @cached_property
+    def _holes(self) -> Holes | None:
+        """The table's built states (None: a complete table)."""
+        return None if self.table.complete else Holes(self.table.built, self._u, self._dp, self.along_u)
+
+    def _filled(self, z: np.ndarray) -> np.ndarray:
+        """z with 0 at the holes: the surfaces need numbers there; `Holes.need` keeps them unread."""
+        return z if self._holes is None else np.where(self.table.built, z, 0.0)
 
     def Ndot(self, u: float, dp: float) -> float:
         """Molecules per second leaking in at (u, dp): dp times the conductance Ndot / dp,
         interpolated in ln (it varies exponentially with the contact pressure; dividing by dp
         removes the zero of the driving force at dp = 0). A sealed node enters as 1e-30 of the
         largest conductance, and a conductance below 1e-20 of it is a seal (0)."""
+        if self._holes is not None:
+            self._holes.need(u, dp)
         g = float(np.exp(self._rate_surface(u, dp)))
         return dp * g if g > 1e-20 * self._largest_conductance else 0.0
 
@@ -142,35 +170,44 @@ class CoupledCavity:
 
     @cached_property
     def _mechanics(self) -> dict[str, TableSurface]:
-        return {"F1": TableSurface(self._u, self._dp, self.table.F1_N, self.along_u),
-                "V": TableSurface(self._u, self._dp, self.table.V_m3, self.along_u)}
+        return {"F1": TableSurface(self._u, self._dp, self._filled(self.table.F1_N), self.along_u),
+                "V": TableSurface(self._u, self._dp, self._filled(self.table.V_m3), self.along_u)}
 
     @cached_property
     def _rate_surface(self) -> TableSurface:
         g = self._node_conductance          # inf: no contact (1e3 x the largest); nan: p_b < 0
         top, floor = 1e3 * self._largest_conductance, 1e-30 * self._largest_conductance
         rates = np.log(np.clip(np.where(np.isnan(g), floor, g), floor, top))
-        return TableSurface(self._u, self._dp, rates, self.along_u)
+        return TableSurface(self._u, self._dp, self._filled(rates), self.along_u)
 
     @cached_property
     def _node_conductance(self) -> np.ndarray:
         """Ndot / dp [1/(s Pa)] at every node (u_i, dp_j) through its profile with p_b = p_a - dp_j;
-        at dp = 0 its limit, from a 1 Pa difference (nan beyond p_a)."""
+        at dp = 0 its limit, from a 1 Pa difference (nan beyond p_a and at a hole)."""
         E = self.table.E_Pa
         out = np.full((self._u.size, self._dp.size), np.nan)
+        built, memo = self.table.built, self.conductances
         for i in range(self._u.size):
             for j, dp in enumerate(self._dp):
-                if dp > self.p_a_Pa:
+                if dp > self.p_a_Pa or not built[i, j]:
                     continue
-                prof = self._solid_profile(i, j)
-                drive = max(dp, 1.0)
-                gaps = ring_gaps(prof, self.u_c, E)
-                if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
-                    out[i, j] = np.inf           # open): no resistance, see _rate_surface
+                key = (float(self._u[i]), float(self.table.dp_Pa[j]))
+                if memo is not None and key in memo:
+                    out[i, j] = memo[key]
                     continue
-                out[i, j] = profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - drive, prof.r_m, gaps,
-                                              self.radial) / drive
+                out[i, j] = self._conductance(i, j, dp, E)
+                if memo is not None:
+                    memo[key] = out[i, j]
         return out
+
+    def _conductance(self, i: int, j: int, dp: float, E: float) -> float:
+        """Ndot / dp at node (i, j) (`_node_conductance`)."""
+        prof = self._solid_profile(i, j)
+        drive = max(dp, 1.0)
+        gaps = ring_gaps(prof, self.u_c, E)
+        if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
+            return np.inf                # open): no resistance, see _rate_surface
+        return profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - drive, prof.r_m, gaps, self.radial) / drive
 
     def _solid_profile(self, i: int, j: int) -> ContactProfile:
         """The solid contact pressure at node (i, j) of the kappa-times-stiffer cup (`solid_profile`)."""
@@ -184,6 +221,8 @@ class CoupledCavity:
     # -------------------------------------------------------------- the branch at fixed F1
     def u_at(self, F1: float, dp: float) -> float:
         """u with F1(u, dp) = F1 (F1 falls with u); ValueError where the table ends."""
+        if self._holes is not None:
+            return holes.u_at(self, F1, dp)
         lo, hi = self.F1(self._u[-1], dp), self.F1(self._u[0], dp)
         slack = 1e-9 * max(abs(lo), abs(hi), 1.0)       # the bracket ends, found by brentq on dp
         if lo - slack <= F1 < lo:
@@ -207,8 +246,11 @@ class CoupledCavity:
         return u, self.V(u, dp)
 
     def _dp_range(self, F1: float) -> tuple[float, float]:
-        """The dp interval of the branch inside the table: u from u_min (low dp) to u_max."""
+        """The dp interval of the branch inside the table: u from u_min (low dp) to u_max (on a
+        table with holes: (the low end, nan))."""
         top = self._dp_top
+        if self._holes is not None:
+            return holes.dp_low(self, F1), math.nan
         if F1 > self.F1(self._u[0], top):
             return math.nan, math.nan
         lo = 0.0 if F1 <= self.F1(self._u[0], 0.0) else brentq(
@@ -223,6 +265,9 @@ class CoupledCavity:
             raise ValueError(f"u_start: must lie in the table's u range [{1e3 * self._u[0]:.4g}, "
                              f"{1e3 * self._u[-1]:.4g}] mm, got {1e3 * u_start_m:.4g} mm")
         top = self._dp_top
+        if self._holes is not None:
+            dp = holes.start_dp(self, u_start_m)
+            return dp, (self.p_a_Pa - dp) * self.V(u_start_m, dp) / self.gas.kT_J
         if self.F1(u_start_m, top) < 0:
             raise ValueError(f"u_start: the table's dp <= {top / 1e3:.4g} kPa cannot hold the cup "
                              f"released at u = {1e3 * u_start_m:.4g} mm")
@@ -237,6 +282,8 @@ class CoupledCavity:
         lo, hi = self._dp_range(F1)
         if not np.isfinite(lo) or N0 > self.content(F1, lo)[1]:
             return N0, None, lo
+        if self._holes is not None:
+            return N0, holes.holding_dp(self, F1, N0, lo), lo
         if N0 < self.content(F1, hi)[1]:
             raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
                              f"{1e3 * self._u[-1]:.4g} mm; extend the table")
@@ -254,9 +301,15 @@ class CoupledCavity:
         def holds(F1: float) -> bool:
             lo, _ = self._dp_range(F1)
             return bool(np.isfinite(lo)) and N0 <= self.content(F1, lo)[1]
-        lo, hi = 0.0, self.F1(self._u[0], self._dp_top)
-        if holds(hi):
-            return hi
+        if self._holes is not None:
+            found = holes.force_cell(self, holds)
+            if not isinstance(found, tuple):
+                return found
+            lo, hi = found
+        else:
+            lo, hi = 0.0, self.F1(self._u[0], self._dp_top)
+            if holds(hi):
+                return hi
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if holds(mid) else (lo, mid)

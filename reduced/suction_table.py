@@ -1,7 +1,8 @@
 """The hand-off for the coupled cavity: the cup's response on a grid of plate displacement u and
 cavity pressure difference dp = p_a - p_b, as plain data (a `SuctionTable`).
 
-For every (u_i, dp_j): the pull on the handle F1 (eq. 5's F1 with the suction acting on the
+For every (u_i, dp_j) the table holds (a table may have holes: states only where the cup's
+paths go, the others null in every grid and profile; `built`): the pull on the handle F1 (eq. 5's F1 with the suction acting on the
 deformed cup), the cavity volume V, the seal radius r_k (the cavity's edge), the outer edge r_cut
 of the contact zone next to it, and the contact-pressure profile p(r) across that zone, the
 pressure the plane carries with the interface gas at p_b. It comes from the FEM
@@ -21,6 +22,7 @@ import json
 import math
 import os
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -28,15 +30,29 @@ import numpy as np
 
 from reduced.profile_leak import ContactProfile
 
-__all__ = ["SuctionTable"]
+__all__ = ["MissingStates", "SuctionTable"]
 
 _GRIDS = {"F1_N": ("F1_N", 1.0), "V_mm3": ("V_m3", 1e-9), "seal_r_mm": ("seal_r_m", 1e-3),
           "cut_r_mm": ("cut_r_m", 1e-3)}
 
 
+class MissingStates(LookupError):
+    """A value read at a hole of a `SuctionTable`: `nodes` are the (i, j) indices of the missing
+    states on the table's axes (what a builder must add), `u_m`, `dp_Pa` their coordinates."""
+
+    def __init__(self, nodes, u_axis: np.ndarray, dp_axis: np.ndarray, where: str = ""):
+        self.nodes = tuple(sorted({(int(i), int(j)) for i, j in nodes}))
+        self.u_m = tuple(float(u_axis[i]) for i, _ in self.nodes)
+        self.dp_Pa = tuple(float(dp_axis[j]) for _, j in self.nodes)
+        first = ", ".join(f"({1e3 * u:.4g} mm, {d / 1e3:.4g} kPa)" for u, d in zip(self.u_m[:3], self.dp_Pa[:3]))
+        super().__init__(f"suction table: {len(self.nodes)} state(s) not built {where}: (u, dp) = {first}"
+                         + (", ..." if len(self.nodes) > 3 else ""))
+
+
 @dataclass(frozen=True, eq=False)
 class SuctionTable:
-    """The cup's states on the (u, dp) grid (module docstring); grids are [len(u), len(dp)]."""
+    """The cup's states on the (u, dp) grid (module docstring); grids are [len(u), len(dp)],
+    nan in each of them (and None in profiles) where the table has a hole."""
 
     u_m: np.ndarray
     dp_Pa: np.ndarray
@@ -54,22 +70,40 @@ class SuctionTable:
             raise ValueError("u_mm: the plate displacements must be >= 0 and strictly increasing (>= 2)")
         if dp.ndim != 1 or dp.size < 2 or np.any(np.diff(dp) <= 0) or dp[0] != 0.0:
             raise ValueError("dp_kPa: the pressure differences must start at 0 and strictly increase (>= 2)")
+        hole = None
         for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m"):
             a = np.array(getattr(self, name), dtype=float)
-            if a.shape != (u.size, dp.size) or not np.all(np.isfinite(a)):
-                raise ValueError(f"{name}: expected finite values on the {u.size} x {dp.size} grid, "
-                                 f"got {'non-finite values' if a.shape == (u.size, dp.size) else f'shape {a.shape}'}")
+            if a.shape != (u.size, dp.size):
+                raise ValueError(f"{name}: expected finite values on the {u.size} x {dp.size} grid, got shape {a.shape}")
+            hole = np.isnan(a) if hole is None else hole
+            if not np.array_equal(np.isfinite(a), ~hole):
+                raise ValueError(f"{name}: expected finite values on the {u.size} x {dp.size} grid "
+                                 f"(nan only at a hole, and there in every grid), got other non-finite values")
             a.flags.writeable = False
             object.__setattr__(self, name, a)
-        if np.any(self.V_m3 <= 0):
+        if np.any(self.V_m3[~hole] <= 0):
             raise ValueError("V_mm3: cavity volumes must be > 0")
         if len(self.profiles) != u.size or any(len(row) != dp.size for row in self.profiles):
             raise ValueError(f"profiles: expected {u.size} rows of {dp.size} profiles")
+        if any(self.profiles[i][j] is not None for i, j in zip(*np.nonzero(hole))):
+            raise ValueError("profiles: expected null at every hole of the grids")
         if not (np.isfinite(self.E_Pa) and self.E_Pa > 0):
             raise ValueError(f"E_Pa: the modulus of the table must be > 0 Pa, got {self.E_Pa}")
         u.flags.writeable = dp.flags.writeable = False
         object.__setattr__(self, "u_m", u)
         object.__setattr__(self, "dp_Pa", dp)
+
+    @cached_property
+    def built(self) -> np.ndarray:
+        """[len(u), len(dp)] True where the table holds the state (False: a hole)."""
+        built = np.isfinite(self.F1_N)
+        built.flags.writeable = False
+        return built
+
+    @cached_property
+    def complete(self) -> bool:
+        """Whether the table holds every state of its grid (no holes)."""
+        return bool(self.built.all())
 
     @property
     def h1_m(self) -> float:
@@ -81,7 +115,7 @@ class SuctionTable:
         """Write the table (atomically: a temporary file renamed into place)."""
         path = Path(path)
         data = {"u_mm": (self.u_m * 1e3).tolist(), "dp_kPa": (self.dp_Pa / 1e3).tolist(),
-                **{key: (getattr(self, name) / scale).tolist() for key, (name, scale) in _GRIDS.items()},
+                **{key: _nulled(getattr(self, name) / scale) for key, (name, scale) in _GRIDS.items()},
                 "E_Pa": self.E_Pa,
                 "profiles": [[None if p is None else {"r_mm": (p.r_m * 1e3).tolist(),
                                                       "p_kPa": (p.p_Pa / 1e3).tolist()} for p in row]
@@ -122,6 +156,11 @@ class SuctionTable:
             field_, _, rest = str(err).partition(": ")
             spelled = {name: key for key, (name, _) in _GRIDS.items()}.get(field_, field_)   # as the file spells it
             raise ValueError(f"{where}: {spelled}: {rest}") from None
+
+
+def _nulled(a: np.ndarray) -> list:
+    """Nested lists of `a` with None (JSON null) for its nan (a hole)."""
+    return [[None if math.isnan(x) else x for x in row] for row in a.tolist()]
 
 
 def _numbers(value: Any, key: str, scalar: bool = False) -> np.ndarray:

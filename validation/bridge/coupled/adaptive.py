@@ -17,13 +17,12 @@ It starts on every 8th u and every 10th dp of the lattice, then:
 - an interval whose error is below `tol` is not split again; the others' halves are, while the
   paths cross them, down to the lattice.
 
-Why a tensor grid and not the states along each path: the leak through a profile jumps where a
-node lands, so a path needs the grid's own u spacing wherever it goes (coarser rows move the
-lifetimes by percents), and states solved only next to the paths would need `reduced.coupled` to
-interpolate a table with holes. Splitting a tensor grid where the asked lifetimes need it keeps
-`reduced` unchanged, reproduces the full table's lifetimes and skips what no path reads; its
-cost is every row the paths cross times every column any force's path crosses. The lifetimes'
-error against the full grid and the cost of both: benchmarks/bench_coupled.py --adaptive.
+The leak through a profile jumps where a node lands, so a path needs the grid's own u spacing
+wherever it goes (coarser rows move the lifetimes by percents). A tensor grid's cost is every row
+the paths cross times every column any force's path crosses; the table with holes around the
+paths (`validation.bridge.coupled.around`, the default of `suction_table_for`) solves only the
+states next to them. The lifetimes' error against the full grid and the cost of both:
+benchmarks/bench_coupled.py --adaptive, --around.
 """
 
 from __future__ import annotations

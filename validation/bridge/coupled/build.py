@@ -9,9 +9,11 @@ model's `SuctionTable`; with a cache directory the table goes through `validatio
 design, the law, the grid and a hash of the sources that make it (`fem`, `validation.bridge.coupled` and
 the table's data types in `reduced`), so a second call computes nothing and a change to that code
 recomputes (a change to the leak, which reads the table, does not).
-With a `SuctionGoal` (the model and the pull forces the table is for) it builds only the rows and
-columns of the grid that those lifetimes need (`validation.bridge.coupled.adaptive`); the goal
-and the whole of `reduced` are then part of the key.
+With a `SuctionGoal` (the model and the pull forces the table is for) it builds only the states
+of the grid that those lifetimes read: a table with holes around their paths
+(`validation.bridge.coupled.around`, the default), or the rows and columns of a tensor grid
+(`AdaptiveSpec`, `validation.bridge.coupled.adaptive`); the goal and the whole of `reduced` are
+then part of the key.
 """
 
 from __future__ import annotations
@@ -24,11 +26,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from validation.bridge.coupled.adaptive import AdaptiveSpec, SuctionGoal, adaptive_axes
+from validation.bridge.coupled.around import AroundSpec, around_paths
 
 if TYPE_CHECKING:
     from fem.interface import ContactLaw
 
-__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "QUICK_GRID", "SuctionGoal", "AdaptiveSpec", "suction_table_for"]
+__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "QUICK_GRID", "SuctionGoal", "AdaptiveSpec", "AroundSpec",
+           "suction_table_for"]
 
 _U_COARSE = (0.001, 0.0025, 0.005, 0.0075, 0.01, 0.0175, 0.025, 0.0375, 0.05, 0.075, 0.1, 0.125,
              0.15, 0.175, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8)
@@ -65,11 +69,12 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw
                       E_Pa: float = 4e6, nu: float = 0.49,
                       grid: SuctionGridSpec = DEFAULT_GRID, cache_dir: str | Path | None = None,
                       progress: Callable[[float, str], None] | None = None,
-                      goal: SuctionGoal | None = None, adaptive: AdaptiveSpec = AdaptiveSpec()):
+                      goal: SuctionGoal | None = None, adaptive: AroundSpec | AdaptiveSpec = AroundSpec()):
     """The `SuctionTable` of a design (`fem.geometry.CupGeometry` or a preset name 'A', 'B') at a
     mesh level, contact law (a `fem.interface.ContactLaw`, None: frictionless) and grid (module
     docstring); with a `goal`, only the part of the grid the goal's lifetimes need, chosen as
-    `adaptive` says. `progress(fraction, message)` while the FEM runs. Raises
+    `adaptive` says (`AroundSpec`: the states around the paths, a table with holes; `AdaptiveSpec`:
+    a tensor sub-grid). `progress(fraction, message)` while the FEM runs. Raises
     `fem.solver.ConvergenceError` where a state does not converge."""
     from fem.geometry import cup_geometry
     from fem.interface import ContactLaw
@@ -81,7 +86,8 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw
     if not isinstance(contact, ContactLaw):
         raise ValueError(f"contact: expected a fem.interface.ContactLaw, got {type(contact).__name__}")
     if goal is not None:
-        build = Cache(cache_dir).cached(_build_adaptive, ignore=["progress"])
+        build = Cache(cache_dir).cached(_build_around if isinstance(adaptive, AroundSpec) else _build_adaptive,
+                                        ignore=["progress"])
         code = source_hash("fem", "validation/bridge/coupled", "reduced")
         return build(geometry, fidelity, contact, E_Pa, nu, grid, goal, adaptive, code, progress=progress)
     build = Cache(cache_dir).cached(_build, ignore=["progress"])
@@ -115,6 +121,32 @@ def _build_adaptive(geometry, fidelity, contact, E_Pa, nu, grid, goal, adaptive,
     final = states.grid(u[list(axes.u_index)], dp[list(axes.dp_index)])
     return suction_table(final, {**provenance, "grid": axes.describe(), "lattice": grid.describe(),
                                  "states_solved": states.solved, "forces_N": list(goal.forces_N)})
+
+
+def _build_around(geometry, fidelity, contact, E_Pa, nu, grid, goal, spec, code, progress=None):
+    from fem.cup import cup_height
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+    from fem.suction import SuctionStates
+    from validation.bridge.coupled.table import holed_suction_table
+
+    mesh = cup_mesh(geometry, fidelity)
+    # a new row is pressed from the kept row below it in one step (cut where Newton needs it): the
+    # rows are close, and a frictionless state does not depend on the path that reached it
+    states = SuctionStates(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), contact, initial_step=1.0, max_step=1.0)
+    u, dp = grid.u_m(cup_height(mesh)), grid.dp_Pa
+    provenance = {"geometry": geometry.describe(), "fidelity": fidelity}
+
+    def table_on(built: np.ndarray):
+        if progress:
+            progress(0.0, f"{states.solved} states solved; table of {int(built.sum())}")
+        return holed_suction_table(states, u, dp, built, contact, provenance)
+
+    done = around_paths(table_on, u.size, dp.size, goal, spec)
+    return holed_suction_table(states, u, dp, done.table.built, contact,
+                               {**provenance, "grid": f"{int(done.table.built.sum())} states around the paths on "
+                                f"{grid.describe()}", "lattice": grid.describe(), "states_solved": states.solved,
+                                "rounds": [list(r) for r in done.rounds], "forces_N": list(goal.forces_N)})
 
 
 def _build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=None):

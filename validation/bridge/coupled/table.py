@@ -6,11 +6,12 @@ from typing import Any
 
 import numpy as np
 
-from fem.suction import SuctionGrid
+from fem.interface import ContactLaw
+from fem.suction import SuctionGrid, SuctionStates
 from reduced.stiffness_curve import profiles_from_lists
 from reduced.suction_table import SuctionTable
 
-__all__ = ["suction_table", "fem_beta"]
+__all__ = ["suction_table", "holed_suction_table", "fem_beta"]
 
 
 def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -> SuctionTable:
@@ -18,20 +19,13 @@ def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -
     pressures (provenance: the grid's law and mu, material, h1, solver, then `provenance`),
     converted as the stiffness sidecar's are (`profiles_from_lists`: a node shared by
     two facets merged, fewer than two points or no pressure is None)."""
-    from validation.bridge.handoff import contact_provenance
-
-    m = grid.material
-    prov = {"source": "fem.suction", **contact_provenance(grid.contact_law), "E_Pa": m.E_Pa, "nu": m.nu,
-            "formulation": m.formulation, "h1_mm": 1e3 * grid.h1_m,
-            "solver": {"newton_iterations": grid.stats.newton_iterations,
-                       "wall_time_s": grid.stats.wall_time_s, "dofs": grid.stats.dofs},
-            **(provenance or {})}
+    prov = _provenance(grid.contact_law, grid.material, grid.h1_m, grid.stats, provenance)
     return SuctionTable(u_m=grid.u_m, dp_Pa=grid.dp_Pa, F1_N=grid.F1_N, V_m3=grid.V_m3,
                         seal_r_m=grid.seal_r_m, cut_r_m=grid.cut_r_m,
                         profiles=tuple(profiles_from_lists([1e3 * p.r_m for p in row],
                                                            [1e-3 * p.p_Pa for p in row])
                                        for row in grid.profiles),
-                        E_Pa=m.E_Pa, provenance=prov)
+                        E_Pa=grid.material.E_Pa, provenance=prov)
 
 
 def fem_beta(table: SuctionTable) -> np.ndarray:
@@ -47,3 +41,33 @@ def fem_beta(table: SuctionTable) -> np.ndarray:
                   for p in (row[0] for row in table.profiles)])
     area = 2 * np.pi * table.seal_r_m[:, 0] * np.where(l > 0, l, np.nan)
     return (N[:, 1:] - N[:, :1]) / (table.dp_Pa[1:] * area[:, None])
+
+
+def holed_suction_table(states: SuctionStates, u_m: np.ndarray, dp_Pa: np.ndarray, built: np.ndarray,
+                        contact: ContactLaw, provenance: dict[str, Any] | None = None) -> SuctionTable:
+    """The hand-off table (as `suction_table`) on the grid u_m x dp_Pa with only the states
+    `built` [len(u), len(dp)] (solved by `states`, whose contact law is `contact`, in increasing
+    u and dp where it lacks them), nan and None at the others: a table with holes
+    (`reduced.suction_table`)."""
+    shape = (len(u_m), len(dp_Pa))
+    grids = {name: np.full(shape, np.nan) for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
+    profiles = [[None] * shape[1] for _ in range(shape[0])]
+    for i, j in zip(*np.nonzero(built)):
+        F1, _, V, r_k, r_cut, _, _, p = states.state(float(u_m[i]), float(dp_Pa[j]))
+        for name, x in zip(grids, (F1, V, r_k, r_cut)):
+            grids[name][i, j] = x
+        profiles[i][j] = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0]
+    prov = _provenance(contact, states.material, states.h1_m, states.stats, provenance)
+    return SuctionTable(u_m=np.asarray(u_m, float), dp_Pa=np.asarray(dp_Pa, float), **grids,
+                        profiles=tuple(tuple(row) for row in profiles), E_Pa=states.material.E_Pa,
+                        provenance=prov)
+
+
+def _provenance(law: ContactLaw, material, h1_m: float, stats, extra: dict[str, Any] | None) -> dict[str, Any]:
+    from validation.bridge.handoff import contact_provenance
+
+    return {"source": "fem.suction", **contact_provenance(law), "E_Pa": material.E_Pa, "nu": material.nu,
+            "formulation": material.formulation, "h1_mm": 1e3 * h1_m,
+            "solver": {"newton_iterations": stats.newton_iterations if stats else 0,
+                       "wall_time_s": stats.wall_time_s if stats else 0.0, "dofs": stats.dofs if stats else 0},
+            **(extra or {})}

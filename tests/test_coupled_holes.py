@@ -1,0 +1,123 @@
+"""A suction table with holes (`reduced.coupled_holes`, `validation.bridge.coupled.around`): where
+every state a value reads is built it is the full table's value to the last bit, a value that
+would read a hole raises `MissingStates` naming those states, and the table built around the
+paths of a goal gives the full table's lifetimes and largest holdable force from a fraction of its
+states (on the paper's own eqs 3-7 sampled on a grid: no FEM)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from reduced.coupled import CoupledCavity
+from reduced.critical_gap import illustrative_uc_table
+from reduced.cup import cup_by_name
+from reduced.lifetime import largest_holdable_force, reference_model, solve_lifetime
+from reduced.suction_table import MissingStates, SuctionTable
+from reduced.viscoelastic import default_relaxation
+from tests.test_reduced_coupled import paper_table
+from validation.bridge.coupled.adaptive import SuctionGoal
+from validation.bridge.coupled.around import AroundSpec, around_paths, holed_subtable
+
+FORCES_N = (5.0, 20.0)
+
+
+@pytest.fixture(scope="module")
+def lattice():
+    """Cup A's eqs (3)-(7) on a 41 x 41 grid and a goal of two forces (interface gas at p_b)."""
+    model = reference_model(cup_by_name("A"), illustrative_uc_table())
+    goal = SuctionGoal(replace(model, stiffness=None, interface="p_b"), FORCES_N)
+    return paper_table(model, 41, 41), goal
+
+
+@pytest.fixture(scope="module")
+def around(lattice):
+    table, goal = lattice
+    asked = []
+
+    def table_on(built):
+        asked.append(built.copy())
+        return holed_subtable(table, built)
+    return around_paths(table_on, table.u_m.size, table.dp_Pa.size, goal, AroundSpec(u_every=8, dp_every=8)), asked
+
+
+def _results(goal, table):
+    model = replace(goal.model, suction=table)
+    return np.array([solve_lifetime(model, F, route="coupled").lifetime_s for F in goal.forces_N]
+                    + [largest_holdable_force(model, route="coupled")])
+
+
+def test_built_values_are_the_full_tables_to_the_bit(lattice):
+    """F1, V and the leak read where their cells are built are the full table's bit for bit; a
+    point whose cell reads a hole raises MissingStates naming exactly the missing states."""
+    table, goal = lattice
+    built = np.zeros(table.built.shape, dtype=bool)
+    built[10:20, 5:12] = True
+    full = CoupledCavity(table, goal.model.u_c, interface="p_b")
+    holed = CoupledCavity(holed_subtable(table, built), goal.model.u_c, interface="p_b")
+    u, dp = table.u_m, table.dp_Pa
+    rng = np.random.default_rng(1)
+    for a, b in zip(rng.uniform(u[11], u[18], 50), rng.uniform(dp[5], dp[11], 50)):
+        assert (holed.F1(a, b), holed.V(a, b), holed.Ndot(a, b)) == (full.F1(a, b), full.V(a, b), full.Ndot(a, b))
+    a, b = 0.5 * (u[18] + u[19]), 0.5 * (dp[8] + dp[9])      # monotone cubic along u: reads rows 17 ... 20
+    with pytest.raises(MissingStates) as err:
+        holed.F1(a, b)
+    assert err.value.nodes == ((20, 8), (20, 9))
+    assert err.value.u_m == (u[20], u[20]) and err.value.dp_Pa == (dp[8], dp[9])
+
+
+def test_a_path_leaving_the_built_cells_raises(lattice):
+    """A lifetime whose path runs out of the built states is an error naming states the table
+    lacks, never a value read from a hole."""
+    table, goal = lattice
+    built = np.zeros(table.built.shape, dtype=bool)
+    built[:, :] = True
+    built[:, 20:] = False                                      # no state beyond dp = 48 kPa
+    built[:8, :] = False                                       # nor below u = 0.2 h1
+    model = replace(goal.model, suction=holed_subtable(table, built))
+    with pytest.raises(MissingStates) as err:
+        solve_lifetime(model, 5.0, route="coupled")
+    assert err.value.nodes and not any(built[i, j] for i, j in err.value.nodes)
+
+
+def test_table_around_the_paths_gives_the_full_tables_lifetimes(lattice, around):
+    """Built around the goal's paths, the table with holes gives the full table's lifetimes and
+    largest holdable force (to the root finders' tolerances) from under half its states, and
+    every round asked only for more states."""
+    table, goal = lattice
+    build, asked = around
+    np.testing.assert_allclose(_results(goal, build.table), _results(goal, table), rtol=1e-9, atol=0)
+    assert build.asked.sum() < 0.5 * table.built.size and not build.table.complete
+    assert all(np.all(later[earlier]) for earlier, later in zip(asked[1:], asked[2:]))
+
+
+def test_stiffer_cup_reads_its_own_paths(lattice):
+    """kappa = 2: the cup answers dp as the table's does dp / 2, and its top dp (p_a) falls inside
+    the table's last cell; built around its paths the table still gives the full one's results."""
+    table, goal = lattice
+    stiff = SuctionGoal(replace(goal.model, kappa=2.0), (5.0, 60.0))
+    build = around_paths(lambda built: holed_subtable(table, built), table.u_m.size, table.dp_Pa.size, stiff,
+                         AroundSpec(u_every=8, dp_every=8))
+    np.testing.assert_allclose(_results(stiff, build.table), _results(stiff, table), rtol=1e-9, atol=0)
+    assert build.asked.sum() < 0.5 * table.built.size
+
+
+def test_holed_table_json_round_trip_and_checks(lattice, tmp_path):
+    """Holes are null in the JSON and come back as holes; a hole must be one in every grid, with
+    no profile, and relaxation refuses a table with holes."""
+    table, goal = lattice
+    built = np.ones(table.built.shape, dtype=bool)
+    built[3, 4] = built[30, 0] = False
+    holed = holed_subtable(table, built)
+    back = SuctionTable.from_json(holed.to_json(tmp_path / "t.json"))
+    assert np.array_equal(back.built, built) and not back.complete
+    assert '"F1_N": [[' in (tmp_path / "t.json").read_text() and "NaN" not in (tmp_path / "t.json").read_text()
+    np.testing.assert_array_equal(back.F1_N[built], table.F1_N[built])
+    V = np.array(holed.V_m3)
+    V[3, 4] = 1e-6
+    with pytest.raises(ValueError, match="V_m3: .*nan only at a hole"):
+        replace(holed, V_m3=V)
+    with pytest.raises(ValueError, match="profiles: expected null at every hole"):
+        replace(holed, profiles=table.profiles)
+    with pytest.raises(ValueError, match="relaxation needs a table without holes"):
+        CoupledCavity(holed, goal.model.u_c, relaxation=default_relaxation(), phi0_s=13.0)

@@ -1,0 +1,174 @@
+"""The coupled route's suction table built around the paths: only the states its lifetimes read.
+
+Scheme, and why. The cup's paths at the asked forces are curves in the (u, dp) plane; a tensor
+grid carries every row through every force's dp window, but `reduced.coupled` reads a table with
+holes (`reduced.coupled_holes`): states only where the interpolation of a visited point reads
+them, an error (`MissingStates`, naming the states) where it would read a hole. The table lives
+on the full grid's axes (the lattice, `DEFAULT_GRID`), so every value the lifetimes read is the
+full table's own and so are the lifetimes (to the root finders' tolerance and the FEM solver's:
+a state reached by another dp ramp is the same state for frictionless contact). The build:
+
+1. the seed: the goal's paths (its forces, the start and the largest holdable force) on the
+   tensor sub-grid of every `u_every`-th u and `dp_every`-th dp: cheap, and within a few
+   lattice cells of the full table's paths;
+2. on the lattice, the states the interpolation of those paths reads, widened by `margin` cells;
+3. the goal's lifetimes and largest holdable force on that table; where they read a hole, the
+   missing states (widened by `margin`) are added and they are computed again, until they run
+   through. What they read then is built, and nothing else is asked of the table.
+
+The cost and the lifetimes against the full grid: benchmarks/bench_coupled.py --around.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from validation.bridge.coupled.adaptive import SuctionGoal
+
+__all__ = ["AroundSpec", "AroundBuild", "around_paths", "holed_subtable"]
+
+
+@dataclass(frozen=True)
+class AroundSpec:
+    """The seed's sub-grid (every `u_every`-th u and `dp_every`-th dp of the lattice), the cells
+    added around each path point and each missing state, and a bound on the rounds."""
+
+    u_every: int = 24
+    dp_every: int = 5
+    margin: int = 0
+    max_rounds: int = 100
+
+    def __post_init__(self) -> None:
+        if not all(isinstance(k, int) and k >= 1 for k in (self.u_every, self.dp_every, self.max_rounds)):
+            raise ValueError(f"u_every, dp_every, max_rounds: need integers >= 1, got "
+                             f"{self.u_every}, {self.dp_every}, {self.max_rounds}")
+        if not (isinstance(self.margin, int) and self.margin >= 0):
+            raise ValueError(f"margin: need an integer >= 0, got {self.margin}")
+
+
+@dataclass(frozen=True, eq=False)
+class AroundBuild:
+    """The table with holes, the states asked of the lattice (the seed's included), and per
+    round the states built and how many were missing."""
+
+    table: Any
+    asked: np.ndarray
+    rounds: tuple[tuple[int, int], ...]
+
+
+def holed_subtable(table, built: np.ndarray):
+    """`table` with holes wherever `built` is False (what a build around the paths gets from the
+    same states; tests and benchmarks use it with the full table as the oracle)."""
+    from reduced.suction_table import SuctionTable
+
+    cut = {name: np.where(built, getattr(table, name), np.nan) for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
+    return SuctionTable(u_m=table.u_m, dp_Pa=table.dp_Pa, **cut, E_Pa=table.E_Pa,
+                        profiles=tuple(tuple(p if built[i, j] else None for j, p in enumerate(row))
+                                       for i, row in enumerate(table.profiles)),
+                        provenance=table.provenance)
+
+
+def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goal: SuctionGoal,
+                 spec: AroundSpec = AroundSpec()) -> AroundBuild:
+    """The table with holes the goal's lifetimes read (module docstring). table_on(built) returns
+    the `SuctionTable` on the lattice with the states `built` [n_u, n_dp] (solving what it lacks)."""
+    asked = np.zeros((n_u, n_dp), dtype=bool)
+    U = sorted(set(range(0, n_u, spec.u_every)) | {n_u - 1})
+    D = sorted(set(range(0, n_dp, spec.dp_every)) | {n_dp - 1})
+    asked[np.ix_(U, D)] = True
+    lattice = table_on(asked)
+    reads = _Reads(lattice.u_m, goal.model.kappa * lattice.dp_Pa)
+    memo: dict = {}                                   # node conductances, shared by the rounds
+    built = np.zeros_like(asked)
+    for u, dp in _path_points(goal, _compressed(lattice, U, D), memo):
+        _widen(built, reads(u, dp), spec.margin)
+    rounds = []
+    every = list(range(len(goal.forces_N) + 1))       # the lifetimes, then the largest force
+    pending = every
+    for _ in range(spec.max_rounds):
+        asked |= built
+        table = table_on(built)
+        ran = pending
+        missing, pending = _missing(goal, table, memo, ran)
+        if not missing and ran != every:              # all of them once more, on the last table
+            missing, pending = _missing(goal, table, memo, every)
+        rounds.append((int(built.sum()), len(missing)))
+        if not missing:
+            return AroundBuild(table, asked, tuple(rounds))
+        _widen(built, missing, spec.margin)
+    raise RuntimeError(f"suction table around the paths: states still missing after {spec.max_rounds} rounds")
+
+
+class _Reads:
+    """The lattice nodes the interpolation of a point reads (every one, built or not)."""
+
+    def __init__(self, u: np.ndarray, dp: np.ndarray):
+        from reduced.coupled_holes import Holes
+
+        self.holes = Holes(np.zeros((u.size, dp.size), dtype=bool), u, dp, "pchip")
+
+    def __call__(self, u: float, dp: float) -> list[tuple[int, int]]:
+        return self.holes.missing(u, dp)
+
+
+def _widen(built: np.ndarray, nodes, margin: int) -> None:
+    """Mark `nodes` and every node within `margin` cells of one as built."""
+    n_u, n_dp = built.shape
+    for i, j in nodes:
+        built[max(i - margin, 0):min(i + margin + 1, n_u), max(j - margin, 0):min(j + margin + 1, n_dp)] = True
+
+
+def _compressed(table, U: list[int], D: list[int]):
+    """The complete table on the rows U and columns D of a lattice table (all built there)."""
+    from validation.bridge.coupled.adaptive import lattice_subtable
+
+    return lattice_subtable(table, U, D)
+
+
+def _cavity(goal: SuctionGoal, table, memo: dict):
+    """The route's cavity of the goal on `table`, sharing the node conductances in `memo`."""
+    from reduced.lifetime.routes import ROUTES
+
+    route = ROUTES["coupled"]
+    cavity, u_start, _ = route.cavity(replace(goal.model, suction=table), dict(route.options))
+    return replace(cavity, conductances=memo), u_start
+
+
+def _path_points(goal: SuctionGoal, table, memo: dict) -> list[tuple[float, float]]:
+    """Every (u, dp) the goal's paths visit on a complete table: the lifetimes' trajectories, the
+    start and the largest holdable force's end."""
+    cavity, u_start = _cavity(goal, table, memo)
+    points = [(u_start, cavity.start(u_start)[0])]
+    for F in goal.forces_N:
+        try:
+            r = cavity._lifetime(F, u_start)
+        except ValueError:          # the coarse table fails where the lattice may not: no seed
+            continue
+        points += list(zip(r.u_m.tolist(), r.dp_Pa.tolist()))
+    largest = cavity._largest_force(u_start)
+    points.append((float(table.u_m[0]), cavity._dp_range(largest)[0]))
+    return points
+
+
+def _missing(goal: SuctionGoal, table, memo: dict, pending: list[int]) -> tuple[list[tuple[int, int]], list[int]]:
+    """(the states the pending computations (index k < len(forces): the k-th lifetime, else the
+    largest holdable force) read and the table lacks, the computations that lacked some). Each is
+    computed on its own, so that one round finds the holes of all of them; one that ran through
+    reads only built states, which added states do not change."""
+    from reduced.suction_table import MissingStates
+
+    cavity, u_start = _cavity(goal, table, memo)
+    forces = goal.forces_N
+    missing: set[tuple[int, int]] = set()
+    failed = []
+    for k in pending:
+        try:
+            cavity._lifetime(forces[k], u_start) if k < len(forces) else cavity._largest_force(u_start)
+        except MissingStates as err:
+            missing |= set(err.nodes)
+            failed.append(k)
+    return sorted(missing), failed
