@@ -209,7 +209,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
         if u_pred < u_min:
             return walk.result(None, "u_min", trials, slopes)
         try:
-            if abs(tangent[0]) >= abs(tangent[1]):      # u leads: N is the unknown
+            if _u_leads(tangent):                        # u leads: N is the unknown
                 s = walk.hold(prev, u_pred, N_pred)
             else:                                        # N leads (near a turn of u): u is
                 s = walk.hold_u(prev, u_pred, N_pred)
@@ -260,6 +260,13 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
         slopes.append(walk.slope(s))
         tangent = t
     raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
+
+
+def _u_leads(tangent) -> bool:
+    """Whether the plate position leads the branch's next move (N the unknown) rather than N. The
+    first state's tangent is diagonal by construction (|t_u| = |t_N|): the tie goes to u, not to
+    the last bit of round-off, which would pick one of two frictional paths."""
+    return abs(tangent[0]) >= (1.0 - 1e-9) * abs(tangent[1])
 
 
 def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float,
@@ -536,7 +543,7 @@ class _Walk:
         for _ in range(halvings):
             u, N = 0.5 * (closed.u_m + opened.u_m), 0.5 * (closed.N + opened.N)
             try:
-                s = self.hold(closed, u, N) if abs(tangent[0]) >= abs(tangent[1]) else \
+                s = self.hold(closed, u, N) if _u_leads(tangent) else \
                     self.hold_u(closed, u, N)
             except RuntimeError:
                 opened = _Trial(u, N, math.nan, opened.step)
