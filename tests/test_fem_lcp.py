@@ -3,7 +3,10 @@ method written in the module (scipy.optimize's import costs about half a coarse 
 checked against scipy's nnls on the same problem (the LCP as least squares on the Cholesky factor,
 as the step solved it before), on random problems and on every LCP of cup A's coarse curve,
 frictionless and sticking (1 to 10 nodes each): the same pressed set and the same multipliers to
-round-off. Also its own conditions."""
+round-off; also on every LCP of the sticking fem-route branch at 10 N, whose walk chooses its
+first move's unknown (N or the plate) by a comparison of the tangent's components that round-off
+decides (that tangent is diagonal by construction): a different branch there is not a different
+LCP answer. Also its own conditions."""
 
 from __future__ import annotations
 
@@ -15,6 +18,7 @@ import fem.contact_step
 from fem.contact_step import lawson_hanson, lcp
 from fem.cup import compress_cup
 from fem.geometry import cup_geometry
+from fem.interface import ContactLaw
 from fem.mesh import cup_mesh
 
 
@@ -59,6 +63,34 @@ def test_the_cups_own_contact_problems_agree_with_scipys_nnls(law, monkeypatch):
     monkeypatch.setattr(fem.contact_step, "lcp", record)
     compress_cup(cup_mesh(cup_geometry("A"), "coarse"), contact=law)
     assert len(seen) > 10 and max(len(q) for _, q in seen) >= 3
+    for S, q in seen:
+        _agree(S, q, 1e-9)
+
+
+def test_the_sticking_branchs_contact_problems_agree_with_scipys_nnls(monkeypatch):
+    """The sticking cup A pressed to r_start, sealed, pulled to 10 N and walked to 4.4 mm (as in
+    tests/test_fem_route_branch.py, built here so that no shared sealed state is made with scipy's
+    answers), scipy's answers driving: on every LCP on the way, the same pressed set and
+    multipliers to 1e-9."""
+    import reduced
+    from fem.gas_branch import equilibrium_branch
+    from validation.bridge.fem_route import DEFAULT_DU_M, FemCup
+    from validation.bridge.pipeline import surface_uc_table
+
+    seen = []
+
+    def record(S, q):
+        seen.append((S.copy(), q.copy()))
+        return _by_scipy(S, q)
+
+    monkeypatch.setattr(fem.contact_step, "lcp", record)
+    model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
+    cup = FemCup("A", "coarse", contact=ContactLaw("sticking"))
+    cup = cup.build(model.gas.T_K, model.p_a_Pa, model.fluid)
+    sealed = cup.press_to(r_start_m=model.cup.r_start_m)[-1]
+    branch = equilibrium_branch(cup, sealed, 10.0, du_m=DEFAULT_DU_M, u_min_m=4.4e-3)
+    assert branch.reason == "u_min" and len(branch.states) >= 3
+    assert len(seen) > 50 and max(len(q) for _, q in seen) >= 3
     for S, q in seen:
         _agree(S, q, 1e-9)
 
