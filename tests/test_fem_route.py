@@ -119,3 +119,22 @@ def test_mu0_equals_the_table_coupled_route(model, table, force_N):
 def table():
     from validation.bridge.coupled.build import suction_table_for
     return suction_table_for("A", fidelity="coarse")
+
+
+@pytest.mark.slow
+def test_the_largest_pull_of_a_sticking_cup_is_searched_past_its_slips():
+    """Raised at fixed N, the sticking cup's pull drops by ~20 % where its seal slips and then
+    rises again: the search goes on past the slip (it stopped there before, at 16.07 N), so the
+    largest pull exceeds every pull before the first slip; frictionless (no slips) is unchanged."""
+    from fem.interface import ContactLaw
+    from reduced.cup import CUPS
+    from validation.bridge.fem_route import FemCup, largest_pull_checked
+
+    seen = {}
+    for law in ("sticking", "frictionless"):
+        cup = FemCup("A", "coarse", contact=ContactLaw(law)).build(293.15, 1e5)
+        sealed = cup.press_to(r_start_m=CUPS["A"].r_start_m)[-1]
+        seen[law] = largest_pull_checked(cup, sealed)
+    print(seen)
+    assert seen["sticking"][1] is None and seen["sticking"][0] > 1.5 * 16.07
+    assert seen["frictionless"] == (pytest.approx(51.5653, rel=1e-5), None)

@@ -371,9 +371,11 @@ class _Past(Exception):
 
 def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float:
     """The largest pull F1 [N] along the plate raised at fixed N (the sealed state's) from
-    `sealed` (module docstring): the path is followed up to -h1 until F1 has fallen by `drop` of
-    its maximum or the solver stops (the seal opening), and the maximum refined by the parabola
-    through the three states around it."""
+    `sealed` (module docstring): the path is followed up to -h1 until F1 has fallen steadily by
+    `drop` of its maximum since the last slip (a slip drops the pull by more than that within one
+    step, and the pull may rise again after it: the search goes on past it), or the solver stops
+    (the seal opening); the maximum over the path refined by the parabola through the three
+    states around it."""
     return largest_pull_checked(cup, sealed, drop)[0]
 
 
@@ -390,11 +392,17 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
     plate = lambda t: (dofs, np.concatenate([zeros, np.full(top.size, -(u0 - t))]))  # noqa: E731
     seen: list[tuple[float, float]] = [(u0, sealed.F1_N)]
 
+    since_slip = [sealed.F1_N]                   # the pulls since the last slip
+
     def on_step(step) -> None:
         F1 = float(np.sum(step.r_int[2 * top + 1]))
+        best = max(since_slip)
+        if best > 0 and seen[-1][1] - F1 > drop * best:        # fell by more than drop in one step: a slip
+            since_slip[:] = [F1]
+        else:
+            since_slip.append(F1)
         seen.append((u0 - step.t, F1))
-        best = max(f for _, f in seen)
-        if best > 0 and F1 < (1.0 - drop) * best:
+        if best > 0 and len(since_slip) > 1 and F1 < (1.0 - drop) * max(since_slip):
             raise _Past
     options = replace(cup.options, max_step=min(cup.options.max_step, 0.01))
     stopped = None
