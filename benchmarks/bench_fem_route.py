@@ -44,7 +44,8 @@ from validation.bridge.fem_route import DEFAULT_DU_M, FemCup, FemRouteError, Pre
 from validation.bridge.pipeline import surface_uc_table
 
 LAWS = {"frictionless": ContactLaw(), "coulomb 0.5": ContactLaw("coulomb", 0.5),
-        "coulomb 2": ContactLaw("coulomb", 2.0), "sticking": ContactLaw("sticking")}
+        "coulomb 1": ContactLaw("coulomb", 1.0), "coulomb 2": ContactLaw("coulomb", 2.0),
+        "sticking": ContactLaw("sticking")}
 
 
 def _explain(life) -> dict:

@@ -19,6 +19,13 @@ from validation import guards
 from validation.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
+
+
+def _as_a_terminal_starts_it() -> None:
+    """Ctrl-C at its default in the child, as an interactive shell starts a command: a test run
+    started in the background (`pytest ... &` from a script) inherits SIGINT ignored, and Python
+    keeps an ignored SIGINT ignored."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 CURVE = "u_mm,F0_N\n0,0\n1,2.5\n2,4\n4,5.5\n8,14\n"
 
 
@@ -104,7 +111,8 @@ def test_ctrl_c_at_any_moment_is_one_line(tmp_path):
     for i, delay in enumerate((0.0, 0.1, 0.3, 0.8, 1.5)):
         proc = subprocess.Popen([sys.executable, "-c", start, "run", str(tmp_path / "s.toml"),
                                  "--out", str(tmp_path / f"out{i}"), "--no-cache"], env=env,
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                preexec_fn=_as_a_terminal_starts_it)
         assert proc.stdout.readline() == "ready\n"
         time.sleep(delay)
         proc.send_signal(signal.SIGINT)
@@ -127,7 +135,8 @@ def test_ctrl_c_on_a_sweep_is_one_line(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg"}
     proc = subprocess.Popen([sys.executable, "-m", "validation.cli", "sweep", str(tmp_path / "s.toml"), "--out",
                              str(tmp_path / "out"), "--workers", "1", "--quiet"], env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=_as_a_terminal_starts_it)
     deadline = time.monotonic() + 120
     while not (tmp_path / "out" / "designs").is_dir() and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)                         # the sweep checked its file and took its store
