@@ -5,19 +5,20 @@ dofs eliminated, K_ff factored once) subject to the linearized contact condition
 g_a + du_z,a >= 0 of the free nodes the unconstrained step would push through the plane, and of
 the held nodes whose linearized reaction lambda_a + (K du)_z,a would turn tensile. With the
 columns K_ff^-1 e_a of those m nodes this is the small LCP lambda >= 0, w = q + S lambda >= 0,
-lambda . w = 0 (S = E^T K_ff^-1 E), solved exactly by Lawson and Hanson's active-set method (`lcp`), so
-the whole contact front moves in one iteration. Nodes pressed (lambda > 0) are held afterwards; held
+lambda . w = 0 (S = E^T K_ff^-1 E), solved exactly by non-negative least squares (`lcp`), so the
+whole contact front moves in one iteration. Nodes pressed (lambda > 0) are held afterwards; held
 nodes the LCP lets go are released. Coulomb's step is `fem.friction.FrictionStep`.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import nnls
 
 from .factorization import factor_shifted
 from .linsolve import NotPositiveDefinite
 
-__all__ = ["ContactStep", "lcp", "lawson_hanson"]
+__all__ = ["ContactStep", "lcp"]
 
 
 class ContactStep:
@@ -96,60 +97,13 @@ class ContactStep:
         return active
 
 
-def lcp(S: np.ndarray, q: np.ndarray) -> np.ndarray:
+def lcp(S, q):
     """lambda >= 0 with w = q + S lambda >= 0 and lambda . w = 0 (S symmetric positive definite):
-    the minimizer of lambda S lambda / 2 + q . lambda over lambda >= 0, scaled to a unit diagonal
-    and solved by Lawson and Hanson's active-set method (`lawson_hanson`, finite and exact). The
-    problems are small (the nodes one step brings onto the plane), so the method is written here
-    on the quadratic form itself: scipy.optimize's nnls would cost its package's import, about
-    half a coarse curve's whole process."""
+    the minimizer of lambda S lambda / 2 + q . lambda over lambda >= 0, by non-negative least
+    squares on the Cholesky factor S = L L^T (Lawson-Hanson, finite)."""
     scale = np.sqrt(np.diag(S))
-    return lawson_hanson(S / np.outer(scale, scale), -q / scale) / scale
-
-
-def lawson_hanson(H: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """argmin over x >= 0 of x H x / 2 - c . x (H symmetric positive definite): non-negative least
-    squares in its normal equations (Lawson & Hanson, Solving Least Squares Problems, ch. 23).
-    The passive set P grows by the index of largest w = c - H x; while its unconstrained minimizer
-    s (H_PP s_P = c_P) has a non-positive entry, x moves towards s until the first entry reaches 0
-    and that index leaves P. Ends when no index outside P has w above round-off (10 n eps max|c|)."""
-    n = c.size
-    x = np.zeros(n)
-    passive = np.zeros(n, dtype=bool)
-    if n == 0:
-        return x
-    tol = 10.0 * n * np.finfo(float).eps * float(np.max(np.abs(c)))
-    w = c.copy()
-    barred = np.zeros(n, dtype=bool)      # indices whose s came out <= 0 on entry: skipped until x moves
-    for _ in range(3 * n):
-        candidates = ~passive & ~barred & (w > tol)
-        if not candidates.any():
-            return x
-        j = int(np.argmax(np.where(candidates, w, -np.inf)))
-        passive[j] = True
-        s = _passive_minimizer(H, c, passive)
-        if s[j] <= 0.0:               # round-off made the entering index useless: do not cycle on it
-            passive[j] = False
-            barred[j] = True
-            continue
-        while passive.any() and np.min(s[passive]) <= 0.0:
-            blocking = np.flatnonzero(passive & (s <= 0.0))
-            ratios = x[blocking] / (x[blocking] - s[blocking])
-            alpha = float(np.min(ratios))
-            x = x + alpha * (s - x)
-            x[blocking[np.argmin(ratios)]] = 0.0
-            passive &= x > 0.0
-            x[~passive] = 0.0
-            s = _passive_minimizer(H, c, passive)
-        x = s
-        w = c - H @ x
-        barred[:] = False
-    raise RuntimeError(f"lawson_hanson: no solution within {3 * n} passes (n = {n})")
-
-
-def _passive_minimizer(H: np.ndarray, c: np.ndarray, passive: np.ndarray) -> np.ndarray:
-    """s with H_PP s_P = c_P on the passive set P and 0 outside it."""
-    s = np.zeros(c.size)
-    if passive.any():
-        s[passive] = np.linalg.solve(H[np.ix_(passive, passive)], c[passive])
-    return s
+    Sn = S / np.outer(scale, scale)
+    L = np.linalg.cholesky(Sn)
+    y = np.linalg.solve(L, q / scale)
+    x, _ = nnls(L.T, -y)
+    return x / scale

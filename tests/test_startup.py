@@ -4,10 +4,8 @@ machinery, no plotting, no dask, no pyvista, no scipy.signal; the paper route's 
 surface imports no scipy at all (its u_c table is stored, its interpolants and roots are the
 project's own: scipy.interpolate and scipy.optimize cost ~0.5 s to import, more than the command);
 the profile route's lifetime on an FEM curve's CSV imports no scipy either (its flow tables' spline
-is the project's own); a stiffness curve without a mesh file imports no meshio, and of scipy only
-the sparse matrices and linear algebra scikit-fem needs (no scipy.optimize: ~0.17 s). Each case is
-a fresh process (the modules a test session has already loaded say nothing), its `sys.modules`
-read after the command ran.
+is the project's own); a stiffness curve without a mesh file imports no meshio. Each case is a fresh process (the modules
+a test session has already loaded say nothing), its `sys.modules` read after the command ran.
 """
 
 from __future__ import annotations
@@ -101,8 +99,6 @@ def test_a_fem_command_does_import_the_fem(coarse_curve):
     _, modules = coarse_curve
     assert {"skfem", "scipy"} <= _top(modules)
     assert "meshio" not in _top(modules)
-    # of scipy only what scikit-fem needs: the contact step's LCP is the project's own
-    assert not {"scipy.optimize", "scipy.interpolate", "scipy.special", "scipy.spatial"} & modules
 
 
 def test_the_profile_route_on_a_curve_imports_no_scipy(coarse_curve, tmp_path):
