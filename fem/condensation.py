@@ -22,16 +22,14 @@ they are (`make_solver`).
 from __future__ import annotations
 
 import weakref
-from collections.abc import Callable
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from skfem import Mesh, MeshQuad2
 
 from .linsolve import BandedCholesky, BorderedFactor, NotPositiveDefinite, _constrained_rhs, strip_ordering
 
-__all__ = ["CondensedCholesky", "free_block_solver", "make_solver", "interior_nodes"]
+__all__ = ["CondensedCholesky", "make_solver", "interior_nodes"]
 
 
 def make_solver(pattern: sp.csr_matrix, coordinates: np.ndarray, mesh: Mesh | None = None):
@@ -57,25 +55,6 @@ def make_solver(pattern: sp.csr_matrix, coordinates: np.ndarray, mesh: Mesh | No
 
 
 _SOLVERS: dict[int, tuple] = {}      # id(mesh) -> (weakref to the mesh, pattern, coordinates, solver)
-
-
-def free_block_solver(K: sp.csr_matrix, free: np.ndarray, coordinates: np.ndarray, mesh: Mesh | None,
-                      symmetric: bool) -> Callable[[np.ndarray], np.ndarray]:
-    """x_f = K_ff^-1 b_f for b_f given on the free dofs ([nf] or [nf, m]): by the mesh's banded
-    Cholesky factor (`make_solver`, K in the tangent's pattern) where K is `symmetric` and K_ff
-    positive definite, otherwise by scipy's sparse LU of K_ff (indefinite or unsymmetric)."""
-    if symmetric:
-        try:
-            factor = make_solver(K, coordinates, mesh).factor(K, free)
-        except (NotPositiveDefinite, ValueError):
-            pass
-        else:
-            def solve(b: np.ndarray) -> np.ndarray:
-                full = np.zeros((len(free),) + b.shape[1:])
-                full[free] = b
-                return factor.solve(full)[free]
-            return solve
-    return spla.splu(sp.csr_matrix(K)[free][:, free].tocsc()).solve
 
 
 def _new_solver(pattern: sp.csr_matrix, coordinates: np.ndarray, mesh: Mesh | None):

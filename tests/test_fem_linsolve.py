@@ -145,25 +145,3 @@ def test_a_path_with_factor_reuse_equals_one_without(monkeypatch):
     assert reused.stats.factorizations < fresh.stats.factorizations
     assert np.array_equal(reused.u_m, fresh.u_m) and np.array_equal(reused.F0_N, fresh.F0_N)
     assert all(np.array_equal(a, b) for a, b in zip(reused.displacements, fresh.displacements))
-
-
-def test_free_block_solver_uses_the_cholesky_factor_where_it_can_and_lu_elsewhere(system, monkeypatch):
-    """K_ff^-1 b_f: by the mesh's Cholesky factor for a symmetric positive definite K_ff (no
-    sparse LU made), by LU for an indefinite or unsymmetric one; all equal a dense solve."""
-    import fem.condensation
-    from fem.condensation import free_block_solver
-    mesh, K, free, _, _, rng = system
-    b = rng.normal(size=(int(free.sum()), 3))
-    K_ff = K[free][:, free].toarray()
-    lu = fem.condensation.spla.splu
-    monkeypatch.setattr(fem.condensation.spla, "splu", lambda *a, **k: pytest.fail("LU of a definite K_ff"))
-    x = free_block_solver(K, free, mesh.doflocs, mesh, symmetric=True)(b)
-    assert _close(x, np.linalg.solve(K_ff, b))
-    made = []
-    monkeypatch.setattr(fem.condensation.spla, "splu", lambda A: made.append(A) or lu(A))
-    indefinite = sp.csr_matrix(K - 2.0 * abs(K).max() * sp.diags((np.arange(K.shape[0]) == 7).astype(float)))
-    x = free_block_solver(indefinite, free, mesh.doflocs, mesh, symmetric=True)(b[:, 0])
-    assert len(made) == 1 and _close(x, np.linalg.solve(indefinite[free][:, free].toarray(), b[:, 0]))
-    unsymmetric = sp.csr_matrix(K + 1e-3 * sp.triu(K, 1))
-    x = free_block_solver(unsymmetric, free, mesh.doflocs, mesh, symmetric=False)(b)
-    assert len(made) == 2 and _close(x, np.linalg.solve(unsymmetric[free][:, free].toarray(), b))
