@@ -77,8 +77,9 @@ class SuctionTable:
                 raise ValueError(f"{name}: expected finite values on the {u.size} x {dp.size} grid, got shape {a.shape}")
             hole = np.isnan(a) if hole is None else hole
             if not np.array_equal(np.isfinite(a), ~hole):
+                holes = "" if name == "F1_N" else ": its holes differ from F1_N's"
                 raise ValueError(f"{name}: expected finite values on the {u.size} x {dp.size} grid "
-                                 f"(nan only at a hole, and there in every grid), got other non-finite values")
+                                 f"(nan only at a hole, and there in every grid{holes}), got other non-finite values")
             a.flags.writeable = False
             object.__setattr__(self, name, a)
         if np.any(self.V_m3[~hole] <= 0):
