@@ -40,7 +40,6 @@ on the contact rows (an inexact tangent there; the energy and the residual stay 
 from __future__ import annotations
 
 import math
-import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -279,9 +278,9 @@ class GasMechanics:
     def make_solver(self, pattern, coordinates: np.ndarray, mesh=None) -> "RankOneSolver":
         """The linear solver `follow_path` uses for this mechanics: the body's sparse factor with the
         gas's rank-one term by Sherman-Morrison (module docstring). The body's solver depends on
-        the mesh and the tangent's pattern only, so it is built once per mesh (`_body_solver`):
+        the mesh and the tangent's pattern only, so it is built once per mesh (`make_solver` keeps it):
         a branch runs hundreds of short paths on one cup."""
-        return RankOneSolver(_body_solver(_sparse_part(pattern), coordinates, mesh))
+        return RankOneSolver(make_solver(_sparse_part(pattern), coordinates, mesh))
 
     def at(self, t: float) -> "GasMechanics":
         if self.schedule is None:
@@ -330,29 +329,6 @@ class GasMechanics:
         g = np.bincount(dofs, grad, minlength=r.size)
         data = K.data + dp * np.bincount(self._load._positions(K, pairs), hess, minlength=K.nnz)
         return W + Pi_gas, r + dp * g, GasTangent.of(K, data, self.gas.NkT_J / V**2, g)
-
-
-_SOLVERS: dict[int, tuple] = {}      # id(mesh) -> (weakref to the mesh, pattern, coordinates, solver)
-
-
-def _body_solver(pattern: sp.csr_matrix, coordinates: np.ndarray, mesh):
-    """`fem.condensation.make_solver` of the pattern, reused while the mesh, its node coordinates
-    and the pattern are the same (the solver holds the ordering and condensation maps only; each
-    factorization is a new object)."""
-    if mesh is None:
-        return make_solver(pattern, coordinates, mesh)
-    kept = _SOLVERS.get(id(mesh))
-    if kept is not None and kept[0]() is mesh and kept[1].shape == pattern.shape \
-            and np.array_equal(kept[1].indptr, pattern.indptr) \
-            and np.array_equal(kept[1].indices, pattern.indices) and np.array_equal(kept[2], coordinates):
-        return kept[3]
-    solver = make_solver(pattern, coordinates, mesh)
-    for key in [k for k, v in _SOLVERS.items() if v[0]() is None]:
-        del _SOLVERS[key]
-    _SOLVERS[id(mesh)] = (weakref.ref(mesh), sp.csr_matrix((np.zeros(pattern.nnz), pattern.indices.copy(),
-                                                             pattern.indptr.copy()), shape=pattern.shape),
-                          np.array(coordinates, copy=True), solver)
-    return solver
 
 
 def follow_gas_path(mech: GasMechanics, dirichlet: Callable[[float], tuple[np.ndarray, np.ndarray]],

@@ -47,12 +47,13 @@ from .cavity import CavitySurface, PressurizedMechanics
 from .contact import PressureProfile
 from .cup import CupSetup, _joined
 from .forms import Mechanics
+from .condensation import make_solver
 from .gas_path import CupWithGas
 from .integrity import check_state
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 from .suction import _outputs
-from .trapped_gas import GasTangent, RankOneSolver, _body_solver, _sparse_part
+from .trapped_gas import GasTangent, RankOneSolver, _sparse_part
 
 __all__ = ["WaterMechanics", "WaterState", "CupWithWater", "AL_FACTOR", "UZAWA_TOL"]
 
@@ -97,7 +98,7 @@ class WaterMechanics:
 
     def make_solver(self, pattern, coordinates: np.ndarray, mesh=None) -> RankOneSolver:
         """The body's sparse factor with the penalty's rank-one term (`fem.trapped_gas`)."""
-        return RankOneSolver(_body_solver(_sparse_part(pattern), coordinates, mesh))
+        return RankOneSolver(make_solver(_sparse_part(pattern), coordinates, mesh))
 
     def at(self, t: float) -> "WaterMechanics":
         if self.schedule is None:
