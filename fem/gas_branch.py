@@ -69,7 +69,7 @@ from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
-__all__ = ["Branch", "equilibrium_branch", "pull_sensitivities", "state_between"]
+__all__ = ["Branch", "equilibrium_branch", "held_plate_system", "pull_sensitivities", "state_between"]
 
 STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
 
@@ -110,26 +110,35 @@ def pull_sensitivities(cup: CupWithGas, s: GasState) -> tuple[float, float]:
     return _sensitivities(cup, s.N, s.state)
 
 
-def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, float]:
-    mech = GasMechanics(cup.cup.mech, cup.cavity, cup._gas(N))
+def held_plate_system(cup, state: StepResult) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix, np.ndarray]:
+    """The linear response at the held plate, shared by the gas and the water cavity: the plate's
+    z dofs, the free dofs (plate and held contact dofs fixed), the rows P that let Coulomb's sliding
+    nodes slide (r + mu s lambda = 0) and the plate's unit move d/du (u_z = -u on the plate)."""
     u = state.u
-    _, r, K = mech.evaluate(u)
-    c, g = K.rank_one
     plane, top = cup.cup.plane, cup.cup.top
     plate_z = 2 * top + 1
     held, _ = plane.constraints(state.contact)
     free = np.ones(u.size, bool)
     free[np.concatenate([2 * top, plate_z, held])] = False
     slide = state.contact.active & (state.contact.slip != 0)
-    P = sp.identity(u.size, format="csr")                 # rows: r + mu s lambda = 0 when sliding
+    P = sp.identity(u.size, format="csr")
     if slide.any():
         nodes = plane.nodes[slide]
         P = P + sp.csr_matrix((plane.law.mu * state.contact.slip[slide].astype(float),
                                (2 * nodes, 2 * nodes + 1)), shape=P.shape)
+    down = np.zeros(u.size)
+    down[plate_z] = -1.0
+    return plate_z, free, P, down
+
+
+def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, float]:
+    mech = GasMechanics(cup.cup.mech, cup.cavity, cup._gas(N))
+    u = state.u
+    _, r, K = mech.evaluate(u)
+    c, g = K.rank_one
+    plate_z, free, P, down = held_plate_system(cup, state)
     Ks = K.plain()
     lu = spla.splu((P @ Ks)[free][:, free].tocsc())
-    down = np.zeros(u.size)
-    down[plate_z] = -1.0                                  # u_z = -u on the plate: d/du
     b = -(K_B * cup.T_K / mech.volume_m3(u)) * g          # dr/dN at fixed u
     h = (P @ g)[free]
     rhs = np.stack([-(P @ b)[free], -(P @ (Ks @ down))[free] - c * h * (g @ down), h], axis=1)

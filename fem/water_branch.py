@@ -39,10 +39,9 @@ from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
-import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .gas_branch import Branch, _Trial, _Walk, equilibrium_branch, state_between
+from .gas_branch import Branch, _Trial, _Walk, equilibrium_branch, held_plate_system, state_between
 from .solver import StepResult
 from .cup import _joined
 from .integrity import check_state
@@ -99,20 +98,8 @@ def _sensitivities(cup: CupWithWater, state: StepResult, dp_Pa: float) -> tuple[
     _, _, K = mech.evaluate(u)                  # K_s = K + dp Hess V (V = V_w: dp exact)
     _, g = K.rank_one
     Ks = K.plain()
-    plane, top = cup.cup.plane, cup.cup.top
-    plate_z = 2 * top + 1
-    held, _ = plane.constraints(state.contact)
-    free = np.ones(u.size, bool)
-    free[np.concatenate([2 * top, plate_z, held])] = False
-    slide = state.contact.active & (state.contact.slip != 0)
-    P = sp.identity(u.size, format="csr")                 # rows: r + mu s lambda = 0 when sliding
-    if slide.any():
-        nodes = plane.nodes[slide]
-        P = P + sp.csr_matrix((plane.law.mu * state.contact.slip[slide].astype(float),
-                               (2 * nodes, 2 * nodes + 1)), shape=P.shape)
+    plate_z, free, P, down = held_plate_system(cup, state)
     lu = spla.splu((P @ Ks)[free][:, free].tocsc())
-    down = np.zeros(u.size)
-    down[plate_z] = -1.0                                  # u_z = -u on the plate: d/du
     a, b = lu.solve(np.stack([(P @ (Ks @ down))[free], (P @ g)[free]], axis=1)).T
     gf = g[free]
     s = gf @ b                                            # dV/d(-dp) at the held plate
