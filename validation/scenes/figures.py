@@ -54,10 +54,14 @@ def draw(name: str, products: Products, paths: list[Path], table: Path | None = 
             plt.close(fig)
 
 
+#: subscript digits of plain-text labels (F₁, drawn without mathtext) as the tables spell them (F_1)
+_SUBSCRIPTS = str.maketrans({chr(0x2080 + d): f"_{d}" for d in range(10)})
+
+
 def figure_table(fig) -> dict[str, list]:
     """Every labelled line of `fig`, one row per point: its panel (the axes' quantities with their
-    units, TeX marks dropped), its legend label, and x, y as drawn."""
-    plain = lambda text: text.replace("$", "").replace("\\", "")                  # noqa: E731
+    units, TeX marks dropped, subscript digits as _1), its legend label, and x, y as drawn."""
+    plain = lambda text: text.replace("$", "").replace("\\", "").translate(_SUBSCRIPTS)   # noqa: E731
     rows: dict[str, list] = {"series": [], "x_quantity": [], "x": [], "y_quantity": [], "y": []}
     for ax in fig.axes:
         for line in ax.get_lines():
@@ -106,7 +110,7 @@ def _lifetime_figure(products: Products):
     FEM study of a Table 1 cup the same cup fed by Appendix A beside it."""
     from validation.style import log_axis
     s = products.study
-    fig, ax = _axes("pull force $F_1$ (N)", "lifetime (s)")
+    fig, ax = _axes("pull force F\u2081 (N)", "lifetime (s)")
     for label, p in _lines(products):
         pts = _held(p.lifetimes())
         if pts:
@@ -133,7 +137,7 @@ def _parameter_figure(products: Products):
         pts = [(j if not numeric else v, p.lifetimes()[i].lifetime_s) for j, (v, p) in enumerate(variants)]
         pts = [(x, t) for x, t in pts if math.isfinite(t) and t > 0]
         if pts:
-            ax.plot(*zip(*pts), "o-", ms=3, label=f"$F_1$ = {F:g} N")
+            ax.plot(*zip(*pts), "o-", ms=3, label=f"F\u2081 = {F:g} N")
     ax.set_yscale("log")
     log_axis(ax, "y")
     if not numeric:
@@ -164,7 +168,7 @@ def _uc_figure(products: Products):
 def _F0_figure(products: Products):
     from reduced.appendix_a import appendix_a_curve
     from reduced.cup import CUPS
-    fig, ax = _axes("plate displacement $u$ (mm)", "stiffness force $F_0$ (N)")
+    fig, ax = _axes("plate displacement u (mm)", "stiffness force F\u2080 (N)")
     for label, p in _lines(products):
         curve, s = p.curve(), p.study
         name = f"{label}: " if label else ""
@@ -191,23 +195,23 @@ def _time_figure(products: Products, top: tuple[str, str, float], bottom: tuple[
         for ax, (col, label, factor) in zip(axes, (top, bottom)):
             col = {"N_dot_per_s": "V_dot_mm3_per_s"}.get(col, col) if water else col
             keep = t > 0
-            ax.plot(t[keep], factor * cols[col][keep], label=f"$F_1$ = {r.force_N:g} N")
+            ax.plot(t[keep], factor * cols[col][keep], label=f"F\u2081 = {r.force_N:g} N")
             ax.set_ylabel(label if not water or col == top[0] else "$\\dot V$ (mm$^3$/s)")
     axes[0].set_xscale("log")
     log_axis(axes[1], "x")
-    axes[1].set_xlabel("time $t$ (s)")
+    axes[1].set_xlabel("time t (s)")
     axes[0].legend(fontsize=5)
     return fig
 
 
 def _r_pb_figure(products: Products):
-    return _time_figure(products, ("r_mm", "contact radius $r$ (mm)", 1.0),
+    return _time_figure(products, ("r_mm", "contact radius r (mm)", 1.0),
                         ("p_b_Pa", "cavity pressure $p_b$ (kPa)", 1e-3))
 
 
 def _p_Ndot_figure(products: Products):
     from validation.style import log_axis
-    fig = _time_figure(products, ("p_Pa", "contact pressure $p$ (kPa)", 1e-3),
+    fig = _time_figure(products, ("p_Pa", "contact pressure p (kPa)", 1e-3),
                        ("N_dot_per_s", "leak rate $\\dot N$ (1/s)", 1.0))
     fig.axes[1].set_yscale("log")
     log_axis(fig.axes[1], "y")
