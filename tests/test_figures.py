@@ -7,12 +7,16 @@ bars and their labels are recorded. The PNGs are measured too: the scale bar is 
 horizontal run of pixels whose length is the bar's length over the pixel size.
 """
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
 from matplotlib.image import imread
 
 from validation import style
+from validation.bridge.cache import file_digest
 
 RANGES = [(20, 60), (600, 2000), (5, 200), (1, 1e4), (550, 650), (0.2, 0.9), (3e-3, 40)]
 
@@ -365,3 +369,93 @@ def test_sweep_figures_name_the_base_design_law_mesh_route_and_surface(measured,
         matplotlib.figure.Figure.suptitle = monkey
     assert len(paths) == 3 and seen == [caption] * 3
     assert all(m["clipped"] == [] for m in measured)
+
+
+# ------------------------------------------------------------------ figures drawn in a second process
+def _drawing_processes():
+    import multiprocessing
+    return [p for p in multiprocessing.active_children() if p.name == "cupcheck-figures"]
+
+
+_FORKS = pytest.mark.skipif("not __import__('validation.scenes.drawing').scenes.drawing.can_fork()",
+                            reason="figures are drawn in a second process only where it can fork")
+#: a FEM study of cup A (the lifetime figure draws the Appendix A-fed lifetimes beside it) and its curve
+_SCENE = {"loads": {"F1_N": [10, 40]}, "outputs": [
+    {"kind": "lifetimes"}, {"kind": "figure", "figure": "lifetime_vs_force"}, {"kind": "curve"},
+    {"kind": "figure", "figure": "F0_vs_u"}]}
+
+
+@_FORKS
+def test_figures_drawn_aside_are_the_figures_drawn_in_process(tmp_path):
+    """The same scene with its figures drawn in the drawing process and in this one: the same files
+    in the same order, the same PNG pixels and the same data tables (what each figure draws, the
+    Appendix A-fed lifetimes included), and no drawing process left."""
+    from validation.scenes.outputs import run_scene
+
+    here = run_scene(_SCENE, tmp_path / "here", cache_dir=tmp_path / "cache")
+    aside = run_scene(_SCENE, tmp_path / "aside", cache_dir=tmp_path / "cache", figure_process=True)
+    assert [(f["name"], f["kind"], Path(f["path"]).name) for f in aside.files] == \
+        [(f["name"], f["kind"], Path(f["path"]).name) for f in here.files]
+    for name in ("lifetime_vs_force", "F0_vs_u"):
+        assert np.array_equal(imread(tmp_path / "aside" / f"{name}.png"), imread(tmp_path / "here" / f"{name}.png"))
+        assert (tmp_path / "aside" / f"{name}_data.csv").read_bytes() == \
+            (tmp_path / "here" / f"{name}_data.csv").read_bytes()
+    assert set(pd.read_csv(tmp_path / "aside" / "lifetime_vs_force_data.csv").series) == \
+        {"fem-fed, paper route", "appendix-a-fed, paper route"}
+    manifest = json.loads((tmp_path / "aside" / "manifest.json").read_text())
+    assert all(f["sha256"] == file_digest(tmp_path / "aside" / f["path"]) for f in manifest["files"])
+    assert _drawing_processes() == []
+
+
+@_FORKS
+def test_a_figure_failing_aside_raises_here_and_a_dead_drawer_is_an_error(tmp_path):
+    """A figure the drawing process cannot write raises its own error in this process; a drawing
+    process that was killed is a RuntimeError naming the figure; either way none is left."""
+    import os
+    import signal
+
+    from validation.bridge.products import Products
+    from validation.scenes.drawing import FigureDrawer
+    from validation.scenes.schema import scene_from_mapping
+
+    products = Products(scene_from_mapping({"stiffness": {"source": "appendix-a"}, "outputs": [{"kind": "curve"}]}).study())
+    with FigureDrawer(forked=True) as drawer:
+        assert drawer.forked
+        drawer.submit("F0_vs_u", products, [tmp_path / "no" / "F0.svg", tmp_path / "no" / "F0.png"], None)
+        with pytest.raises(FileNotFoundError):
+            drawer.wait()
+    assert _drawing_processes() == []
+    with FigureDrawer(forked=True) as drawer:
+        os.kill(_drawing_processes()[0].pid, signal.SIGKILL)
+        drawer.submit("F0_vs_u", products, [tmp_path / "F0.svg", tmp_path / "F0.png"], None)
+        with pytest.raises(RuntimeError, match="figure F0_vs_u: the drawing process ended before drawing it"):
+            drawer.wait()
+    assert _drawing_processes() == []
+
+
+@_FORKS
+def test_ctrl_c_is_the_main_processes_and_an_interrupted_run_leaves_nothing(tmp_path):
+    """The drawing process ignores Ctrl-C (the main process reports it); a run interrupted after a
+    figure was sent to it writes nothing, leaves no temporary directory and no drawing process."""
+    import os
+    import signal
+    import time
+
+    from validation.scenes.drawing import FigureDrawer
+    from validation.scenes.outputs import run_scene
+
+    with FigureDrawer(forked=True) as drawer:
+        child = _drawing_processes()[0]
+        os.kill(child.pid, signal.SIGINT)
+        time.sleep(0.3)
+        assert child.is_alive() and drawer.forked
+    assert not child.is_alive()
+
+    def interrupt(message):
+        if message.startswith("output 3 of 4"):          # the lifetime figure has been sent
+            raise KeyboardInterrupt
+
+    scene = {**_SCENE, "stiffness": {"source": "appendix-a"}}
+    with pytest.raises(KeyboardInterrupt):
+        run_scene(scene, tmp_path / "out", progress=interrupt, figure_process=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [] and _drawing_processes() == []

@@ -74,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         result = run_scene(scene, args.out, cache_dir=None if args.no_cache else args.cache_dir,
-                           progress=progress if bar is not None else None, reuse=not args.no_cache)
+                           progress=progress if bar is not None else None, reuse=not args.no_cache,
+                           figure_process=True)
     finally:
         if bar is not None:
             bar.close()

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from validation.bridge.products import Products
 
-__all__ = ["FIGURES", "caption", "draw", "figure_table", "write_figure_table"]
+__all__ = ["FIGURES", "NEEDS", "appendix_a_reference", "caption", "draw", "figure_table", "write_figure_table"]
 
 
 def caption(products: Products) -> str:
@@ -105,6 +105,13 @@ def _held(results) -> list[tuple[float, float]]:
     return [(r.force_N, r.lifetime_s) for r in results if math.isfinite(r.lifetime_s) and r.lifetime_s > 0]
 
 
+def appendix_a_reference(products: Products):
+    """The same cup fed by Appendix A, drawn beside a lifetime figure's FEM-fed lines: for a study
+    of a Table 1 cup that sweeps nothing (`Products.appendix_a`, None for an Appendix A study)."""
+    s = products.study
+    return products.appendix_a() if not s.design.file and s.sweep is None else None
+
+
 def _lifetime_figure(products: Products):
     """Lifetime against F1: one line per swept value (every cup of a cup.preset sweep), and for a
     FEM study of a Table 1 cup the same cup fed by Appendix A beside it."""
@@ -115,7 +122,7 @@ def _lifetime_figure(products: Products):
         pts = _held(p.lifetimes())
         if pts:
             ax.plot(*zip(*pts), "o-", label=label or f"{s.stiffness}-fed, {s.route} route")
-    reference = products.appendix_a() if not s.design.file and s.sweep is None else None
+    reference = appendix_a_reference(products)
     if reference is not None:
         ref = _held(reference.lifetimes())
         if ref:
@@ -222,3 +229,7 @@ def _p_Ndot_figure(products: Products):
 FIGURES = {"lifetime_vs_force": _lifetime_figure, "uc_vs_pressure": _uc_figure, "F0_vs_u": _F0_figure,
            "lifetime_vs_parameter": _parameter_figure, "r_pb_vs_time": _r_pb_figure,
            "p_Ndot_vs_time": _p_Ndot_figure}
+#: the products each figure draws (of each swept value in a sweep; "appendix_a": the lifetimes of
+#: `appendix_a_reference`), computed before it is drawn in another process (validation.scenes.drawing)
+NEEDS = {"lifetime_vs_force": ("lifetimes", "appendix_a"), "uc_vs_pressure": ("uc_table",), "F0_vs_u": ("curve",),
+         "lifetime_vs_parameter": ("lifetimes",), "r_pb_vs_time": ("lifetimes",), "p_Ndot_vs_time": ("lifetimes",)}

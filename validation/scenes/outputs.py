@@ -75,11 +75,14 @@ def made_from(output: Mapping[str, Any], study: Study) -> dict[str, Any]:
 
 
 def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
-              cache_dir: str | Path | None = None, progress=None, reuse: bool = True) -> SceneResult:
+              cache_dir: str | Path | None = None, progress=None, reuse: bool = True,
+              figure_process: bool = False) -> SceneResult:
     """Compute a scene's outputs; with `out`, write them (atomically) and ``out/manifest.json``.
 
     reuse: keep the outputs of an earlier run in `out` whose key and files are unchanged (False:
-    draw every output afresh)."""
+    draw every output afresh). figure_process: draw the figures in a second process while the
+    products are computed (`validation.scenes.drawing`; where the platform allows), those that
+    need no lifetimes as soon as their products are there (the command line's way)."""
     from validation.output import atomic_directory, software_versions
 
     if not isinstance(scene, Scene):
@@ -105,18 +108,33 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None,
         files = [{**f, "path": str(out / f["path"])} for kept in intact for f in kept]
         return SceneResult(scene, {}, files, {}, kept=list(files), up_to_date=True,
                            partial=previous.get("partial") or {})
-    products = Products(study, cache_dir=cache_dir, progress=progress, keep_partial=True)
-    with atomic_directory(out) as tmp:
-        files, kept = [], []
-        for k, (o, origin, old) in enumerate(zip(scene.outputs, made, intact)):
-            if progress is not None:
-                progress(f"output {k + 1} of {n}: {o['name']}")
-            linked = _link(old, out, Path(tmp)) if old else None
-            if linked is not None:
-                kept += linked
-                files += linked
-                continue
-            files += [{**f, **origin, "sha256": file_digest(f["path"])} for f in _write(o, products, Path(tmp))]
+    from validation.scenes.drawing import FigureDrawer, can_fork
+    from validation.scenes.figures import NEEDS
+
+    drawn = [k for k, (o, old) in enumerate(zip(scene.outputs, intact)) if o["kind"] == "figure" and not old]
+    with FigureDrawer(forked=figure_process and bool(drawn) and can_fork()) as drawer, \
+            atomic_directory(out) as tmp:
+        products = Products(study, cache_dir=cache_dir, progress=progress, keep_partial=True)
+        try:
+            # a figure needing no lifetimes is drawn aside while they are computed
+            early = {k: _write(scene.outputs[k], products, Path(tmp), drawer) for k in drawn
+                     if drawer.forked and "lifetimes" not in NEEDS[scene.outputs[k]["figure"]]}
+            files, kept = [], []
+            for k, (o, origin, old) in enumerate(zip(scene.outputs, made, intact)):
+                if progress is not None:
+                    progress(f"output {k + 1} of {n}: {o['name']}")
+                linked = _link(old, out, Path(tmp)) if old else None
+                if linked is not None:
+                    kept += linked
+                    files += linked
+                    continue
+                written = early[k] if k in early else _write(o, products, Path(tmp), drawer)
+                files += [{**f, **origin} for f in written]
+            drawer.wait()
+        except BaseException:
+            drawer.close()                 # nothing is drawn into the directory once it is removed
+            raise
+        files = [f if "sha256" in f else {**f, "sha256": file_digest(f["path"])} for f in files]
         partial = partial_records(products)
         if any(old for old in intact):     # an output kept from the previous run keeps its partial record
             partial = {**(previous or {}).get("partial", {}), **partial}
@@ -233,7 +251,10 @@ def _link(entries: list[dict], out: Path, tmp: Path) -> list[dict] | None:
     return None
 
 
-def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str, str]]:
+def _write(output: dict, products: Products, tmp: Path | None, drawer=None) -> list[dict[str, str]]:
+    """Write `output` into `tmp` (None: compute only): its files (name, kind, path); a figure is
+    drawn by `drawer` (`validation.scenes.drawing.FigureDrawer`; None: here), its files there once
+    the drawer has waited."""
     kind, name = output["kind"], output["name"]
     if kind == "curve":
         curve = products.curve()
@@ -258,7 +279,7 @@ def _write(output: dict, products: Products, tmp: Path | None) -> list[dict[str,
     from validation.scenes.figures import draw
     paths = [] if tmp is None else [tmp / f"{name}.{suffix}" for suffix in ("svg", "png")]
     table = None if tmp is None else tmp / f"{name}_data.csv"
-    draw(output["figure"], products, paths, table)
+    (draw if drawer is None else drawer.submit)(output["figure"], products, paths, table)
     return [_file(name, "figure", path) for path in (*reversed(paths), *([table] if table else []))]
 
 
