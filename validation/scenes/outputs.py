@@ -277,10 +277,10 @@ def _write(output: dict, products: Products, tmp: Path | None, drawer=None) -> l
         from validation.scenes.views3d import write_view
         return write_view(output, products, tmp)
     from validation.scenes.figures import draw
-    paths = [] if tmp is None else [tmp / f"{name}.{suffix}" for suffix in ("svg", "png")]
+    paths = [] if tmp is None else [tmp / f"{name}.{suffix}" for suffix in ("png", "svg")]
     table = None if tmp is None else tmp / f"{name}_data.csv"
     (draw if drawer is None else drawer.submit)(output["figure"], products, paths, table)
-    return [_file(name, "figure", path) for path in (*reversed(paths), *([table] if table else []))]
+    return [_file(name, "figure", path) for path in (*paths, *([table] if table else []))]
 
 
 #: the files of each output kind, by suffix (as `_write` and `write_view` name them)
