@@ -20,6 +20,10 @@ times the named figures alone (what they need, e.g. the medium curve of the prof
 made, untimed). --pyc lets the processes cache their compiled bytecode (in a temporary
 PYTHONPYCACHEPREFIX, as an installed package does) where the environment sets
 PYTHONDONTWRITEBYTECODE: else every run compiles the project's sources anew (~0.05 s of a command).
+--main-parts prints instead where the cold main job's time goes, run by run: the whole process's
+wall time, the CPU of the main process and of the drawing process beside it (the figures,
+validation.scenes.drawing), and the products' wall times from the manifest (FEM path, curve, u_c
+table, lifetimes); --against gives the same for another checkout, run for run.
 """
 
 from __future__ import annotations
@@ -88,6 +92,48 @@ for argv in json.loads(sys.argv[1]):
     times.append((time.perf_counter() - w, time.process_time() - c))
 print(json.dumps(times))
 """
+
+
+#: the cold main job in one process: its wall time, the CPU of this process and of its children (the
+#: drawing process) and the manifest's product timings, as JSON on the last line
+MAIN_PARTS = """import json, resource, sys, time
+w = time.perf_counter()
+from validation.cli import main
+status = main(["run", "scenes/main.toml", "--quiet", "--no-cache", "--out", sys.argv[1]])
+wall = time.perf_counter() - w
+me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+timings = json.load(open(sys.argv[1] + "/manifest.json"))["timings_s"]
+print(json.dumps({"wall": wall, "main_cpu": me.ru_utime + me.ru_stime, "drawing_cpu": kids.ru_utime + kids.ru_stime,
+                  **{k.split("_")[0] if k.startswith("fem_path") else k: v for k, v in timings.items()}}))
+"""
+
+
+def main_parts(cli: Runner) -> dict[str, float]:
+    """`MAIN_PARTS`' figures of one cold main job [s]."""
+    out = cli.work / f"parts_{time.monotonic_ns()}"
+    done = subprocess.run([sys.executable, "-c", MAIN_PARTS, str(out)], cwd=cli.tree, env=cli.env, check=True,
+                          capture_output=True, text=True)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def print_main_parts(tree: Path, against: Path | None, repeat: int, pyc: bool) -> None:
+    """The cold main job's parts (`MAIN_PARTS`), of `tree` and `against`, their runs interleaved."""
+    with tempfile.TemporaryDirectory() as d, tempfile.TemporaryDirectory() as e:
+        cli = Runner(tree, Path(d), pyc)
+        other = Runner(against, Path(e), pyc) if against is not None else None
+        got, base = [], []
+        for _ in range(repeat):
+            got.append(main_parts(cli))
+            if other is not None:
+                base.append(main_parts(other))
+    print(f"{'main job, cold (s)':24s} {'this':>8s}" + (f" {'against':>8s} {'ratio':>6s}" if base else ""))
+    for key in got[0]:
+        t = statistics.median(r.get(key, 0.0) for r in got)
+        line = f"{key:24s} {t:8.3f}"
+        if base:
+            b = statistics.median(r.get(key, 0.0) for r in base)
+            line += f" {b:8.3f} {_cell(t / b if b > 0 else None, 6, 2)}"
+        print(line, flush=True)
 
 
 def median(run: Callable[[], tuple[float, float]], repeat: int,
@@ -166,7 +212,12 @@ def main() -> None:
     ap.add_argument("--only", nargs="+", choices=NAMES, default=None, metavar="FIGURE",
                     help=f"time only these figures ({', '.join(NAMES)})")
     ap.add_argument("--write-baseline", action="store_true", help=f"store the figures as {BASELINE.name}")
+    ap.add_argument("--main-parts", action="store_true",
+                    help="where the cold main job's time goes (the main and drawing processes' CPU, the products)")
     args = ap.parse_args()
+    if args.main_parts:
+        print_main_parts(args.tree.resolve(), args.against.resolve() if args.against else None, args.repeat, args.pyc)
+        return
     if args.only is not None and args.write_baseline:
         ap.error("--write-baseline: records every figure; drop --only")
     only = frozenset(args.only or NAMES)
