@@ -6,7 +6,9 @@ Products are cached on disk, in the user's cache (--cache-dir; default the platf
 ~/.cache/cupcheck/scenes on Linux, or $CUPCHECK_CACHE_DIR/scenes): a second run of the same scene
 computes nothing. A rerun into the same DIR draws only the outputs whose inputs changed or whose
 files were edited or deleted (the manifest records what each file was made from and its sha256);
-one that changes nothing writes nothing. --no-cache computes and draws everything afresh.
+one that changes nothing writes nothing. --no-cache computes and draws everything afresh. The
+figures are drawn in a second process while the curves and lifetimes are computed (on Linux with
+two processors or more; elsewhere one after the other).
 
 An FEM stiffness curve whose path fails after some converged steps keeps them: the outputs drawn
 from it use the converged part, flagged partial (the curve's sidecar, a curve_partial_to_u_mm

@@ -4,7 +4,8 @@ Each output pulls only the products it needs (`validation.bridge.products.Produc
 `validation.bridge.study.Study`). Figures (`validation.scenes.figures`) are drawn in the toolkit's style,
 PNG and SVG, axes labelled with units; tables name design, contact law, mesh, route and surface.
 `run_scene` is the Python entry point (a scene file, a dict or a `Scene`; the results in memory,
-and on disk when given a directory, written atomically with ``manifest.json``).
+and on disk when given a directory, written atomically with ``manifest.json``). `cupcheck run` has
+the figures drawn in a second process while the products are computed (`validation.scenes.drawing`).
 
 A rerun into the same directory does no work for what has not changed: the manifest records, for
 every file, the key of what its output was made from (`made_from`) and the sha256 of its bytes;
