@@ -84,3 +84,48 @@ def test_quick_section_end_to_end(tmp_path):
         assert s["lifetime_s"][f"A {law} 10N"] > 0
         assert s["largest_force_N"]["A"][f"fem {law}"] > 10.0
     assert "88 N" in (out / "README.md").read_text()
+
+
+def test_the_plan_splits_into_independent_parts_per_cup_and_law():
+    parts = fem_life.groups(False)
+    flat = [r for p in parts for r in p]
+    assert len(flat) == len(plan(False)) and set(flat) == set(plan(False))
+    assert len(parts) == 2 * len(fem_life.LAWS)
+    for p in parts:
+        assert p[0].force_N is None                     # the largest holdable force first in each part
+        assert len({(r.cup, r.law, r.friction) for r in p}) == 1
+    some = fem_life.groups(False, cups={"B"}, laws={("sticking", None)})
+    assert [(r.cup, r.law) for r in some[0]] == [("B", "sticking")] * 5 and len(some) == 1
+
+
+@pytest.mark.parametrize("text, law", [("frictionless", ("frictionless", None)), ("coulomb 0.3", ("coulomb", 0.3)),
+                                       ("sticking", ("sticking", None)), ("coulomb  2", ("coulomb", 2.0))])
+def test_a_law_as_written_on_the_command_line(text, law):
+    from validation.crosscheck.fem_life_rerun import parse_law
+    assert parse_law(text) == law
+
+
+@pytest.mark.parametrize("argv, field", [(["--law", "coulomb 7"], "--law 'coulomb 7'"),
+                                         (["--law", "coulomb"], "--law 'coulomb'"),
+                                         (["--jobs", "0"], "--jobs 0")])
+def test_bad_rerun_options_are_one_line_exit_2_nothing_written(tmp_path, capsys, argv, field):
+    from validation.crosscheck.fem_life_rerun import main
+    (tmp_path / "README.md").write_text(README)
+    (tmp_path / "summary.json").write_text("{}\n")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert main(["--into", str(tmp_path), "--cache-dir", str(tmp_path / "c"), *argv]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and field in err[0]
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+@pytest.mark.slow
+def test_parts_filled_by_two_workers_are_what_one_process_computes(tmp_path):
+    """The quick parts run by two loky workers into a cache, then read back without running: the
+    same lifetimes and largest forces as `live` in this process (~60 s on one core)."""
+    fem_life.fill(fem_life.groups(True), tmp_path, jobs=2)
+    back = fem_life.lives(plan(True), fem_life.cached_runner(tmp_path, cached_only=True))
+    assert not any(o.reason == "not run" for o in back.values())
+    here = live(LifeRun("A", "coulomb", 0.5, 10.0))
+    there = back[("A", "coulomb", 0.5, 10.0)]
+    assert there.lifetime_s == here.lifetime_s and there.reason == here.reason

@@ -180,20 +180,24 @@ def lives(runs, one: Callable[[LifeRun], LifeOutcome]) -> dict[tuple, LifeOutcom
 
 
 def _runner(ctx: Context, cached_only: bool = False) -> Callable[[LifeRun], LifeOutcome]:
-    """`live` through the run memo's cache directory (when there is one), keyed by the run and the
-    sources of fem, reduced and the route; `cached_only`: a run not in the cache is not run (its
-    cell says so)."""
+    """`live` through the run memo's cache directory (when there is one); see `cached_runner`."""
+    return cached_runner(ctx.memo.cache_dir, ctx.progress, cached_only)
+
+
+def cached_runner(root, progress: Callable[[float, str], None] = lambda f, m: None,
+                  cached_only: bool = False) -> Callable[[LifeRun], LifeOutcome]:
+    """`live` cached under `root` / fem_life (None: not cached), keyed by the run and the sources of
+    fem, reduced and the route; `cached_only`: a run not in the cache is not run (its cell says so)."""
     from joblib import Memory
 
     from validation.bridge.cache import Cache, source_hash
 
-    root = ctx.memo.cache_dir
     cached = Cache(None if root is None else root / "fem_life").cached(live, ignore=["progress"])
     code = source_hash("fem", "reduced", "validation/bridge/fem_route.py", "validation/bridge/pipeline.py")
     stored = None if root is None else Memory(str(root / "fem_life"), verbose=0).cache(live, ignore=["progress"])
 
     def run_one(run: LifeRun) -> LifeOutcome:
-        ctx.progress(0.0, f"{NAME}: {run.label()}")
+        progress(0.0, f"{NAME}: {run.label()}")
         if cached_only and (stored is None or not stored.check_call_in_cache(run, code)):
             out = LifeOutcome(run, math.nan, "not run", "not in the cache (rerun to fill)", math.nan)
         else:
@@ -201,6 +205,43 @@ def _runner(ctx: Context, cached_only: bool = False) -> Callable[[LifeRun], Life
         print(f"{NAME}: {run.label()}: {out.cell()} ({out.wall_s:.0f} s)", flush=True)
         return out
     return run_one
+
+
+def groups(quick: bool, cups=None, laws=None) -> list[tuple[LifeRun, ...]]:
+    """The plan cut into its independent parts, one per (cup, law): each part's largest holdable
+    force comes first, since it decides which of its forces run (`lives`). `cups`, `laws`: keep
+    only these (None: all)."""
+    parts: dict[tuple, list[LifeRun]] = {}
+    for r in plan(quick):
+        if (cups is None or r.cup in cups) and (laws is None or (r.law, r.friction) in laws):
+            parts.setdefault((r.cup, r.law, r.friction), []).append(r)
+    return [tuple(p) for p in parts.values()]
+
+
+def _fill_part(runs: tuple[LifeRun, ...], root) -> int:
+    """Run one (cup, law) part into the cache under `root`; returns how many lives it holds."""
+    return len(lives(runs, cached_runner(root)))
+
+
+def fill(parts, root, jobs: int = 1, tables=()) -> None:
+    """Run the (cup, law) parts, and build the suction tables of the cups in `tables` (the
+    table-coupled route's), into the cache under `root`, `jobs` processes at a time (joblib's loky
+    workers; the cache on disk is the hand-back). The slowest tasks go first."""
+    from joblib import Parallel, delayed
+
+    tasks = [delayed(_build_table)(cup, root) for cup in tables]
+    tasks += [delayed(_fill_part)(p, root) for p in sorted(parts, key=_expected_cost, reverse=True)]
+    Parallel(n_jobs=jobs, backend="loky", verbose=0)(tasks)
+
+
+def _build_table(cup: str, root) -> None:
+    _table_in(cup, root)
+
+
+def _expected_cost(part: tuple[LifeRun, ...]) -> float:
+    """A rough order of the parts' cost: sticking and large mu walk longer branches."""
+    r = part[0]
+    return {"sticking": 3.0, "coulomb": 1.0 + (r.friction or 0.0)}.get(r.law, 1.0)
 
 
 def run(ctx: Context, cached_only: bool = False) -> None:
@@ -248,9 +289,13 @@ def _route_cells(compute: Callable, n: int) -> tuple[list[str], float, list[floa
 def suction_table(ctx: Context, cup: str):
     """The frictionless FEM suction table of a preset cup on the default grid, kept where section 6
     keeps it (the memo's cache directory / suction): one build per code version for both."""
+    return _table_in(cup, ctx.memo.cache_dir)
+
+
+def _table_in(cup: str, root):
     from validation.bridge.coupled.build import DEFAULT_GRID, suction_table_for
 
-    cache = None if ctx.memo.cache_dir is None else ctx.memo.cache_dir / "suction"
+    cache = None if root is None else root / "suction"
     return suction_table_for(cup, fidelity=CROSSCHECK_FIDELITY, grid=DEFAULT_GRID, cache_dir=cache)
 
 
