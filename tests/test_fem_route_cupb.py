@@ -24,7 +24,8 @@ from fem.branch_end import FLOOR_STRETCH, plate_floor_m, up_to_most_gas, wall_le
 from fem.gas_branch import equilibrium_branch
 from fem.geometry import cup_geometry
 from fem.interface import ContactLaw
-from validation.bridge.fem_route import DEFAULT_DU_M, FemCup, largest_pull_checked, lifetime_integral, register
+from validation.bridge.fem_route import (DEFAULT_DU_M, FemCup, largest_pull_checked, lifetime_integral,
+                                         register)
 from validation.bridge.pipeline import surface_uc_table
 
 
@@ -85,7 +86,8 @@ def test_cup_b_at_40_N_folds(sealed):
 
 def test_cup_b_holds_its_largest_pull_inside_the_walk(sealed):
     largest, partial = largest_pull_checked(sealed.cup, sealed.state)
-    assert partial is None and 40.0 < largest < sealed.cup.p_a_Pa * math.pi * sealed.cup.mesh.doflocs[0].max()**2
+    rim = sealed.cup.mesh.doflocs[0].max()
+    assert partial is None and 40.0 < largest < sealed.cup.p_a_Pa * math.pi * rim**2   # below full vacuum
 
 
 @pytest.mark.slow
