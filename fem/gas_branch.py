@@ -63,6 +63,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .branch_end import plate_floor_m
 from .branch_jumps import LetGo, leak_to_hold, settle
 from .gas_path import CupWithGas, GasState
 from .solver import ConvergenceError, SolverStats, StepResult
@@ -157,8 +158,8 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     """The states holding the pull F1_N from `sealed` (a "pressed" state, sealed there at p_a, or
     a sealed state) to detachment (module docstring). du_m: the plate step along the branch
     (halved, down to du_m / 16, where a state cannot be found); u_min_m: the lowest plate
-    position (default -h1: the plate above the touching height, the suction holding the wall on
-    the plane); progress(k, u_m, N): called with every state k of the branch as it is found;
+    position (default `fem.branch_end.plate_floor_m`: the apex twice the wall's length above the
+    plane); progress(k, u_m, N): called with every state k of the branch as it is found;
     walk: the walk's class for another cavity content (None: the gas's; `fem.water_branch`).
     Raises ValueError for bad input; where no state is found even with the smallest step, the
     branch ends there with reason "stopped: <why>" and no detachment."""
@@ -166,7 +167,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
         raise ValueError(f"F1_N: must be a finite number, got {F1_N!r}")
     if not (math.isfinite(du_m) and 0.0 < du_m <= 0.1 * cup.h1_m):
         raise ValueError(f"du_m: must be in (0, {0.1 * cup.h1_m * 1e3:.4g}] mm, got {du_m * 1e3:.4g} mm")
-    u_min = -cup.h1_m if u_min_m is None else float(u_min_m)
+    u_min = plate_floor_m(cup) if u_min_m is None else float(u_min_m)
     if not (u_min < sealed.u_m):
         raise ValueError(f"u_min_m: must be below the sealed plate position {sealed.u_m * 1e3:.4g} mm, "
                          f"got {u_min * 1e3:.4g} mm")
@@ -511,8 +512,8 @@ class _Walk:
         """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m
         (Newton's with the exact dF1/du where it points up), each from the last state pulling
         less than F1; a step that overshoots brackets the crossing, which regula falsi (Illinois)
-        closes. None if the plate reaches u_min first. The plate never moves down: with friction
-        a back-and-forth would enter the history."""
+        closes. None if the plate reaches u_min or the seal opens first. The plate never moves
+        down: with friction a back-and-forth would enter the history."""
         a, b = sealed, None
         while b is None:
             miss = a.F1_N - self.F1
@@ -524,6 +525,8 @@ class _Walk:
             if u_new < u_min:
                 return None
             s = self.solve(a, u_new, a.N)
+            if _open(self.cup, s):          # the seal opened before the pull reached F1
+                return None
             if s.F1_N - self.F1 > self.tolerance:
                 b = s
             else:

@@ -222,6 +222,7 @@ class FemRoute:
         return kept[1], kept[2]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
+        from fem.branch_end import up_to_most_gas
         from fem.gas_branch import equilibrium_branch, state_between
         from fem.water_branch import water_branch, water_state_between
         from reduced.lifetime import Lifetime
@@ -255,12 +256,14 @@ class FemRoute:
             raise FemRouteError(f"F1 = {force_N:g} N: the branch ended without a detachment "
                                 f"({branch.reason}) after {len(branch.states)} states")
         leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, options["radial"])  # noqa: E731
-        states, q, added = refine_branch(sealed.cup, list(branch.states), [leak(s) for s in branch.states],
+        # a fold lets go with the most gas held (`fem.branch_end.up_to_most_gas`)
+        kept = up_to_most_gas(branch.states) if branch.reason == "fold" else list(branch.states)
+        states, q, added = refine_branch(sealed.cup, kept, [leak(s) for s in kept],
                                          float(force_N), leak, water_state_between if water else state_between)
         N = np.array([s.N for s in states])
         columns = _columns(states, q, water)
         stats = branch.stats
-        most = {"V_w_max_mm3": 1e9 * branch.N_max} if water else {"N_max": branch.N_max}
+        most = {"V_w_max_mm3": 1e9 * states[-1].N} if water else {"N_max": states[-1].N}
         details = {**base, **most, "states": len(states), "refined": added, "snaps": branch.snaps,
                    "newton_iterations": stats.newton_iterations, "wall_time_s": stats.wall_time_s,
                    "seal_r_final_mm": 1e3 * states[-1].seal_r_m, "p_b_final_Pa": states[-1].p_b_Pa,
@@ -371,24 +374,25 @@ class _Past(Exception):
 
 def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float:
     """The largest pull F1 [N] along the plate raised at fixed N (the sealed state's) from
-    `sealed` (module docstring): the path is followed up to -h1 until F1 has fallen steadily by
-    `drop` of its maximum since the last slip (a slip drops the pull by more than that within one
-    step, and the pull may rise again after it: the search goes on past it), or the solver stops
-    (the seal opening); the maximum over the path refined by the parabola through the three
-    states around it."""
+    `sealed` (module docstring): the path is followed up to the plate's floor (`fem.branch_end`)
+    until F1 has fallen steadily by `drop` of its maximum since the last slip (a slip drops the
+    pull by more than that within one step, and the pull may rise again after it: the search goes
+    on past it), or the solver stops (the seal opening); the maximum over the path refined by the
+    parabola through the three states around it."""
     return largest_pull_checked(cup, sealed, drop)[0]
 
 
 def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> tuple[float, str | None]:
-    """`largest_pull` and, where the solver stopped while the pull was still rising (the maximum
-    not reached: a lower bound only), the solver's message; else None."""
+    """`largest_pull` and, where the solver stopped or the plate reached its floor while the pull
+    was still rising (the maximum not reached: a lower bound only), why; else None."""
+    from fem.branch_end import plate_floor_m
     from fem.solver import ConvergenceError
     from fem.trapped_gas import GasMechanics, TrappedGas, follow_gas_path
 
     mech = GasMechanics(cup.cup.mech, cup.cavity, TrappedGas(sealed.N, cup.T_K, cup.p_a_Pa))
     top = cup.cup.top
     dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
-    u0, span = sealed.u_m, sealed.u_m + cup.h1_m
+    u0, span = sealed.u_m, sealed.u_m - plate_floor_m(cup)
     plate = lambda t: (dofs, np.concatenate([zeros, np.full(top.size, -(u0 - t))]))  # noqa: E731
     seen: list[tuple[float, float]] = [(u0, sealed.F1_N)]
 
@@ -404,7 +408,11 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
         seen.append((u0 - step.t, F1))
         if best > 0 and len(since_slip) > 1 and F1 < (1.0 - drop) * max(since_slip):
             raise _Past
-    options = replace(cup.options, max_step=min(cup.options.max_step, 0.01))
+    # the solver's steps are fractions of the whole range: scaled to give the same steps in u
+    # whatever the floor's depth, those of 1 % of the way from the sealed plate to -h1
+    o, f = cup.options, (u0 + cup.h1_m) / span
+    options = replace(o, initial_step=f * o.initial_step, max_step=f * min(o.max_step, 0.01),
+                      min_step=f * o.min_step, jump_min_step=f * o.jump_min_step)
     stopped = None
     try:
         follow_gas_path(mech, plate, span, plane=cup.cup.plane, start=sealed.state, options=options,
@@ -416,6 +424,8 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
     u, F = np.array(seen).T
     k = int(np.argmax(F))
     partial = stopped if stopped is not None and k == F.size - 1 else None
+    if stopped is None and k == F.size - 1 > 0:            # still rising at the plate's floor
+        partial = f"the pull still rising at the plate's floor u = {1e3 * u[-1]:.4g} mm"
     if 0 < k < F.size - 1:
         a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
         if a < 0:
