@@ -38,6 +38,7 @@ F1 = dp pi r_0^2 + P_z = dp pi r_k^2 - N (eq. 5 with the FEM's N and r_k in plac
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -228,7 +229,11 @@ class PressurizedMechanics:
     cavity: CavitySurface
     dp_Pa: float
     schedule: Callable[[float], float] | None = None
-    _table: dict = field(default_factory=dict, repr=False)     # CSR positions, shared by `at`
+    _table: dict | None = field(default=None, repr=False)     # CSR positions, one per body
+
+    def __post_init__(self) -> None:
+        if self._table is None:        # shared by every load on the body: a branch makes hundreds
+            self._table = _TABLES.setdefault(self.body, {})
 
     def at(self, t: float) -> "PressurizedMechanics":
         if self.schedule is None:
@@ -262,9 +267,28 @@ class PressurizedMechanics:
             return W, r, K
         V, (dofs, grad), hess, pairs = self.cavity.derivatives(self.coordinates(u))
         r = r + self.dp_Pa * np.bincount(dofs, grad, minlength=r.size)
-        data = K.data + self.dp_Pa * np.bincount(self._positions(K, pairs), hess,
-                                                 minlength=K.nnz)
+        data = self.add_hessian(K, pairs, hess, self.dp_Pa)
         return W + self.dp_Pa * V, r, sp.csr_matrix((data, K.indices, K.indptr), shape=K.shape)
+
+    def add_hessian(self, K: sp.csr_matrix, pairs: np.ndarray, hess: np.ndarray, scale: float) -> np.ndarray:
+        """K's CSR data plus `scale` times the Hessian entries `hess` at the dof `pairs` (summed
+        where pairs repeat), touching only the entries the pairs reach."""
+        slots, inverse = self._slots(K, pairs)
+        data = K.data.copy()
+        data[slots] += scale * np.bincount(inverse, hess, minlength=slots.size)
+        return data
+
+    def _slots(self, K: sp.csr_matrix, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The distinct CSR positions of the dof pairs and each pair's index among them (kept as
+        `_positions`)."""
+        key = ("slots", id(pairs), K.nnz)
+        kept = self._table.get(key)
+        if kept is not None and kept[0] is pairs:
+            return kept[1]
+        slots = np.unique(self._positions(K, pairs), return_inverse=True)
+        if not pairs.flags.writeable:
+            self._table[key] = (pairs, slots)
+        return slots
 
     def _positions(self, K: sp.csr_matrix, pairs: np.ndarray) -> np.ndarray:
         """Positions of the dof pairs (i, j) in K's CSR data (sorted column indices per row);
@@ -294,3 +318,6 @@ class PressurizedMechanics:
             if np.any(np.diff(table) <= 0):
                 raise ValueError("cavity: the tangent's CSR column indices must be sorted")
         return table
+
+
+_TABLES: "weakref.WeakKeyDictionary[Mechanics, dict]" = weakref.WeakKeyDictionary()
