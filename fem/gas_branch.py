@@ -105,8 +105,8 @@ def pull_sensitivities(cup: CupWithGas, s: GasState) -> tuple[float, float]:
     held contact dofs fixed (its contact set kept). F1 is the plate's reaction (`fem.gas_path`).
     Coulomb's sliding nodes keep t = -mu lambda s: their radial row gains mu s times their normal
     row (the reaction lambda changes with the state). The matrix is factored by the mesh's banded
-    Cholesky, or by sparse LU where it is not symmetric or not definite (the gas alone holding
-    the wall; `fem.free_block`), the rank-one term added by Sherman-Morrison."""
+    Cholesky, Coulomb's rows added by the Woodbury identity (a sparse LU where it is not definite:
+    the gas alone holding the wall; `fem.free_block`), the rank-one term by Sherman-Morrison."""
     return _sensitivities(cup, s.N, s.state)
 
 
