@@ -54,7 +54,10 @@ def solve_free_block(K: sp.csr_matrix, rows: sp.csr_matrix, free: np.ndarray, rh
     Y, Z = YZ[:, :m], YZ[:, m:]
     WK = (W[S] @ K).toarray()
     WK[:, ~free] = 0.0                               # V = (W K)_Sf
-    X = Y - Z @ np.linalg.solve(np.eye(S.size) + WK @ Z, WK @ Y)
+    try:
+        X = Y - Z @ np.linalg.solve(np.eye(S.size) + WK @ Z, WK @ Y)
+    except np.linalg.LinAlgError:                   # a singular capacitance matrix
+        return _lu(K, rows, free, rhs)
     R = sp.csr_matrix(rows)
     residual = R @ (K @ X) - full.reshape(n, -1)
     bound = abs(R) @ (abs(K) @ np.abs(X)) + np.abs(full.reshape(n, -1))
