@@ -166,6 +166,8 @@ class CavitySurface:
         cut at `cut_index`; all edges at once, in chain order (the last one halved if the cut is
         at a mid-side node)."""
         c = self._chain(self.cut_index(x))
+        if z_ref <= 0.0:
+            return self._geometric_terms(x, order, c)
         edges, N, dN, w = c.edges, c.N, c.dN, c.w                       # [E, 3], [E, 3, q], [E, q]
         rk, zk = x[:, c.seal]
         Phi_k, phi_k, dphi_k, _ = (float(v) for v in wetted_fraction(np.array(zk), z_ref))
@@ -193,6 +195,31 @@ class CavitySurface:
         seal_grad = np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])
         seal_hess = np.array([2.0 * np.pi * Phi_k, 2.0 * np.pi * rk * phi_k,
                               2.0 * np.pi * rk * phi_k, np.pi * rk**2 * dphi_k])
+        return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
+                np.concatenate([-np.pi * H.ravel(), seal_hess]), c.pairs)
+
+
+    @staticmethod
+    def _geometric_terms(x: np.ndarray, order: int, c: "_Chain"):
+        """`_terms` for phi = 1 (z_ref = 0: the geometric volume, the gas's): the same products
+        without the factors phi = 1 and the terms in phi' = phi'' = 0."""
+        edges, N, dN, w = c.edges, c.N, c.dN, c.w
+        rk, zk = x[:, c.seal]
+        xr, xz = x[0, edges], x[1, edges]
+        r = np.einsum("eiq,ei->eq", N, xr)
+        dz = np.einsum("eiq,ei->eq", dN, xz)
+        V = np.pi * rk**2 * zk - np.pi * np.sum(w * r**2 * dz)
+        if not order:
+            return (float(V),)
+        g_r = np.einsum("eiq,eq->ei", N, 2.0 * r * dz * w)
+        g_z = np.einsum("eiq,eq->ei", dN, r**2 * w)
+        grad = -np.pi * np.concatenate([g_r, g_z], axis=1)
+        H = np.zeros((edges.shape[0], 6, 6))
+        H[:, :3, :3] = np.einsum("eiq,eq,ejq->eij", N, 2.0 * dz * w, N)
+        H[:, :3, 3:] = np.einsum("eiq,eq,ejq->eij", N, 2.0 * r * w, dN)
+        H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
+        seal_grad = np.array([2.0 * np.pi * rk * zk, np.pi * rk**2])
+        seal_hess = np.array([2.0 * np.pi * zk, 2.0 * np.pi * rk, 2.0 * np.pi * rk, 0.0])
         return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
                 np.concatenate([-np.pi * H.ravel(), seal_hess]), c.pairs)
 
