@@ -30,11 +30,14 @@ in-process (the command's own work: pressing, sealing, the largest holdable forc
 the leak), its CPU time per part as above plus
 
   cavity     the cavity volume, its gradient and Hessian (`fem.cavity.CavitySurface`);
-  sens       the branch's sensitivities dF1/dN, dF1/du (`fem.gas_branch._sensitivities`: a
-             sparse LU of the bordered tangent, outside the solver's factorizations);
+  sens       the branch's sensitivities dF1/dN, dF1/du (`fem.gas_branch._sensitivities`: one
+             factorization of the held plate's free block, `fem.free_block`, outside the
+             solver's factorizations);
   setup      building a linear solver (`fem.condensation.make_solver`'s orderings and maps);
 
-and the calls of each.
+and the calls of each, and the CPU time per solver factorization (each Newton iteration factors
+once; a shifted retry or a freed contact node adds one) against one factorization of the last
+tangent the route factored.
 With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
 --repeat runs, CPU time of the child and wall time), whose excess over the in-process curve is
 start-up (imports), the mesh and the output files.
@@ -183,16 +186,21 @@ def profile_route(level: str, force_N: float) -> dict:
     with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()):
         cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level])
     cpu = time.process_time() - t
+    solver, K, free = CLOCK.last_factor
+    own = _median_time(lambda: solver.factor(K, free))
     row = next((line.split() for line in out.getvalue().splitlines()
                 if line.split()[:1] == [f"{force_N:g}"]), ["", "?", "?"])
     return {"level": level, "force": force_N, "cpu": cpu, "lifetime": row[1], "reason": row[2],
-            "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls)}
+            "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own}
 
 
 def report_route(r: dict) -> None:
     total = r["cpu"]
     print(f"\nfem route, cup A {r['level']}, F1 = {r['force']:g} N: lifetime {r['lifetime']} s "
           f"({r['reason']}); in-process CPU time {total:.2f} s")
+    per = total / r["calls"]["factor"]
+    print(f"  per solver factorization (~ per Newton iteration) {1e3 * per:.2f} ms; one factorization of the "
+          f"last tangent {1e3 * r['own_factor']:.2f} ms: a Newton iteration costs {per / r['own_factor']:.1f} of them")
     print(f"  {'part':9} {'time/s':>7} {'share':>6} {'calls':>6} {'per call/ms':>11}")
     for part in PARTS + ("other",):
         t = r["parts"].get(part, total - sum(r["parts"].values()))

@@ -38,6 +38,7 @@ F1 = dp pi r_0^2 + P_z = dp pi r_k^2 - N (eq. 5 with the FEM's N and r_k in plac
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -165,6 +166,8 @@ class CavitySurface:
         cut at `cut_index`; all edges at once, in chain order (the last one halved if the cut is
         at a mid-side node)."""
         c = self._chain(self.cut_index(x))
+        if z_ref <= 0.0:
+            return self._geometric_terms(x, order, c)
         edges, N, dN, w = c.edges, c.N, c.dN, c.w                       # [E, 3], [E, 3, q], [E, q]
         rk, zk = x[:, c.seal]
         Phi_k, phi_k, dphi_k, _ = (float(v) for v in wetted_fraction(np.array(zk), z_ref))
@@ -192,6 +195,31 @@ class CavitySurface:
         seal_grad = np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])
         seal_hess = np.array([2.0 * np.pi * Phi_k, 2.0 * np.pi * rk * phi_k,
                               2.0 * np.pi * rk * phi_k, np.pi * rk**2 * dphi_k])
+        return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
+                np.concatenate([-np.pi * H.ravel(), seal_hess]), c.pairs)
+
+
+    @staticmethod
+    def _geometric_terms(x: np.ndarray, order: int, c: "_Chain"):
+        """`_terms` for phi = 1 (z_ref = 0: the geometric volume, the gas's): the same products
+        without the factors phi = 1 and the terms in phi' = phi'' = 0."""
+        edges, N, dN, w = c.edges, c.N, c.dN, c.w
+        rk, zk = x[:, c.seal]
+        xr, xz = x[0, edges], x[1, edges]
+        r = np.einsum("eiq,ei->eq", N, xr)
+        dz = np.einsum("eiq,ei->eq", dN, xz)
+        V = np.pi * rk**2 * zk - np.pi * np.sum(w * r**2 * dz)
+        if not order:
+            return (float(V),)
+        g_r = np.einsum("eiq,eq->ei", N, 2.0 * r * dz * w)
+        g_z = np.einsum("eiq,eq->ei", dN, r**2 * w)
+        grad = -np.pi * np.concatenate([g_r, g_z], axis=1)
+        H = np.zeros((edges.shape[0], 6, 6))
+        H[:, :3, :3] = np.einsum("eiq,eq,ejq->eij", N, 2.0 * dz * w, N)
+        H[:, :3, 3:] = np.einsum("eiq,eq,ejq->eij", N, 2.0 * r * w, dN)
+        H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
+        seal_grad = np.array([2.0 * np.pi * rk * zk, np.pi * rk**2])
+        seal_hess = np.array([2.0 * np.pi * zk, 2.0 * np.pi * rk, 2.0 * np.pi * rk, 0.0])
         return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
                 np.concatenate([-np.pi * H.ravel(), seal_hess]), c.pairs)
 
@@ -228,7 +256,11 @@ class PressurizedMechanics:
     cavity: CavitySurface
     dp_Pa: float
     schedule: Callable[[float], float] | None = None
-    _table: dict = field(default_factory=dict, repr=False)     # CSR positions, shared by `at`
+    _table: dict | None = field(default=None, repr=False)     # CSR positions, one per body
+
+    def __post_init__(self) -> None:
+        if self._table is None:        # shared by every load on the body: a branch makes hundreds
+            self._table = _TABLES.setdefault(self.body, {})
 
     def at(self, t: float) -> "PressurizedMechanics":
         if self.schedule is None:
@@ -262,9 +294,28 @@ class PressurizedMechanics:
             return W, r, K
         V, (dofs, grad), hess, pairs = self.cavity.derivatives(self.coordinates(u))
         r = r + self.dp_Pa * np.bincount(dofs, grad, minlength=r.size)
-        data = K.data + self.dp_Pa * np.bincount(self._positions(K, pairs), hess,
-                                                 minlength=K.nnz)
+        data = self.add_hessian(K, pairs, hess, self.dp_Pa)
         return W + self.dp_Pa * V, r, sp.csr_matrix((data, K.indices, K.indptr), shape=K.shape)
+
+    def add_hessian(self, K: sp.csr_matrix, pairs: np.ndarray, hess: np.ndarray, scale: float) -> np.ndarray:
+        """K's CSR data plus `scale` times the Hessian entries `hess` at the dof `pairs` (summed
+        where pairs repeat), touching only the entries the pairs reach."""
+        slots, inverse = self._slots(K, pairs)
+        data = K.data.copy()
+        data[slots] += scale * np.bincount(inverse, hess, minlength=slots.size)
+        return data
+
+    def _slots(self, K: sp.csr_matrix, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The distinct CSR positions of the dof pairs and each pair's index among them (kept as
+        `_positions`)."""
+        key = ("slots", id(pairs), K.nnz)
+        kept = self._table.get(key)
+        if kept is not None and kept[0] is pairs:
+            return kept[1]
+        slots = np.unique(self._positions(K, pairs), return_inverse=True)
+        if not pairs.flags.writeable:
+            self._table[key] = (pairs, slots)
+        return slots
 
     def _positions(self, K: sp.csr_matrix, pairs: np.ndarray) -> np.ndarray:
         """Positions of the dof pairs (i, j) in K's CSR data (sorted column indices per row);
@@ -294,3 +345,6 @@ class PressurizedMechanics:
             if np.any(np.diff(table) <= 0):
                 raise ValueError("cavity: the tangent's CSR column indices must be sorted")
         return table
+
+
+_TABLES: "weakref.WeakKeyDictionary[Mechanics, dict]" = weakref.WeakKeyDictionary()

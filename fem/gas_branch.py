@@ -61,13 +61,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from .branch_end import plate_floor_m
 from .branch_jumps import LetGo, leak_to_hold, settle
 from .gas_path import CupWithGas, GasState
 from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
+from .free_block import solve_free_block
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
 __all__ = ["Branch", "equilibrium_branch", "held_plate_system", "pull_sensitivities", "state_between"]
@@ -105,9 +105,9 @@ def pull_sensitivities(cup: CupWithGas, s: GasState) -> tuple[float, float]:
     full tangent K + dp Hess V + (N k_B T / V^2) grad V grad V^T on the free dofs and the state's
     held contact dofs fixed (its contact set kept). F1 is the plate's reaction (`fem.gas_path`).
     Coulomb's sliding nodes keep t = -mu lambda s: their radial row gains mu s times their normal
-    row (the reaction lambda changes with the state). The matrix is factored by sparse LU (it
-    need not be symmetric, nor definite where the gas alone holds the wall), the rank-one term
-    added by Sherman-Morrison."""
+    row (the reaction lambda changes with the state). The matrix is factored by the mesh's banded
+    Cholesky, Coulomb's rows added by the Woodbury identity (a sparse LU where it is not definite:
+    the gas alone holding the wall; `fem.free_block`), the rank-one term by Sherman-Morrison."""
     return _sensitivities(cup, s.N, s.state)
 
 
@@ -139,11 +139,10 @@ def _sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float,
     c, g = K.rank_one
     plate_z, free, P, down = held_plate_system(cup, state)
     Ks = K.plain()
-    lu = spla.splu((P @ Ks)[free][:, free].tocsc())
     b = -(K_B * cup.T_K / mech.volume_m3(u)) * g          # dr/dN at fixed u
     h = (P @ g)[free]
     rhs = np.stack([-(P @ b)[free], -(P @ (Ks @ down))[free] - c * h * (g @ down), h], axis=1)
-    y = lu.solve(rhs)
+    y = solve_free_block(Ks, P, free, rhs, cup.cup.mech.kin)
     gf = g[free]
     y[:, :2] -= np.outer(y[:, 2], c * (gf @ y[:, :2]) / (1.0 + c * gf @ y[:, 2]))
     x_N, x_u = np.zeros(u.size), down.copy()

@@ -327,7 +327,7 @@ class GasMechanics:
         dp = self.gas.p_a_Pa - self.gas.pressure_Pa(V)
         W, r, K = self.body.evaluate(u)
         g = np.bincount(dofs, grad, minlength=r.size)
-        data = K.data + dp * np.bincount(self._load._positions(K, pairs), hess, minlength=K.nnz)
+        data = self._load.add_hessian(K, pairs, hess, dp)
         return W + Pi_gas, r + dp * g, GasTangent.of(K, data, self.gas.NkT_J / V**2, g)
 
 
