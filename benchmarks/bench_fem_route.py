@@ -194,8 +194,9 @@ def why(model, low: float, high: float, level: str = "coarse") -> None:
     print("|---|---|---|---|---|---|---|")
     for ratio in (1.0, 2.0, 4.0, 8.0):
         a, b = (br.states[int(np.argmin(np.abs(br.column("N") / N0 - ratio)))] for br in branches)
-        q = [state_leak_rate(s, model, sealed.E_Pa) for s in (a, b)]
-        swapped = [state_leak_rate(replace(s, p_b_Pa=o.p_b_Pa, dp_Pa=o.dp_Pa), model, sealed.E_Pa)
+        plane = sealed.cup.cup.plane
+        q = [state_leak_rate(s, model, sealed.E_Pa, plane=plane) for s in (a, b)]
+        swapped = [state_leak_rate(replace(s, p_b_Pa=o.p_b_Pa, dp_Pa=o.dp_Pa), model, sealed.E_Pa, plane=plane)
                    for s, o in ((a, b), (b, a))]
         print(f"| {a.N / N0:.2f} / {b.N / N0:.2f} | {a.p_b_Pa / 1e3:.1f} / {b.p_b_Pa / 1e3:.1f} | "
               f"{1e3 * a.seal_r_m:.2f} / {1e3 * b.seal_r_m:.2f} | {a.contact_force_N:.2f} / {b.contact_force_N:.2f} | "
