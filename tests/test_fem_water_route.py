@@ -85,7 +85,7 @@ def test_the_inflow_is_eq_24_inverse_in_the_viscosity(model):
 def test_the_command_line_prints_the_python_calls_lifetime(capsys, tmp_path, held):
     out = tmp_path / "fem"
     code, text, err = run_cli(capsys, "lifetime", "--route", "fem", "--fluid", "water", "--cup", "A",
-                              "--surface", "pmma-1.89", "--force", "10", "--out", out)
+                              "--surface", "pmma-1.89", "--force", "10", "--fidelity", "coarse", "--out", out)
     assert code == 0, err
     head, columns, row = text.splitlines()
     life, d = held[0], held[0].details

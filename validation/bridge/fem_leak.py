@@ -8,10 +8,11 @@ plots and widths, the lumped pressures p_a = lambda_a / int N_a dA. Where the co
 the traction's density, as on the profile route. Where one node touches alone (its neighbours
 lifted: the rim corner of a seal that has narrowed to its last ring) the traction is a line load
 of unresolved width: the lumped pressure divides lambda_a by the node's share of the facets on
-either side, which leave the plane (one of them the rim's face), and that profile's force over
-its neighbours' radii is not lambda_a but depends on the elements (0.06-5.4 N for a 4.5 N corner,
-benchmarks/fem_route_mesh_study.md). Such a node enters as a ring load of its own reaction
-lambda_a at its radius (`SealLoad`): patch-averaged, a box F / (2 pi r L), the element size gone.
+either side, which leave the plane (one of them the rim's face), so that profile's force over
+its neighbours' radii is not lambda_a and follows the elements (benchmarks/fem_route_mesh_study.md).
+Such a node enters as a ring load of its own reaction lambda_a at its radius (`SealLoad`):
+patch-averaged, a box F / (2 pi r L), the element size gone. The reaction is the FEM's converged
+quantity: alone on the plane, the corner's is the plate's force (global equilibrium).
 """
 
 from __future__ import annotations
@@ -79,18 +80,20 @@ def seal_load(state: GasState, plane: RigidPlane) -> SealLoad:
 
 
 def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: str = "annulus", *,
-                    plane: RigidPlane) -> float:
+                    plane: RigidPlane, lone_by_reaction: bool = True) -> float:
     """Molecules per second leaking into the cavity at one sealed FEM state, or for water the
     volume inflow [m^3/s] of eq (24): the gas in the contact zone [r_k, r_cut] rises from p_b to
     p_a (the model's `interface`, as `reduced.table_surface.solid_profile`), which the FEM's
     traction (the suction p_a - p_b out to r_cut) does not carry, so the solid pressure is the
     profile's less that rise; patch-averaged with the lone nodes' ring loads (`seal_load`, module
-    docstring) where u_c has a patch length, its rings' gaps u_c(p / E_Pa) in series at the
-    state's p_b. inf where no solid contact is left (the fluid holds the seal open)."""
+    docstring) where u_c has a patch length (the rise acts on the resolved contact: a lone
+    node's zone has no width), its rings' gaps u_c(p / E_Pa) in series at the state's p_b. inf where no solid contact is left (the fluid holds the seal open).
+    lone_by_reaction=False reads the lumped profile as it is, lone nodes included (the reading
+    before, for the mesh study's diagnosis)."""
     from reduced.profile_leak import ContactProfile, patch_average, profile_leak_rate, profile_liquid_rate, ring_gaps
 
     patch = getattr(model.u_c, "patch_length_m", None)
-    if patch:
+    if patch and lone_by_reaction:
         load = seal_load(state, plane)
     else:                   # no nominal pressure: the lumped profile as it is, lone nodes included
         load = SealLoad(*_merged_profile(state), np.zeros(0), np.zeros(0))

@@ -69,10 +69,12 @@ def _law() -> ContactLaw:
 @dataclass(frozen=True)
 class FemCup:
     """The FEM cup of the route: the design (a `fem.geometry.CupGeometry` or a preset name), the
-    wall's neo-Hookean material (E [Pa], nu), the contact law with the plane and the mesh level."""
+    wall's neo-Hookean material (E [Pa], nu), the contact law with the plane and the mesh level
+    (default medium: the coarsest whose lifetimes are within 1 % of the next finer level's,
+    benchmarks/fem_route_mesh_study.md)."""
 
     geometry: Any = "A"
-    fidelity: str = "coarse"
+    fidelity: str = "medium"
     E_Pa: float = 4e6
     nu: float = 0.49
     contact: Any = field(default_factory=_law)
