@@ -26,8 +26,9 @@ fidelity name or an intermediate mesh "N_ALONGxN_THROUGH" with the levels' gradi
 the mesh study: per law and force each level's lifetime, the converged estimate (Richardson from
 the three finest levels where they converge monotonically, else the finest level) and each
 level's error against it, and the coarsest level within 1 % wherever every level has a lifetime.
---seal F1 splits each level's lifetime at F1 where the seal has narrowed to one node, read from
-the lumped profile and as the route reads it (validation.bridge.fem_leak), on the same states.
+--seal F1 splits each level's lifetime at F1 at N = 8 N0 (before the seal narrows to one node),
+read from the lumped profile and as the route reads it (validation.bridge.fem_leak), on the same
+states.
 """
 
 from __future__ import annotations
@@ -213,19 +214,20 @@ def why(model, low: float, high: float, level: str = "coarse") -> None:
               f"{swapped[0]:.3g} / {swapped[1]:.3g} |", flush=True)
 
 
-def seal_diagnosis(model, F: float, levels: list[str], law: str = "frictionless") -> None:
-    """Where the mesh moves the lifetime at F under `law`: per level, the time until the seal has
-    narrowed to one node (the rim corner touching alone) and after it, read from the lumped
-    profile as it is and as the route reads it (`validation.bridge.fem_leak`: a lone node by its
-    reaction), on the same branch states; and at the first lone-node state the corner's reaction
-    against the lumped profile's force over its neighbours' radii."""
+def seal_diagnosis(model, F: float, levels: list[str], law: str = "frictionless", split: float = 8.0) -> None:
+    """Where the mesh moves the lifetime at F under `law`: per level, the time until N = split N0
+    (before any level's seal has narrowed to one node) and after it, read from the lumped profile
+    as it is and as the route reads it (`validation.bridge.fem_leak`: a lone node by its
+    reaction), on the same branch states; and at the first state whose contact is one node (the
+    rim corner alone) its N, the corner's reaction and the lumped profile's force over its
+    neighbours' radii."""
     from fem.gas_branch import equilibrium_branch, state_between
     from reduced.profile_leak import ContactProfile
     from validation.bridge.fem_leak import contact_reactions, seal_load, state_leak_rate
     from validation.bridge.fem_route import refine_branch
 
-    print(f"| level | reading | lifetime [s] | until one node [s] | after [s] | N/N0 there | corner reaction [N] "
-          f"| lumped profile's force [N] |  (F1 = {F:g} N, {law})")
+    print(f"| level | reading | lifetime [s] | until {split:g} N0 [s] | after [s] | one node from N/N0 "
+          f"| corner reaction [N] | lumped profile's force [N] |  (F1 = {F:g} N, {law})")
     print("|---|---|---|---|---|---|---|---|")
     for level in levels:
         route = register()
@@ -238,15 +240,16 @@ def seal_diagnosis(model, F: float, levels: list[str], law: str = "frictionless"
         lumped = np.array([state_leak_rate(s, model, sealed.E_Pa, plane=plane, lone_by_reaction=False)
                            for s in states])
         N = np.array([s.N for s in states])
-        lone = [k for k, s in enumerate(states) if seal_load(s, plane).rings_r_m.size and
-                not np.any(seal_load(s, plane).p_Pa)]
+        loads = [seal_load(s, plane) for s in states]
+        lone = [k for k, ld in enumerate(loads) if ld.rings_r_m.size == 1 and not np.any(ld.p_Pa)]
         k = lone[0] if lone else len(states) - 1
         s = states[k]
         corner = float(np.sum(contact_reactions(plane, s.state)[1]))
         profile_force = ContactProfile(s.profile.r_m, s.profile.p_Pa).force_N if s.profile.r_m.size > 1 else 0.0
         for name, rate in (("lumped profile", lumped), ("route (lone node by its reaction)", q)):
             t = lifetime_integral(N, rate)
-            print(f"| {level} | {name} | {t[-1]:.4g} | {t[k]:.4g} | {t[-1] - t[k]:.4g} | {N[k] / N[0]:.3f} "
+            until = float(np.interp(split * N[0], N, t))
+            print(f"| {level} | {name} | {t[-1]:.4g} | {until:.4g} | {t[-1] - until:.4g} | {N[k] / N[0]:.3f} "
                   f"| {corner:.3f} | {profile_force:.3f} |", flush=True)
 
 
