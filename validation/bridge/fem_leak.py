@@ -87,7 +87,8 @@ def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: s
     traction (the suction p_a - p_b out to r_cut) does not carry, so the solid pressure is the
     profile's less that rise; patch-averaged with the lone nodes' ring loads (`seal_load`, module
     docstring) where u_c has a patch length (the rise acts on the resolved contact: a lone
-    node's zone has no width), its rings' gaps u_c(p / E_Pa) in series at the state's p_b. inf where no solid contact is left (the fluid holds the seal open).
+    node's zone has no width), its rings' gaps u_c(p / E_Pa) in series at the state's p_b; inf
+    where no solid contact is left (the fluid holds the seal open).
     lone_by_reaction=False reads the lumped profile as it is, lone nodes included (the reading
     before, for the mesh study's diagnosis)."""
     from reduced.profile_leak import ContactProfile, patch_average, profile_leak_rate, profile_liquid_rate, ring_gaps

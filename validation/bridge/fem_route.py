@@ -16,8 +16,9 @@ p_b, as the coupled route reads its table (`reduced.coupled`): the solid pressur
 less the interface gas's rise over p_b across the zone [r_k, r_cut] (the model's `interface`),
 averaged over the u_c table's patch length, a node touching alone entering by its reaction
 (`validation.bridge.fem_leak`), its rings' gaps u_c(p / E) in series (`reduced.profile_leak`).
-The lifetime is t = int_{N0}^{N_max} dN / Q by the trapezoid in N over the branch states: N rises monotonically along the branch whereas u turns where the branch does
-(the walk switches to N as its parameter there), and 1/Q is smooth in N except where the
+The lifetime is t = int_{N0}^{N_max} dN / Q by the trapezoid in N over the branch states: N rises
+monotonically along the branch whereas u turns where the branch does (the walk switches to N as
+its parameter there), and 1/Q is smooth in N except where the
 seal's contact narrows to its last ring and Q falls several times within a plate step: there
 states are added midway (`refine_branch`). The change when the plate step is halved measures the
 quadrature and branch error (benchmarks/bench_fem_route.py, docs/lifetime.md).
