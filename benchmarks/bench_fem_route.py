@@ -7,6 +7,7 @@ r_start = 12 mm, sealed, held at F1 along its FEM branch, per mesh level and con
         --forces 5 10 20 40 --du-factors 1 0.5 0.25 --jsonl study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --summarize study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --why 5 20
+    OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --seal 20 --levels coarse medium fine
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --mesh-study --levels coarse medium fine \
         --laws frictionless "coulomb 0.5" --forces 5 10 20 40 --jsonl benchmarks/fem_route_mesh_study.jsonl
 
@@ -25,6 +26,9 @@ fidelity name or an intermediate mesh "N_ALONGxN_THROUGH" with the levels' gradi
 the mesh study: per law and force each level's lifetime, the converged estimate (Richardson from
 the three finest levels where they converge monotonically, else the finest level) and each
 level's error against it, and the coarsest level within 1 % wherever every level has a lifetime.
+--seal F1 splits each level's lifetime at F1 at N = 8 N0 (before the seal narrows to one node),
+read from the lumped profile and as the route reads it (validation.bridge.fem_leak), on the same
+states.
 """
 
 from __future__ import annotations
@@ -91,6 +95,9 @@ def main() -> None:
     ap.add_argument("--summarize", default=None, help="print the convergence table of a --jsonl file")
     ap.add_argument("--mesh-study", action="store_true",
                     help="run the lifetimes missing from --jsonl, then print the mesh study (module docstring)")
+    ap.add_argument("--seal", type=float, default=None, metavar="F1",
+                    help="the seal diagnosis at F1 per level (seal_diagnosis): the lifetime until the seal "
+                         "is one node and after, read from the lumped profile and as the route reads it")
     ap.add_argument("--why", nargs=2, type=float, default=None, metavar=("F_LOW", "F_HIGH"),
                     help="the leak of the two forces' frictionless branch states at equal N / N0, each "
                          "also at the other's p_b (the profile's share against the pressure's)")
@@ -108,6 +115,9 @@ def main() -> None:
     model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
     if a.why:
         why(model, *a.why, level=a.levels[0])
+        return
+    if a.seal is not None:
+        seal_diagnosis(model, a.seal, a.levels, a.laws[0])
         return
     du0 = DEFAULT_DU_M if a.du_mm is None else 1e-3 * a.du_mm
     press = None if a.press_u_mm is None else Press("u_m", 1e-3 * a.press_u_mm)
@@ -194,13 +204,53 @@ def why(model, low: float, high: float, level: str = "coarse") -> None:
     print("|---|---|---|---|---|---|---|")
     for ratio in (1.0, 2.0, 4.0, 8.0):
         a, b = (br.states[int(np.argmin(np.abs(br.column("N") / N0 - ratio)))] for br in branches)
-        q = [state_leak_rate(s, model, sealed.E_Pa) for s in (a, b)]
-        swapped = [state_leak_rate(replace(s, p_b_Pa=o.p_b_Pa, dp_Pa=o.dp_Pa), model, sealed.E_Pa)
+        plane = sealed.cup.cup.plane
+        q = [state_leak_rate(s, model, sealed.E_Pa, plane=plane) for s in (a, b)]
+        swapped = [state_leak_rate(replace(s, p_b_Pa=o.p_b_Pa, dp_Pa=o.dp_Pa), model, sealed.E_Pa, plane=plane)
                    for s, o in ((a, b), (b, a))]
         print(f"| {a.N / N0:.2f} / {b.N / N0:.2f} | {a.p_b_Pa / 1e3:.1f} / {b.p_b_Pa / 1e3:.1f} | "
               f"{1e3 * a.seal_r_m:.2f} / {1e3 * b.seal_r_m:.2f} | {a.contact_force_N:.2f} / {b.contact_force_N:.2f} | "
               f"{a.profile.p_Pa.max() / 1e3:.1f} / {b.profile.p_Pa.max() / 1e3:.1f} | {q[0]:.3g} / {q[1]:.3g} | "
               f"{swapped[0]:.3g} / {swapped[1]:.3g} |", flush=True)
+
+
+def seal_diagnosis(model, F: float, levels: list[str], law: str = "frictionless", split: float = 8.0) -> None:
+    """Where the mesh moves the lifetime at F under `law`: per level, the time until N = split N0
+    (before any level's seal has narrowed to one node) and after it, read from the lumped profile
+    as it is and as the route reads it (`validation.bridge.fem_leak`: a lone node by its
+    reaction), on the same branch states; and at the first state whose contact is one node (the
+    rim corner alone) its N, the corner's reaction and the lumped profile's force over its
+    neighbours' radii."""
+    from fem.gas_branch import equilibrium_branch, state_between
+    from reduced.profile_leak import ContactProfile
+    from validation.bridge.fem_leak import contact_reactions, seal_load, state_leak_rate
+    from validation.bridge.fem_route import refine_branch
+
+    print(f"| level | reading | lifetime [s] | until {split:g} N0 [s] | after [s] | one node from N/N0 "
+          f"| corner reaction [N] | lumped profile's force [N] |  (F1 = {F:g} N, {law})")
+    print("|---|---|---|---|---|---|---|---|")
+    for level in levels:
+        route = register()
+        sealed = route.seal(model, {**route.options, "cup": fem_cup(level, law)})
+        plane = sealed.cup.cup.plane
+        leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, plane=plane)  # noqa: E731
+        branch = equilibrium_branch(sealed.cup, sealed.state, F, du_m=DEFAULT_DU_M)
+        states, q, _ = refine_branch(sealed.cup, list(branch.states), [leak(s) for s in branch.states], F,
+                                     leak, state_between)
+        lumped = np.array([state_leak_rate(s, model, sealed.E_Pa, plane=plane, lone_by_reaction=False)
+                           for s in states])
+        N = np.array([s.N for s in states])
+        loads = [seal_load(s, plane) for s in states]
+        lone = [k for k, ld in enumerate(loads) if ld.rings_r_m.size == 1 and not np.any(ld.p_Pa)]
+        k = lone[0] if lone else len(states) - 1
+        s = states[k]
+        corner = float(np.sum(contact_reactions(plane, s.state)[1]))
+        profile_force = ContactProfile(s.profile.r_m, s.profile.p_Pa).force_N if s.profile.r_m.size > 1 else 0.0
+        for name, rate in (("lumped profile", lumped), ("route (lone node by its reaction)", q)):
+            t = lifetime_integral(N, rate)
+            until = float(np.interp(split * N[0], N, t))
+            print(f"| {level} | {name} | {t[-1]:.4g} | {until:.4g} | {t[-1] - until:.4g} | {N[k] / N[0]:.3f} "
+                  f"| {corner:.3f} | {profile_force:.3f} |", flush=True)
 
 
 def summarize(path: str) -> None:

@@ -46,6 +46,9 @@ conserving, and a lone loaded node becomes a strip L wide at F / (2 pi r L), ind
 element size once the elements are shorter than L. The length is `UcTable.patch_length_m`, set by
 `reduced.roughness.uc_table` with `with_patch_length=True` (the convergence it buys is measured by
 `benchmarks/bench_profile_convergence.py`, docs/lifetime.md).
+A contact far narrower than L that is known by its force alone (a finite-element node touching
+the plane alone, its neighbours lifted) enters as a ring load: `patch_average` spreads its force
+F over the patch around it, the box F / (2 pi r L), whatever the (unresolved) width it acts on.
 Eq (6)'s suction share beta (p_a - p_b) is a pressure on the contact, not a load to spread: it is
 added on the nominal contact, the FEM's contact intervals (edges half-way between the last loaded
 node and the first free one) widened by L/2 each side (the patches that hold contact).
@@ -96,7 +99,8 @@ class ContactProfile:
         return float(np.pi * np.sum((f[1:] + f[:-1]) * np.diff(self.r_m)))
 
 
-def patch_average(profile: ContactProfile, length_m: float) -> ContactProfile:
+def patch_average(profile: ContactProfile, length_m: float, rings_r_m: np.ndarray | None = None,
+                  rings_F_N: np.ndarray | None = None) -> ContactProfile:
     """The nominal pressure of `profile` on patches of radial width `length_m` (module docstring,
     "Patch-averaged pressure"): at radius x, the force on the annulus [x - L/2, x + L/2] over its area,
 
@@ -108,15 +112,24 @@ def patch_average(profile: ContactProfile, length_m: float) -> ContactProfile:
     a rational quadratic between them) and at the ends of the nominal contact (`patch_contact`),
     intervals longer than L/2 split evenly; its
     support is the input's widened by L/2 on each side (a window starting below r = 0 is cut there).
+
+    `rings_F_N` [N] at `rings_r_m`: line loads on circles (a contact far narrower than L, known by
+    its force alone), added to G as steps: each is the box F / (2 pi x L) on [rho - L/2, rho + L/2],
+    its force kept exactly. The box's jumps are sampled on both sides, 1e-6 L apart (a ring that
+    thin carries a negligible share of any flow).
     """
     L = float(length_m)
     if not (math.isfinite(L) and L > 0.0):
         raise ValueError(f"length_m: the patch length must be finite and > 0, got {length_m}")
+    rho, F = _rings(rings_r_m, rings_F_N)
     r, p = profile.r_m, profile.p_Pa
     f = p * r
     G = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(r))])
     a, b = contact_segments(profile)
     kinks = np.unique(np.concatenate([r - 0.5 * L, r + 0.5 * L, a - 0.5 * L, b + 0.5 * L]))
+    if rho.size:
+        jumps = np.concatenate([rho - 0.5 * L, rho + 0.5 * L])
+        kinks = np.unique(np.concatenate([kinks, jumps - 1e-6 * L, jumps + 1e-6 * L]))
     kinks = kinks[kinks > 0.0]
     n = np.maximum(1, np.ceil(np.diff(kinks) / (0.5 * L) - 1e-9).astype(int))
     start = np.repeat(kinks[:-1], n)
@@ -126,7 +139,21 @@ def patch_average(profile: ContactProfile, length_m: float) -> ContactProfile:
     a, b = np.maximum(x - 0.5 * L, 0.0), x + 0.5 * L
     pbar = (_cumulative(r, f, G, b) - _cumulative(r, f, G, a)) / (0.5 * (b * b - a * a))
     pbar[pbar <= 1e-12 * max(float(p.max()), 0.0)] = 0.0     # round-off off the support
+    if rho.size:
+        inside = (rho[None, :] >= a[:, None]) & (rho[None, :] <= b[:, None])
+        pbar = pbar + (inside @ F) / (math.pi * (b * b - a * a))
     return ContactProfile(x, pbar)
+
+
+def _rings(r_m: np.ndarray | None, F_N: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Checked ring loads: radii > 0 and forces >= 0, one force per radius."""
+    rho = np.zeros(0) if r_m is None else np.asarray(r_m, dtype=float).reshape(-1)
+    F = np.zeros(0) if F_N is None else np.asarray(F_N, dtype=float).reshape(-1)
+    if rho.size != F.size:
+        raise ValueError(f"rings_F_N: one force per ring radius, got {F.size} for {rho.size}")
+    if not (np.all(np.isfinite(rho)) and np.all(rho > 0) and np.all(np.isfinite(F)) and np.all(F >= 0)):
+        raise ValueError("rings_r_m, rings_F_N: ring loads need radii > 0 and finite forces >= 0")
+    return rho, F
 
 
 def contact_segments(profile: ContactProfile) -> tuple[np.ndarray, np.ndarray]:

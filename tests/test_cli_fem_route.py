@@ -20,7 +20,7 @@ from validation.bridge.pipeline import surface_uc_table
 def test_cli_lifetime_equals_the_python_call(capsys, tmp_path):
     out = tmp_path / "fem"
     code, text, err = _run(capsys, "lifetime", "--route", "fem", "--cup", "A", "--contact", "frictionless",
-                           "--surface", "pmma-1.89", "--force", "10", "--out", out)
+                           "--surface", "pmma-1.89", "--force", "10", "--fidelity", "coarse", "--out", out)
     assert code == 0, err
     head, columns, row = text.splitlines()
     assert columns.split() == ["F1_N", "lifetime_s", "reason", "u_end_mm", "p_b_end_kPa", "seal_r_mm"]
@@ -83,10 +83,10 @@ def test_fem_options_are_refused_on_other_routes(capsys, option, value):
 def test_pressing_to_the_u_that_r_start_reached_seals_the_same_cup(capsys):
     """--press-u-mm at the plate displacement the default press (to r_start) ended at gives the same
     sealed state and lifetime: two ways to press, one cup (to the FEM's Newton tolerance)."""
-    code, text, err = _run(capsys, "lifetime", "--route", "fem", "--force", "10", "--json")
+    code, text, err = _run(capsys, "lifetime", "--route", "fem", "--force", "10", "--fidelity", "coarse", "--json")
     assert code == 0, err
     by_r, = json.loads(text)
-    code, text, err = _run(capsys, "lifetime", "--route", "fem", "--force", "10", "--json",
+    code, text, err = _run(capsys, "lifetime", "--route", "fem", "--force", "10", "--fidelity", "coarse", "--json",
                            "--press-u-mm", repr(by_r["u_sealed_mm"]))
     assert code == 0, err
     by_u, = json.loads(text)

@@ -17,7 +17,7 @@ from validation.cli import COMMANDS, build_parser, main
 #: can tell a given value from none): the value the stated default must name
 RESOLVED = {
     ("example", "--fidelity"): "medium",       # fem.mesh.DEFAULT_FIDELITY
-    ("stiffness", "--fidelity"): "medium", ("lifetime", "--fidelity"): "coarse",      # validation.commands._fem_route.DEFAULT_FIDELITY
+    ("stiffness", "--fidelity"): "medium", ("lifetime", "--fidelity"): "medium",      # validation.commands._fem_route.DEFAULT_FIDELITY
     ("lifetime", "--cup"): "A", ("example", "--cup"): "A", ("stiffness", "--cup"): "A", ("suction", "--cup"): "A",
     ("lifetime", "--uc-table"): None, ("example", "--surface"): "pmma-1.89",
     ("lifetime", "--cup-laws"): "cone", ("example", "--cup-laws"): "cone",     # "cone for the paper route, ..."

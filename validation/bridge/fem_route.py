@@ -11,13 +11,14 @@ is F1, then the states holding F1 with N rising), which ends at the detachment: 
 largest N held at F1: reason "fold") or the seal opening at the rim (reason "reached_r1"). A
 branch that ends without a detachment is a failure (`FemRouteError`), never a lifetime.
 
-At each branch state the leak Q [1/s] flows through that state's own contact-pressure profile at
-its p_b, as the coupled route reads its table (`reduced.coupled`): the solid pressure is the
-FEM's less the interface gas's rise over p_b across the zone [r_k, r_cut] (the model's
-`interface`), averaged over the u_c table's patch length, its rings' gaps u_c(p / E) in series
-(`reduced.profile_leak`). The lifetime is t = int_{N0}^{N_max} dN / Q by the trapezoid in N over
-the branch states: N rises monotonically along the branch whereas u turns where the branch does
-(the walk switches to N as its parameter there), and 1/Q is smooth in N except where the
+At each branch state the leak Q [1/s] flows through that state's own contact traction at its
+p_b, as the coupled route reads its table (`reduced.coupled`): the solid pressure is the FEM's
+less the interface gas's rise over p_b across the zone [r_k, r_cut] (the model's `interface`),
+averaged over the u_c table's patch length, a node touching alone entering by its reaction
+(`validation.bridge.fem_leak`), its rings' gaps u_c(p / E) in series (`reduced.profile_leak`).
+The lifetime is t = int_{N0}^{N_max} dN / Q by the trapezoid in N over the branch states: N rises
+monotonically along the branch whereas u turns where the branch does (the walk switches to N as
+its parameter there), and 1/Q is smooth in N except where the
 seal's contact narrows to its last ring and Q falls several times within a plate step: there
 states are added midway (`refine_branch`). The change when the plate step is halved measures the
 quadrature and branch error (benchmarks/bench_fem_route.py, docs/lifetime.md).
@@ -44,6 +45,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from validation.bridge.fem_leak import state_leak_rate
+
 if TYPE_CHECKING:
     from fem.gas_path import CupWithGas, GasState
     from fem.interface import ContactLaw
@@ -67,10 +70,12 @@ def _law() -> ContactLaw:
 @dataclass(frozen=True)
 class FemCup:
     """The FEM cup of the route: the design (a `fem.geometry.CupGeometry` or a preset name), the
-    wall's neo-Hookean material (E [Pa], nu), the contact law with the plane and the mesh level."""
+    wall's neo-Hookean material (E [Pa], nu), the contact law with the plane and the mesh level
+    (default medium: the coarsest whose lifetimes are within 1 % of the next finer level's,
+    benchmarks/fem_route_mesh_study.md)."""
 
     geometry: Any = "A"
-    fidelity: str = "coarse"
+    fidelity: str = "medium"
     E_Pa: float = 4e6
     nu: float = 0.49
     contact: Any = field(default_factory=_law)
@@ -110,42 +115,6 @@ class Press:
             raise ValueError(f"press: expected 'r_start_m', 'u_m' or 'force_N', got {self.kind!r}")
         if not (isinstance(self.value, (int, float)) and math.isfinite(self.value) and self.value > 0):
             raise ValueError(f"press: {self.kind} must be a number > 0, got {self.value!r}")
-
-
-def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: str = "annulus") -> float:
-    """Molecules per second leaking into the cavity at one sealed FEM state (module docstring), or
-    for water the volume inflow [m^3/s] of eq (24): the solid pressure of
-    `reduced.table_surface.solid_profile` on the state's own profile, at the state's p_b, u_c read
-    at p / E_Pa (the wall's modulus). inf where no solid contact is left (the fluid holds the
-    seal open)."""
-    from reduced.profile_leak import (ContactProfile, patch_average, profile_leak_rate, profile_liquid_rate,
-                                      ring_gaps)
-    from reduced.stiffness_curve import profiles_from_lists
-
-    prof, = profiles_from_lists([1e3 * state.profile.r_m], [1e-3 * state.profile.p_Pa])
-    if prof is None:
-        return math.inf
-    dp = max(state.dp_Pa, 0.0)
-    r, p = prof.r_m, prof.p_Pa
-    rk, rcut = state.seal_r_m, state.cut_r_m
-    tol = 1e-9 * rcut
-    zone = (r >= rk - tol) & (r <= rcut + tol)
-    rise = {"p_b": 0.0, "p_a": 1.0}.get(model.interface)
-    if rise is None:
-        rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
-    solid = ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
-    patch = getattr(model.u_c, "patch_length_m", None)
-    if patch:
-        solid = patch_average(solid, patch)
-    gaps = ring_gaps(solid, model.u_c, E_Pa)
-    if np.all(np.isinf(gaps)):
-        return math.inf
-    if model.fluid == "water":          # a liquid under tension keeps p_b < 0
-        return profile_liquid_rate(model.liquid_viscosity_Pa_s, model.p_a_Pa, min(state.p_b_Pa, model.p_a_Pa),
-                                   solid.r_m, gaps, radial)
-    p_b = min(max(state.p_b_Pa, 0.0), model.p_a_Pa)
-    return profile_leak_rate(model.gas, model.p_a_Pa, p_b, solid.r_m, gaps, radial)
-
 
 
 @dataclass(frozen=True, eq=False)
@@ -255,7 +224,8 @@ class FemRoute:
         if branch.detachment is None:
             raise FemRouteError(f"F1 = {force_N:g} N: the branch ended without a detachment "
                                 f"({branch.reason}) after {len(branch.states)} states")
-        leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, options["radial"])  # noqa: E731
+        leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, options["radial"],  # noqa: E731
+                                         plane=sealed.cup.cup.plane)
         # a fold lets go with the most gas held (`fem.branch_end.up_to_most_gas`)
         kept = up_to_most_gas(branch.states) if branch.reason == "fold" else list(branch.states)
         states, q, added = refine_branch(sealed.cup, kept, [leak(s) for s in kept],

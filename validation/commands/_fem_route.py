@@ -13,8 +13,9 @@ from typing import Any
 from validation.commands._reduced_options import build_uc, check_run_options, refuse_other_options
 from validation.study_schema import field_of
 
-#: mesh level of the fem route when --fidelity is not given (one lifetime 4-6 s of CPU coarse, ~20 s medium)
-DEFAULT_FIDELITY = "coarse"
+#: mesh level of the fem route when --fidelity is not given: the coarsest whose lifetimes are within
+#: 1 % of the next finer level's (benchmarks/fem_route_mesh_study.md; one lifetime ~11 s of CPU, coarse ~4 s)
+DEFAULT_FIDELITY = "medium"
 
 #: lifetime options the fem route replaces or does not model: (option, attribute, default)
 _NOT_HERE = (("--stiffness", "stiffness", "appendix-a"), ("--suction-table", "suction_table", None),

@@ -50,9 +50,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     fem = p.add_argument_group("fem route (--route fem)")
     add_contact_arguments(fem, "the paper's soap-cleaned PMMA is not frictionless, so give the law you mean")
     add_flags(fem, FEM_KEYS, helps={
-        "stiffness.fidelity": "for --route fem: mesh level of the cup (default coarse with --route fem: one "
-                              "lifetime in ~15 s on one core; medium is ~4x slower, see "
-                              "benchmarks/bench_fem_route.py)"})
+        "stiffness.fidelity": "for --route fem: mesh level of the cup (default medium with --route fem: "
+                              "lifetimes within 1 %% of the fine level's, ~11 s of CPU each; coarse is ~3x "
+                              "faster and up to 5 %% off, see benchmarks/fem_route_mesh_study.md)"})
     add_flags(p, ("loads.F1_N",), helps={"loads.F1_N": "pull force(s) F1 in N, > 0 (default: 10)"},
               **{"--force": {"metavar": "F1_N"}})
     p.add_argument("--stiffness", default="appendix-a", metavar="appendix-a|FILE.csv",
