@@ -135,7 +135,10 @@ class Walk:
 
     def __init__(self, cup: CupWithGas, F1_N: float):
         self.cup, self.F1 = cup, F1_N
-        self.options = replace(cup.options, initial_step=1.0, max_step=1.0)
+        # a move's t is a fraction of the move, not a length: the damped motion across an
+        # instability (`fem.newton.relax_step`) moves a node at most as far per sub-step as on the
+        # pressing path (0.05 of its range ~ h1), not max_step = 1 of the move "in metres"
+        self.options = replace(cup.options, initial_step=1.0, max_step=1.0, relax_move_m=0.05 * cup.h1_m)
         # a trial of the F1 root: cut at most 4 times, a trial that does not converge in 1/16
         # of its move is given up (the walk shortens its step) rather than ground through
         self.trial_options = replace(self.options, min_step=max(cup.options.min_step, 1.0 / 16.0),
