@@ -207,16 +207,18 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
     Once a sub-step with c <= _C_SETTLED moves less than _SETTLED bound, the undamped step from
     its state ends the motion, if it moves no node more than bound. Where the motion stalls (the
     sub-steps that converge move less than _SETTLED bound and every less damped one fails, _STALLS
-    times: c would only ratchet up to _C_MAX at hundreds of Newton iterations per sub-step), the
-    step fails at once and the caller shortens its step. As bound -> 0 the sequence
-    tends to the damped motion, independent of the load step. Returns (u, r_int, contact state,
-    Newton iterations); raises StepFailure (with the `iterations` spent)."""
+    times: c would only ratchet up to _C_MAX at hundreds of Newton iterations per sub-step) on a
+    path with its own move bound (`SolverOptions.relax_move_m`: the held branch's moves, which
+    have their own way on), the step fails at once and the caller shortens its move; a path whose
+    load is its length (pressing) keeps the damping rising, which there has ended the motion. As
+    bound -> 0 the sequence tends to the damped motion, independent of the load step. Returns
+    (u, r_int, contact state, Newton iterations); raises StepFailure (with the `iterations` spent)."""
     metric = np.abs(mech.evaluate(u_start)[2].diagonal())
     sub_opts = replace(opts, max_iterations=min(opts.max_iterations, _SUB_ITERATIONS))
     dofs, values = dirichlet(t)
     u, s, c, its, history = u_start, state, _C_START, 0, []
     settled, settle = False, _SETTLED * bound
-    still, stalls = False, 0        # the last accepted sub-step moved nothing; failures since
+    still, stalls, stalled = False, 0, False    # the last sub-step taken moved nothing; failures since
     for _ in range(int(_RELAX_ATTEMPTS * max(1.0, 0.05 / opts.max_step))):   # sub-steps ~ 1 / bound
         body = mech if settled else _Damped(mech, u, c * metric)
         allowed = bound + np.max(np.abs(values - u[dofs]), initial=0.0)
@@ -232,7 +234,8 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
                 settled, settle = False, 0.1 * settle
                 continue
             stalls += still
-            if c >= _C_MAX or stalls >= _STALLS:
+            stalled = bool(opts.relax_move_m) and stalls >= _STALLS
+            if c >= _C_MAX or stalled:
                 break
             c *= 4.0
             continue
@@ -245,7 +248,7 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
         settled = move < settle and c <= _C_SETTLED
         if move < 0.25 * bound:
             c *= 0.25
-    why = "stalled (the sub-steps that converge no longer move)" if stalls >= _STALLS else "did not settle"
+    why = "stalled (the sub-steps that converge no longer move)" if stalled else "did not settle"
     fail = StepFailure(f"the damped motion across the instability {why} ({its} Newton "
                        "iterations); likely cause: a friction bound falling with the slip faster "
                        "than the damping can hold", history, indefinite=True)

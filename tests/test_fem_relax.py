@@ -25,7 +25,7 @@ def _problem():
     return mech, (lambda t: (np.array([3]), np.array([0.0]))), plane, state
 
 
-def _relax(monkeypatch, sub_step):
+def _relax(monkeypatch, sub_step, **options):
     """relax_step with `sub_step(c or None, u) -> (u1, iterations)` in place of the Newton solve
     (c: the damping factor of the sub-step, None: undamped); raise StepFailure to fail."""
     calls = []
@@ -38,7 +38,7 @@ def _relax(monkeypatch, sub_step):
     monkeypatch.setattr(newton, "newton_step", newton_step)
     mech, dirichlet, plane, state = _problem()
     out = newton.relax_step(mech, dirichlet, lambda t: np.zeros(N_DOFS), plane, state, np.zeros(N_DOFS),
-                            1.0, SolverOptions(max_step=1.0), None, None, BOUND)
+                            1.0, SolverOptions(max_step=1.0, **options), None, None, BOUND)
     return out, calls
 
 
@@ -62,15 +62,20 @@ def test_a_motion_that_comes_to_rest_ends_on_the_undamped_step(monkeypatch):
 
 def test_a_stalled_motion_gives_up_early(monkeypatch):
     """Damped sub-steps converge only where c is so large that they do not move, and every less
-    damped one fails: the motion has stalled. It gives up after _STALLS such failures, not after
-    c has ratcheted up to _C_MAX at 40 iterations per failure (thousands of iterations)."""
+    damped one fails: the motion has stalled. On a path with its own move bound (the held
+    branch's) it gives up after _STALLS such failures, not after c has ratcheted up to _C_MAX at
+    40 iterations per failure (thousands of iterations)."""
     def sub_step(c, u):
         if c is not None and c >= 16.0:
             return u.copy(), 1          # converges, moves nothing
         _fail()
     with pytest.raises(StepFailure, match="stalled") as err:
-        _relax(monkeypatch, sub_step)
+        _relax(monkeypatch, sub_step, relax_move_m=BOUND)
     assert err.value.iterations <= (2 + newton._STALLS) * 40 + newton._STALLS
+    # a path without its own move bound (pressing) keeps raising the damping (it has no other way)
+    with pytest.raises(StepFailure, match="did not settle") as err:
+        _relax(monkeypatch, sub_step)
+    assert err.value.iterations > 10 * (2 + newton._STALLS) * 40
 
 
 def test_failures_while_the_motion_moves_do_not_stall_it(monkeypatch):
