@@ -30,7 +30,7 @@ in-process (the command's own work: pressing, sealing, the largest holdable forc
 the leak), its CPU time per part as above plus
 
   cavity     the cavity volume, its gradient and Hessian (`fem.cavity.CavitySurface`);
-  sens       the branch's sensitivities dF1/dN, dF1/du (`fem.gas_branch._sensitivities`: one
+  sens       the branch's sensitivities dF1/dN, dF1/du (`fem.branch_walk.sensitivities`: one
              factorization of the held plate's free block, `fem.free_block`, outside the
              solver's factorizations);
   setup      building a linear solver (`fem.condensation.make_solver`'s orderings and maps);
@@ -71,7 +71,7 @@ import fem.factorization  # noqa: E402
 import fem.linsolve  # noqa: E402
 import fem.cavity  # noqa: E402
 import fem.condensation  # noqa: E402
-import fem.gas_branch  # noqa: E402
+import fem.branch_walk  # noqa: E402
 from fem.cup import compress_cup  # noqa: E402
 from fem.forms import Mechanics  # noqa: E402
 from fem.geometry import cup_geometry  # noqa: E402
@@ -133,7 +133,7 @@ def _instrument() -> None:
     fem.cup._measure = w("post", fem.cup._measure)
     fem.cup.check_state = w("post", fem.cup.check_state)
     fem.cavity.CavitySurface._terms = w("cavity", fem.cavity.CavitySurface._terms)
-    fem.gas_branch._sensitivities = w("sens", fem.gas_branch._sensitivities)
+    fem.branch_walk.sensitivities = w("sens", fem.branch_walk.sensitivities)
     if hasattr(fem.condensation, "_new_solver"):     # (a solver per path, uncounted, before it)
         fem.condensation._new_solver = w("setup", fem.condensation._new_solver)
 

@@ -189,6 +189,7 @@ _RELAX_ATTEMPTS = 400               # damped sub-steps (accepted or redone) of o
 _C_START, _C_SETTLED, _C_MAX = 1.0, 1e-3, 1e8
 SLIP = 0.25                         # the largest slip of a held node in a (sub-)step / the bound
 _SETTLED = 1e-3                     # a damped sub-step moving less than this of the bound: try undamped
+_STALLS = 3                         # failed sub-steps after one that moved < _SETTLED bound: stalled
 
 
 def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, bound):
@@ -204,14 +205,20 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
     fails, moves a node more than `bound` [m] beyond the prescribed increment or slips a held node
     by more than SLIP bound, and falls fourfold after a sub-step that moves less than bound / 4.
     Once a sub-step with c <= _C_SETTLED moves less than _SETTLED bound, the undamped step from
-    its state ends the motion, if it moves no node more than bound. As bound -> 0 the sequence
-    tends to the damped motion, independent of the load step. Returns (u, r_int, contact state,
-    Newton iterations); raises StepFailure (with the `iterations` spent)."""
+    its state ends the motion, if it moves no node more than bound. Where the motion stalls (the
+    sub-steps that converge move less than _SETTLED bound and every less damped one fails, _STALLS
+    times: c would only ratchet up to _C_MAX at hundreds of Newton iterations per sub-step) on a
+    path with its own move bound (`SolverOptions.relax_move_m`: the held branch's moves, which
+    have their own way on), the step fails at once and the caller shortens its move; a path whose
+    load is its length (pressing) keeps the damping rising, which there has ended the motion. As
+    bound -> 0 the sequence tends to the damped motion, independent of the load step. Returns
+    (u, r_int, contact state, Newton iterations); raises StepFailure (with the `iterations` spent)."""
     metric = np.abs(mech.evaluate(u_start)[2].diagonal())
     sub_opts = replace(opts, max_iterations=min(opts.max_iterations, _SUB_ITERATIONS))
     dofs, values = dirichlet(t)
     u, s, c, its, history = u_start, state, _C_START, 0, []
     settled, settle = False, _SETTLED * bound
+    still, stalls, stalled = False, 0, False    # the last sub-step taken moved nothing; failures since
     for _ in range(int(_RELAX_ATTEMPTS * max(1.0, 0.05 / opts.max_step))):   # sub-steps ~ 1 / bound
         body = mech if settled else _Damped(mech, u, c * metric)
         allowed = bound + np.max(np.abs(values - u[dofs]), initial=0.0)
@@ -225,19 +232,24 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
             its, history = its + len(fail.history), fail.history or history
             if settled:         # the undamped step fails: damped again, and settle closer first
                 settled, settle = False, 0.1 * settle
-            elif c >= _C_MAX:
+                continue
+            stalls += still
+            stalled = bool(opts.relax_move_m) and stalls >= _STALLS
+            if c >= _C_MAX or stalled:
                 break
-            else:
-                c *= 4.0
+            c *= 4.0
             continue
         if body is mech:
             return u1, r1, s1, its
         move = largest_move(u1, u)
+        still = move < _SETTLED * bound
+        stalls = stalls if still else 0
         s, u = plane.law.commit(plane, s1, u1), u1
         settled = move < settle and c <= _C_SETTLED
         if move < 0.25 * bound:
             c *= 0.25
-    fail = StepFailure(f"the damped motion across the instability did not settle ({its} Newton "
+    why = "stalled (the sub-steps that converge no longer move)" if stalled else "did not settle"
+    fail = StepFailure(f"the damped motion across the instability {why} ({its} Newton "
                        "iterations); likely cause: a friction bound falling with the slip faster "
                        "than the damping can hold", history, indefinite=True)
     fail.iterations = its

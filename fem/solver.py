@@ -76,6 +76,8 @@ class SolverOptions:
     easy_iterations: int = 6
     jump_tol: float = 0.005     # energy defect of an unstable step / stored energy that halves it
     jump_min_step: float = 0.002  # ... down to this step (fraction of t_max): a real snap stays
+    relax_move_m: float = 0.0   # the largest node move of a relaxed sub-step [m] (`fem.newton.relax_step`;
+    #                             0: max_step t_max, for a path whose t is a length)
 
     def __post_init__(self) -> None:
         for name in ("rtol", "etol", "initial_step", "max_step", "min_step", "jump_tol",
@@ -177,7 +179,7 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
             iterations += len(fail.history)
             try:
                 u1, r1, state1, its = relax_step(m1, dirichlet, f_ext, plane, state, u0, t1,
-                                                 options, solver, policy, bound)
+                                                 options, solver, policy, options.relax_move_m or bound)
                 fail, indefinite = None, True
             except StepFailure as again:
                 fail = again

@@ -1,0 +1,395 @@
+"""The state-to-state machinery of the held branch (`fem.gas_branch`): a trial state reached
+from the last state of the branch with the plate and N on a line, the root of F1(u, N) = F1 in N
+(or in u) by Newton on the exact sensitivities, regula falsi on the bracket its trials found,
+and the jump of the pull where that bracket closes without a root; the plate raised at N0 to F1;
+the fold and the seal's opening located between two states; the branch measured.
+
+The sensitivities dF1/dN and dF1/du are the linear response of a converged state at the held
+plate (`held_plate_system`, shared with the water cavity's walk, `fem.water_branch`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from .gas_path import CupWithGas, GasState
+from .solver import ConvergenceError, SolverStats, StepResult
+from .cup import _joined
+from .free_block import solve_free_block
+from .trapped_gas import K_B, GasMechanics, follow_gas_path
+
+__all__ = ["Branch", "Walk", "Trial", "Jump", "STICKING_STEPS", "held_plate_system", "sensitivities",
+           "seal_open", "u_leads"]
+
+STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
+
+
+@dataclass(frozen=True, eq=False)
+class Branch:
+    """The states holding the pull F1_N, the pulled state first (plate raised at N0 to F1), then
+    along the plate position; `dN_du` [1/m] per state; the detachment state and its reason
+    (module docstring); the cost of the whole branch."""
+
+    F1_N: float
+    states: tuple[GasState, ...]
+    dN_du: np.ndarray
+    detachment: GasState | None       # the fold (largest N) or the state where the seal opened
+    reason: str                       # "fold", "seal opened", "u_min", "not held", "stopped: why"
+    stats: SolverStats
+    snaps: int = 0                    # jumps of the pull crossed (`fem.branch_jumps`)
+
+    @property
+    def N_max(self) -> float:
+        """The largest N held at F1 (that of the detachment state) [molecules]."""
+        return self.detachment.N if self.detachment is not None else float("nan")
+
+    def column(self, name: str) -> np.ndarray:
+        """One field of every state as an array, e.g. column("N")."""
+        return np.array([getattr(s, name) for s in self.states])
+
+
+def held_plate_system(cup, state: StepResult) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix, np.ndarray]:
+    """The linear response at the held plate, shared by the gas and the water cavity: the plate's
+    z dofs, the free dofs (plate and held contact dofs fixed), the rows P that let Coulomb's sliding
+    nodes slide (r + mu s lambda = 0) and the plate's unit move d/du (u_z = -u on the plate)."""
+    u = state.u
+    plane, top = cup.cup.plane, cup.cup.top
+    plate_z = 2 * top + 1
+    held, _ = plane.constraints(state.contact)
+    free = np.ones(u.size, bool)
+    free[np.concatenate([2 * top, plate_z, held])] = False
+    slide = state.contact.active & (state.contact.slip != 0)
+    P = sp.identity(u.size, format="csr")
+    if slide.any():
+        nodes = plane.nodes[slide]
+        P = P + sp.csr_matrix((plane.law.mu * state.contact.slip[slide].astype(float),
+                               (2 * nodes, 2 * nodes + 1)), shape=P.shape)
+    down = np.zeros(u.size)
+    down[plate_z] = -1.0
+    return plate_z, free, P, down
+
+
+def sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, float]:
+    """(dF1/dN, dF1/du) of the converged state `state` holding N molecules
+    (`fem.gas_branch.pull_sensitivities`)."""
+    mech = GasMechanics(cup.cup.mech, cup.cavity, cup._gas(N))
+    u = state.u
+    _, r, K = mech.evaluate(u)
+    c, g = K.rank_one
+    plate_z, free, P, down = held_plate_system(cup, state)
+    Ks = K.plain()
+    b = -(K_B * cup.T_K / mech.volume_m3(u)) * g          # dr/dN at fixed u
+    h = (P @ g)[free]
+    rhs = np.stack([-(P @ b)[free], -(P @ (Ks @ down))[free] - c * h * (g @ down), h], axis=1)
+    y = solve_free_block(Ks, P, free, rhs, cup.cup.mech.kin)
+    gf = g[free]
+    y[:, :2] -= np.outer(y[:, 2], c * (gf @ y[:, :2]) / (1.0 + c * gf @ y[:, 2]))
+    x_N, x_u = np.zeros(u.size), down.copy()
+    x_N[free], x_u[free] = y[:, 0], y[:, 1]
+    return float(np.sum((K @ x_N + b)[plate_z])), float(np.sum((K @ x_u)[plate_z]))
+
+
+def u_leads(tangent) -> bool:
+    """Whether the plate position leads the branch's next move (N the unknown) rather than N. The
+    first state's tangent is diagonal by construction (|t_u| = |t_N|): the tie goes to u, not to
+    the last bit of round-off, which would pick one of two frictional paths."""
+    return abs(tangent[0]) >= (1.0 - 1e-9) * abs(tangent[1])
+
+
+def seal_open(cup: CupWithGas, s: "Trial") -> bool:
+    """Whether no node of the cavity chain is on the plane (the cavity is open to the outside)."""
+    x = cup.mesh.doflocs + np.stack([s.step.u[0::2], s.step.u[1::2]])
+    return not np.any(x[1, cup.cavity.nodes] <= cup.cavity.tolerance_m)
+
+
+class _Crossed(ConvergenceError):
+    """Stops a trial's path at the first instability it crosses (`Walk.solve`)."""
+
+
+class Jump(RuntimeError):
+    """The pull jumps across F1 between two states close together in N or u (module docstring)."""
+
+    def __init__(self, before: "Trial", after: "Trial", message: str, instability: bool = False):
+        super().__init__(message)
+        self.before, self.after, self.instability = before, after, instability
+
+
+@dataclass(frozen=True, eq=False)
+class Trial:
+    """A converged sealed state before its measurement: plate position, N, pull, solver state."""
+
+    u_m: float
+    N: float
+    F1_N: float
+    step: StepResult
+    crossed: "Trial | None" = None   # the state after the first instability its path crossed
+
+
+class Walk:
+    """The state-to-state machinery of `equilibrium_branch`: solves, the F1 root, the costs."""
+
+    def __init__(self, cup: CupWithGas, F1_N: float):
+        self.cup, self.F1 = cup, F1_N
+        # a move's t is a fraction of the move, not a length: the damped motion across an
+        # instability (`fem.newton.relax_step`) moves a node at most as far per sub-step as on the
+        # pressing path (0.05 of its range ~ h1), not max_step = 1 of the move "in metres"
+        self.options = replace(cup.options, initial_step=1.0, max_step=1.0, relax_move_m=0.05 * cup.h1_m)
+        # a trial of the F1 root: cut at most 4 times, a trial that does not converge in 1/16
+        # of its move is given up (the walk shortens its step) rather than ground through
+        self.trial_options = replace(self.options, min_step=max(cup.options.min_step, 1.0 / 16.0),
+                                     max_iterations=min(cup.options.max_iterations, 40))
+        if cup.cup.plane.law.name == "sticking":
+            # its slips land where the load step puts them: every move in STICKING_STEPS steps
+            self.options = replace(self.options, initial_step=1.0 / STICKING_STEPS,
+                                   max_step=1.0 / STICKING_STEPS)
+            self.trial_options = replace(self.trial_options, initial_step=1.0 / STICKING_STEPS,
+                                         max_step=1.0 / STICKING_STEPS, min_step=1.0 / (16 * STICKING_STEPS))
+        # a move of `fem.branch_jumps` (the leak, the plate's response): given up after a step of
+        # 1/16 of its length fails in 100 iterations (the move is then shortened)
+        self.move_options = replace(self.options, min_step=max(self.options.min_step, 1.0 / 16.0),
+                                    max_iterations=min(self.options.max_iterations, 100))
+        self.stats: SolverStats | None = None
+        self.snaps = 0
+        # an incremental friction law crosses instabilities by damped motion: a trial whose path
+        # crosses one has jumped (the state after it is the jump's far side, `_root`)
+        self.relaxes = bool(getattr(cup.cup.plane.law, "relaxes", False))
+        self.stop_at_crossing = False
+        self.staircase = cup.cup.plane.law.name == "sticking"
+        self.slopes: dict[Trial, tuple[float, float]] = {}     # by identity
+        rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
+        # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
+        self.tolerance = cup.options.rtol * cup.p_a_Pa * math.pi * rim**2
+
+    def derivatives(self, s: Trial) -> tuple[float, float]:
+        if s not in self.slopes:
+            self.slopes[s] = sensitivities(self.cup, s.N, s.step)
+        return self.slopes[s]
+
+    def slope(self, s: Trial) -> float:
+        """dN/du along the branch at s [1/m]."""
+        dF1_dN, dF1_du = self.derivatives(s)
+        return -dF1_du / dF1_dN
+
+    def tangent(self, s: Trial, du_m: float, N_ref: float, previous) -> tuple[float, float]:
+        """The branch's unit tangent at s in (u / du_m, N / N_ref), dF1 = 0: along the previous
+        tangent (continuity), or with N rising if there is none."""
+        dF1_dN, dF1_du = self.derivatives(s)
+        t = np.array([dF1_dN * N_ref, -dF1_du * du_m])
+        t /= np.linalg.norm(t)
+        if (previous is None and t[1] < 0.0) or (previous is not None and t @ previous < 0.0):
+            t = -t
+        return float(t[0]), float(t[1])
+
+    def solve(self, start: Trial, u_m: float, N: float, options=None) -> Trial:
+        """The state at (u_m, N), reached from `start` with the plate and N on a line; its
+        `crossed` is the state after the first instability the path crossed by damped motion
+        (a law that `relaxes`), where the path stops while `stop_at_crossing` is set (`_root`)."""
+        stop_at_crossing = self.stop_at_crossing
+        u0, N0 = start.u_m, start.N
+        mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
+                            schedule=lambda t: N0 + t * (N - N0), relaxes=True)
+        top = self.cup.cup.top
+        dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
+
+        def plate(t):
+            return dofs, np.concatenate([zeros, np.full(top.size, -(u0 + t * (u_m - u0)))])
+        last: list[StepResult] = []
+
+        def on_step(step: StepResult) -> None:
+            last.append(step)
+            if stop_at_crossing and self.relaxes and step.unstable:
+                raise _Crossed("the path crossed an instability")
+        try:
+            stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
+                                    options=options or self.options, on_step=on_step)
+        except _Crossed as stop:
+            stats = stop.stats
+        except ConvergenceError as err:         # the cost of a failed trial counts too
+            self._count(err.stats)
+            raise
+        self._count(stats)
+
+        def trial(step: StepResult, f: float) -> Trial:
+            at_end = f >= 1.0
+            return Trial(float(u_m if at_end else u0 + f * (u_m - u0)),
+                          float(N if at_end else N0 + f * (N - N0)),
+                          float(np.sum(step.r_int[2 * top + 1])), step)
+        crossed = next((st for st in last if st.unstable), None) if self.relaxes else None
+        end = trial(last[-1], last[-1].t)
+        if crossed is not None:
+            return replace(end, crossed=end if crossed is last[-1] else trial(crossed, crossed.t))
+        return end
+
+    def _count(self, stats: SolverStats | None) -> None:
+        if stats is not None:
+            self.stats = stats if self.stats is None else _joined(self.stats, stats)
+
+    def hold(self, prev: Trial, u_m: float, N_guess: float) -> Trial:
+        """The state at plate position u_m whose pull is F1 (N by Newton on F1(N), module
+        docstring), reached from prev. Raises `Jump` where F1(N) jumps across F1."""
+        return self._root(prev, u_m, N_guess, 0)
+
+    def hold_u(self, prev: Trial, u_guess: float, N: float) -> Trial:
+        """The state at N whose pull is F1 (the plate position by Newton on F1(u)), reached
+        from prev. Raises `Jump` where F1(u) jumps across F1."""
+        return self._root(prev, u_guess, N, 1)
+
+    def _root(self, prev: Trial, u_m: float, N: float, k: int) -> Trial:
+        """F1(x) = F1 for x = N at the plate u_m (k = 0) or x = u at N (k = 1), every trial
+        reached from prev: Newton with the exact dF1/dx, the secant where it does not halve the
+        mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`)."""
+        name = "N" if k == 0 else "the plate position"
+
+        def at(x):
+            self.stop_at_crossing = True
+            try:
+                s = self.solve(prev, u_m, x, self.trial_options) if k == 0 else \
+                    self.solve(prev, x, N, self.trial_options)
+            finally:
+                self.stop_at_crossing = False
+            if s.crossed is not None:       # the cup meets an instability on the way: it jumps
+                raise Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
+                            f"crossed on the way to {name} {x:.6g}", instability=True)
+            return s
+        x0, x_prev = (N, prev.N) if k == 0 else (u_m, prev.u_m)
+        s = at(x0)
+        tried: list[tuple[float, float, Trial]] = [(x0, s.F1_N - self.F1, s)]
+        for _ in range(12):
+            miss = s.F1_N - self.F1
+            if abs(miss) <= self.tolerance:
+                return s
+            x_new = tried[-1][0] - miss / self.derivatives(s)[k]
+            if len(tried) >= 2 and abs(miss) > 0.1 * abs(tried[-2][1]):   # slow: secant
+                (xa, fa, _), (xb, fb, _) = tried[-2:]
+                if fb != fa:
+                    x_new = xb - fb * (xb - xa) / (fb - fa)
+            if k == 0 and not x_new > 0.0:
+                break
+            s = at(x_new)
+            tried.append((x_new, s.F1_N - self.F1, s))
+        return self._bracket(at, tried, x0 - x_prev, name)
+
+    def _bracket(self, at, tried, travel: float, name: str) -> Trial:
+        """The root of F1(x) = F1 on the closest bracket among the trials (Illinois regula
+        falsi, every third trial a bisection). Where the bracket closes to 1e-3 of the trial's
+        move from the previous state without a root, F1 jumps across F1 there (a slip of the
+        sticking law, a snap): `Jump` with the states on both sides. RuntimeError where the
+        trials found no bracket."""
+        pos = [t for t in tried if t[1] > 0.0]
+        neg = [t for t in tried if t[1] < 0.0]
+        x, f, s = tried[-1]
+        if not (pos and neg):
+            raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (pull off by "
+                               f"{f:.3g} N after {len(tried) - 1} corrections)")
+        a, b = min(((p, n) for p in pos for n in neg), key=lambda pn: abs(pn[0][0] - pn[1][0]))
+        xtol = 1e-3 * abs(travel) + 1e-12 * abs(x)
+        side = 0
+        for i in range(60):
+            (xa, fa, sa), (xb, fb, sb) = a, b
+            if abs(xa - xb) <= xtol:
+                before, after = (a, b) if (xb - xa) * travel > 0.0 else (b, a)
+                raise Jump(before[2], after[2], f"F1_N = {self.F1:g} N: the pull jumps from "
+                            f"{before[2].F1_N:.4g} to {after[2].F1_N:.4g} N at {name} {xa:.6g}")
+            x = 0.5 * (xa + xb) if i % 3 == 2 else xb - fb * (xb - xa) / (fb - fa)
+            s = at(x)
+            f = s.F1_N - self.F1
+            if abs(f) <= self.tolerance:
+                return s
+            if f > 0.0:
+                a = (x, f, s)
+                b = (xb, 0.5 * fb if side == 1 else fb, sb)
+                side = 1
+            else:
+                b = (x, f, s)
+                a = (xa, 0.5 * fa if side == -1 else fa, sa)
+                side = -1
+        raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (bracket not closed)")
+
+    def pull_to_force(self, sealed: Trial, du_m: float, u_min: float) -> Trial | None:
+        """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m
+        (Newton's with the exact dF1/du where it points up), each from the last state pulling
+        less than F1; a step that overshoots brackets the crossing, which regula falsi (Illinois)
+        closes. None if the plate reaches u_min or the seal opens first. The plate never moves
+        down: with friction a back-and-forth would enter the history."""
+        a, b = sealed, None
+        while b is None:
+            miss = a.F1_N - self.F1
+            if abs(miss) <= self.tolerance:
+                return a
+            dF1_du = self.derivatives(a)[1]
+            step = -miss / dF1_du if dF1_du < 0.0 else -du_m
+            u_new = a.u_m + float(np.clip(step, -du_m, -1e-6 * du_m))
+            if u_new < u_min:
+                return None
+            s = self.solve(a, u_new, a.N)
+            if seal_open(self.cup, s):          # the seal opened before the pull reached F1
+                return None
+            if s.F1_N - self.F1 > self.tolerance:
+                b = s
+            else:
+                a = s
+        fa, fb, side = a.F1_N - self.F1, b.F1_N - self.F1, 0
+        for _ in range(60):
+            u = b.u_m + (a.u_m - b.u_m) * fb / (fb - fa)
+            s = self.solve(a, u, a.N)
+            f = s.F1_N - self.F1
+            if abs(f) <= self.tolerance:
+                return s
+            if f < 0.0:
+                a, fa = s, f
+                fb *= 0.5 if side == -1 else 1.0
+                side = -1
+            else:
+                b, fb = s, f
+                fa *= 0.5 if side == 1 else 1.0
+                side = 1
+        raise RuntimeError(f"F1_N = {self.F1:g} N: the pull at fixed N0 not closed between "
+                           f"u = {b.u_m * 1e3:.6g} and {a.u_m * 1e3:.6g} mm")
+
+    def opening(self, closed: Trial, opened: Trial, tangent, halvings: int = 6) -> Trial:
+        """The last state with the seal closed between `closed` and `opened` (bisection on the
+        line between them, each trial from `closed`, to 2^-halvings of their distance)."""
+        for _ in range(halvings):
+            u, N = 0.5 * (closed.u_m + opened.u_m), 0.5 * (closed.N + opened.N)
+            try:
+                s = self.hold(closed, u, N) if u_leads(tangent) else \
+                    self.hold_u(closed, u, N)
+            except RuntimeError:
+                opened = Trial(u, N, math.nan, opened.step)
+                continue
+            if seal_open(self.cup, s):
+                opened = s
+            else:
+                closed = s
+        return closed
+
+    def fold(self, a: Trial, ka: float, b: Trial, kb: float) -> Trial:
+        """The state between a and b where dN/du = 0 on the branch (secant on dN/du)."""
+        s = b
+        for _ in range(8):
+            u = b.u_m + (a.u_m - b.u_m) * kb / (kb - ka)
+            try:
+                s = self.hold(a, u, a.N + ka * (u - a.u_m))
+            except RuntimeError:        # no state there (a jump): the last one found
+                return s
+            k = self.slope(s)
+            if abs(k) <= 1e-3 * max(abs(ka), abs(kb)) or abs(u - a.u_m) < 1e-9 * self.cup.h1_m:
+                return s
+            if (k > 0.0) == (kb > 0.0):
+                b, kb = s, k
+            else:
+                a, ka = s, k
+        return s
+
+    def result(self, detachment, reason, trials=(), slopes=()) -> Branch:
+        """The measured branch (`fem.gas_path.CupWithGas.measure`)."""
+        states = {id(t): self.cup.measure(t.step, GasMechanics(self.cup.cup.mech, self.cup.cavity,
+                                                               self.cup._gas(t.N)), t.u_m, "held")
+                  for t in trials}
+        return Branch(self.F1, tuple(states[id(t)] for t in trials), np.array(slopes),
+                      None if detachment is None else states[id(detachment)], reason, self.stats,
+                      self.snaps)
