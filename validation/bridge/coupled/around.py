@@ -69,7 +69,7 @@ def holed_subtable(table, built: np.ndarray):
     return SuctionTable(u_m=table.u_m, dp_Pa=table.dp_Pa, **cut, E_Pa=table.E_Pa,
                         profiles=tuple(tuple(p if built[i, j] else None for j, p in enumerate(row))
                                        for i, row in enumerate(table.profiles)),
-                        provenance=table.provenance)
+                        provenance=table.provenance, sealed=table.sealed | ~built)
 
 
 def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goal: SuctionGoal,
@@ -140,17 +140,18 @@ def _cavity(goal: SuctionGoal, table, memo: dict):
 
 def _path_points(goal: SuctionGoal, table, memo: dict) -> list[tuple[float, float]]:
     """Every (u, dp) the goal's paths visit on a complete table: the lifetimes' trajectories, the
-    start and the largest holdable force's end."""
+    start and the cup raised at its start content (the largest holdable force's path)."""
     cavity, u_start = _cavity(goal, table, memo)
-    points = [(u_start, cavity.start(u_start)[0])]
+    dp_start, N0 = cavity.start(u_start)
+    points = [(u_start, dp_start)]
     for F in goal.forces_N:
         try:
             r = cavity._lifetime(F, u_start)
         except ValueError:          # the coarse table fails where the lattice may not: no seed
             continue
         points += list(zip(r.u_m.tolist(), r.dp_Pa.tolist()))
-    largest = cavity._largest_force(u_start)
-    points.append((float(table.u_m[0]), cavity._dp_range(largest)[0]))
+    us, dps, _, _ = cavity._raised_at(N0, u_start)
+    points += list(zip(us.tolist(), dps.tolist()))
     return points
 
 
