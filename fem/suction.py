@@ -161,7 +161,7 @@ class SuctionStates:
             below = [d for d in row if d < dp]
             if not below:
                 state = self._press(u)
-                row[0.0] = (state, _outputs(state, self._cup.mech, self._cup, self._cavity))
+                row[0.0] = (state, _measured(state, self._cup.mech, self._cup, self._cavity))
                 below = [0.0]
             if dp > 0.0:
                 lo = max(below)
@@ -169,7 +169,7 @@ class SuctionStates:
                                             schedule=lambda t, lo=lo, hi=dp: lo + t * (hi - lo))
                 state = self._segment(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
                                       f"u = {u * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa")
-                row[dp] = (state, _outputs(state, mech.at(1.0), self._cup, self._cavity))
+                row[dp] = (state, _measured(state, mech.at(1.0), self._cup, self._cavity))
         return row[dp][1]
 
     def _raised(self, u: float, dp: float) -> tuple:
@@ -188,7 +188,7 @@ class SuctionStates:
             state = self._segment(mech, _raising(self._cup, a), a - u, start, u,
                                   f"plate raised from u = {a * 1e3:.4g} to {u * 1e3:.4g} mm at dp = {dp / 1e3:.4g} kPa",
                                   options=self._options)
-            row[dp] = (state, _outputs(state, mech.at(1.0) if dp > 0.0 else mech, self._cup, self._cavity))
+            row[dp] = (state, _measured(state, mech.at(1.0) if dp > 0.0 else mech, self._cup, self._cavity))
         return row[dp][1]
 
     def _press(self, u: float) -> StepResult:
@@ -227,7 +227,7 @@ def _raising(cup: CupSetup, u_from: float) -> Callable[[float], tuple[np.ndarray
 
 
 def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:
-    """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile, sealed) of a converged state. F1 = -F0, the plate's
+    """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile) of a converged state. F1 = -F0, the plate's
     reaction, which with suction includes the roof's share dp pi r_0^2; N is the plane's
     reaction less the suction dp pi (r_cut^2 - r_k^2) that the load puts on the contact zones
     and pockets beyond the seal (`fem.cavity`), so F1 + N = dp pi r_k^2
@@ -238,8 +238,14 @@ def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> t
     r_k = cavity.seal_radius(x)
     r_cut = float(x[0, cavity.nodes[cavity.cut_index(x)]])
     N = m.F0_contact_N - dp * np.pi * (r_cut**2 - r_k**2)
-    sealed = bool(np.any(x[1, cavity.nodes] <= cavity.tolerance_m))
-    return (-m.F0_N, N, cavity.volume(x), r_k, r_cut, m.r_c_m, state.energy_J, m.pressure, sealed)
+    return (-m.F0_N, N, cavity.volume(x), r_k, r_cut, m.r_c_m, state.energy_J, m.pressure)
+
+
+def _measured(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:
+    """`_outputs` and whether the state is sealed (module docstring: a node of the cavity chain
+    on the plane)."""
+    x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])
+    return (*_outputs(state, mech, cup, cavity), bool(np.any(x[1, cavity.nodes] <= cavity.tolerance_m)))
 
 
 def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, material: NeoHookean) -> None:
