@@ -137,8 +137,8 @@ def _prepare(args: argparse.Namespace) -> dict:
     mesh = cup_mesh(geo, args.fidelity)
     h1 = cup_height(mesh)
     u = DEFAULT_GRID.u_m(h1) if args.u_mm is None else 1e-3 * np.array(args.u_mm, float)
-    if not (np.all(np.isfinite(u)) and np.all(np.diff(u) > 0) and u[0] > 0 and u[-1] <= h1 * (1 + 1e-9)):
-        raise ValueError(f"u_mm: plate displacements must increase within (0, h1] = (0, "
+    if not (np.all(np.isfinite(u)) and np.all(np.diff(u) > 0) and u[0] > -h1 and u[-1] <= h1 * (1 + 1e-9)):
+        raise ValueError(f"u_mm: plate displacements must increase within (-h1, h1] = ({-1e3 * h1:.6g}, "
                          f"{1e3 * h1:.6g}] mm, got {args.u_mm}")
     dp = np.array(args.dp_kPa, float)
     if not (np.all(np.isfinite(dp)) and dp[0] == 0 and np.all(np.diff(dp) > 0) and dp[-1] <= 1000

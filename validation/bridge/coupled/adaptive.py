@@ -59,10 +59,12 @@ class AdaptiveSpec:
 @dataclass(frozen=True)
 class SuctionGoal:
     """What the table is for: a `reduced.LeakageModel` without its table (cup, u_c, gas, kappa,
-    interface) and the pull forces [N] whose lifetimes it must give."""
+    interface), the pull forces [N] whose lifetimes it must give, and the plate displacement [m]
+    the cup is released at (None: the route's default, from the cup's h_start)."""
 
     model: Any
     forces_N: tuple[float, ...]
+    u_start_m: float | None = None
 
     def __post_init__(self) -> None:
         forces = tuple(float(f) for f in self.forces_N)

@@ -14,7 +14,10 @@ a state reached by another dp ramp is the same state for frictionless contact). 
 2. on the lattice, the states the interpolation of those paths reads, widened by `margin` cells;
 3. the goal's lifetimes and largest holdable force on that table; where they read a hole, the
    missing states (widened by `margin`) are added and they are computed again, until they run
-   through. What they read then is built, and nothing else is asked of the table.
+   through. A missing state in a raised row (u <= 0, `fem.suction`) brings with it the `reach`
+   rows below it in the same column: there the paths run down in u at nearly constant dp (the
+   plate rising as the gas leaks in), and a round that adds one row at a time would need one
+   round per row. What they read then is built, and nothing else is asked of the table.
 
 The cost and the lifetimes against the full grid: benchmarks/bench_coupled.py --around.
 """
@@ -41,6 +44,7 @@ class AroundSpec:
     dp_every: int = 5
     margin: int = 0
     max_rounds: int = 100
+    reach: int = 8
 
     def __post_init__(self) -> None:
         if not all(isinstance(k, int) and k >= 1 for k in (self.u_every, self.dp_every, self.max_rounds)):
@@ -48,6 +52,8 @@ class AroundSpec:
                              f"{self.u_every}, {self.dp_every}, {self.max_rounds}")
         if not (isinstance(self.margin, int) and self.margin >= 0):
             raise ValueError(f"margin: need an integer >= 0, got {self.margin}")
+        if not (isinstance(self.reach, int) and self.reach >= 0):
+            raise ValueError(f"reach: need an integer >= 0, got {self.reach}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,6 +106,7 @@ def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goa
         if not missing:
             return AroundBuild(table, asked, tuple(rounds))
         _widen(built, missing, spec.margin)
+        _reach_down(built, missing, lattice.u_m, spec.reach)
     raise RuntimeError(f"suction table around the paths: states still missing after {spec.max_rounds} rounds")
 
 
@@ -113,6 +120,13 @@ class _Reads:
 
     def __call__(self, u: float, dp: float) -> list[tuple[int, int]]:
         return self.holes.missing(u, dp)
+
+
+def _reach_down(built: np.ndarray, nodes, u: np.ndarray, reach: int) -> None:
+    """Mark, for every node in a raised row (u <= 0), the `reach` rows below it in its column."""
+    for i, j in nodes:
+        if u[i] <= 0:
+            built[max(i - reach, 0):i, j] = True
 
 
 def _widen(built: np.ndarray, nodes, margin: int) -> None:
@@ -134,7 +148,8 @@ def _cavity(goal: SuctionGoal, table, memo: dict):
     from reduced.lifetime.routes import ROUTES
 
     route = ROUTES["coupled"]
-    cavity, u_start, _ = route.cavity(replace(goal.model, suction=table), dict(route.options))
+    options = dict(route.options, **({} if goal.u_start_m is None else {"u_start_m": goal.u_start_m}))
+    cavity, u_start, _ = route.cavity(replace(goal.model, suction=table), options)
     return replace(cavity, conductances=memo), u_start
 
 
