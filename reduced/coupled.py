@@ -306,10 +306,12 @@ class CoupledCavity:
         return (self.p_a_Pa - dp) * self.V(u, dp) / self.gas.kT_J
 
     def _walk(self, u_from: float, u_to: float, dp_of: Callable[[float], float | None],
-              samples: int) -> tuple[np.ndarray, np.ndarray, str]:
+              samples: int, stop: Callable[[float, float], bool] | None = None
+              ) -> tuple[np.ndarray, np.ndarray, str]:
         """The states (u, dp(u)) from u_from down to u_to on `samples` points, as far as they
         exist: (u, dp, end) with end "table_edge" (u_to reached, or dp(u) beyond the table's dp),
-        or "reached_r1" (the next state reads one without a seal: the seal has opened)."""
+        "reached_r1" (the next state reads one without a seal: the seal has opened), or "stop"
+        (stop(u, dp) true at the last state)."""
         us, dps = [], []
         end = "table_edge"
         for u in np.linspace(u_from, u_to, samples):
@@ -322,30 +324,27 @@ class CoupledCavity:
                 break
             us.append(float(u))
             dps.append(dp)
+            if stop is not None and stop(float(u), dp):
+                end = "stop"
+                break
         return np.array(us), np.array(dps), end
 
-    def _raised_at(self, N0: float, u_start_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    def _raised_at(self, N0: float, u_start_m: float, F1: float | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
         """The cup sealed with N0 at u_start and raised at fixed N0 (the plate from u_start to
-        the table's smallest u): (u, dp, F1 along it, how it ends, as `_walk`). Kept per (N0, u_start)."""
-        key = (N0, u_start_m)
-        if key not in self._raise_memo:
-            def dp_of(u: float) -> float | None:
-                return self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False)
-            us, dps, end = self._walk(u_start_m, float(self._u[0]), dp_of, self.samples)
-            F1 = np.array([self.F1(u, d) for u, d in zip(us, dps)])
-            self._raise_memo[key] = (us, dps, F1, end)
-        return self._raise_memo[key]
-
-    @cached_property
-    def _raise_memo(self) -> dict:
-        return {}
+        the table's smallest u, or until it pulls F1): (u, dp, F1 along it, how it ends, as `_walk`)."""
+        def dp_of(u: float) -> float | None:
+            return self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False)
+        stop = None if F1 is None else (lambda u, d: self.F1(u, d) >= F1)
+        us, dps, end = self._walk(u_start_m, float(self._u[0]), dp_of, self.samples, stop)
+        return us, dps, np.array([self.F1(u, d) for u, d in zip(us, dps)]), end
 
     def loaded(self, F1: float, u_start_m: float) -> tuple[float, float | None, float]:
         """(N0, dp0, u0): the start content of the cup released at u_start (`start`), and the state
         that holds F1 with it: the cup raised at fixed N0 until the handle pulls F1 (dp0 None if
         no state on that path pulls F1: more than the cup holds, the over-force)."""
         _, N0 = self.start(u_start_m)
-        us, dps, pull, _ = self._raised_at(N0, u_start_m)
+        us, dps, pull, _ = self._raised_at(N0, u_start_m, F1)
         above = np.flatnonzero(pull >= F1)
         if above.size == 0:
             return N0, None, math.nan

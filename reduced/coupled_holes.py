@@ -141,8 +141,12 @@ class Holes:
     def gap_missing(self, axis: str, fixed: float, a: int, b: int, runs: str = "") -> list[tuple[int, int]]:
         """The missing nodes of the cells a ... b of a line in which a crossing lies unseen: of
         the cells next to built ones (the gap `runs` 'down' to the line's start or 'up' to its
-        end: only b, or only a, is) and the middle one (a builder bisects a long gap)."""
-        cells = {(a + b) // 2} | ({b} if runs == "down" else {a} if runs == "up" else {a, b})
+        end: only b, or only a, is) and the middle one (a builder bisects a long gap); every cell
+        of a gap of at most 24 cells (a short gap is filled in one round)."""
+        if b - a <= 24:                                   # a short gap: all of it, in one round
+            cells = set(range(a, b + 1))
+        else:
+            cells = {(a + b) // 2} | ({b} if runs == "down" else {a} if runs == "up" else {a, b})
         return sorted({n for k in cells for n in self.cell_missing(axis, k, fixed)})
 
 

@@ -60,17 +60,23 @@ class AdaptiveSpec:
 class SuctionGoal:
     """What the table is for: a `reduced.LeakageModel` without its table (cup, u_c, gas, kappa,
     interface), the pull forces [N] whose lifetimes it must give, and the plate displacement [m]
-    the cup is released at (None: the route's default, from the cup's h_start)."""
+    the cup is released at (None: the route's default, from the cup's h_start). For the build
+    around the paths (`validation.bridge.coupled.around`): `hint`, points (u [m], dp [Pa]) near
+    which the paths are expected (empty: found on a seed grid), and whether the largest holdable
+    force is asked too (`largest`)."""
 
     model: Any
     forces_N: tuple[float, ...]
     u_start_m: float | None = None
+    hint: tuple[tuple[float, float], ...] = ()
+    largest: bool = True
 
     def __post_init__(self) -> None:
         forces = tuple(float(f) for f in self.forces_N)
         if not forces or not all(math.isfinite(f) and f > 0 for f in forces):
             raise ValueError(f"forces_N: need pull forces > 0 N, got {self.forces_N}")
         object.__setattr__(self, "forces_N", forces)
+        object.__setattr__(self, "hint", tuple((float(u), float(dp)) for u, dp in self.hint))
 
 
 @dataclass(frozen=True)

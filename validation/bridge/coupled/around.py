@@ -10,14 +10,15 @@ a state reached by another dp ramp is the same state for frictionless contact). 
 
 1. the seed: the goal's paths (its forces, the start and the largest holdable force) on the
    tensor sub-grid of every `u_every`-th u and `dp_every`-th dp: cheap, and within a few
-   lattice cells of the full table's paths;
+   lattice cells of the full table's paths; or, where the goal gives a hint (points near which
+   the paths are expected, e.g. another route's trajectories), the cells around those points
+   (a row and four dp columns either side);
 2. on the lattice, the states the interpolation of those paths reads, widened by `margin` cells;
 3. the goal's lifetimes and largest holdable force on that table; where they read a hole, the
    missing states (widened by `margin`) are added and they are computed again, until they run
-   through. A missing state in a raised row (u <= 0, `fem.suction`) brings with it the `reach`
-   rows below it in the same column: there the paths run down in u at nearly constant dp (the
-   plate rising as the gas leaks in), and a round that adds one row at a time would need one
-   round per row. What they read then is built, and nothing else is asked of the table.
+   through. The missing states of a round bring with them the `reach` rows below them, in
+   their columns and two more either side: the paths run down in u (the plate rising as the gas
+   leaks in), and a round that adds one row at a time would need one round per row. What they read then is built, and nothing else is asked of the table.
 
 The cost and the lifetimes against the full grid: benchmarks/bench_coupled.py --around.
 """
@@ -44,7 +45,7 @@ class AroundSpec:
     dp_every: int = 5
     margin: int = 0
     max_rounds: int = 100
-    reach: int = 8
+    reach: int = 4
 
     def __post_init__(self) -> None:
         if not all(isinstance(k, int) and k >= 1 for k in (self.u_every, self.dp_every, self.max_rounds)):
@@ -83,17 +84,24 @@ def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goa
     """The table with holes the goal's lifetimes read (module docstring). table_on(built) returns
     the `SuctionTable` on the lattice with the states `built` [n_u, n_dp] (solving what it lacks)."""
     asked = np.zeros((n_u, n_dp), dtype=bool)
-    U = sorted(set(range(0, n_u, spec.u_every)) | {n_u - 1})
-    D = sorted(set(range(0, n_dp, spec.dp_every)) | {n_dp - 1})
-    asked[np.ix_(U, D)] = True
-    lattice = table_on(asked)
-    reads = _Reads(lattice.u_m, goal.model.kappa * lattice.dp_Pa)
     memo: dict = {}                                   # node conductances, shared by the rounds
     built = np.zeros_like(asked)
-    for u, dp in _path_points(goal, _compressed(lattice, U, D), memo):
-        _widen(built, reads(u, dp), spec.margin)
+    if goal.hint:                                     # the paths' expected points: no seed grid
+        lattice = table_on(asked)
+        reads = _Reads(lattice.u_m, goal.model.kappa * lattice.dp_Pa)
+        for u, dp in goal.hint:
+            _widen(built, reads(u, dp), max(spec.margin, 1), cols=4)
+    else:
+        U = sorted(set(range(0, n_u, spec.u_every)) | {n_u - 1})
+        D = sorted(set(range(0, n_dp, spec.dp_every)) | {n_dp - 1})
+        asked[np.ix_(U, D)] = True
+        lattice = table_on(asked)
+        reads = _Reads(lattice.u_m, goal.model.kappa * lattice.dp_Pa)
+        for u, dp in _path_points(goal, _compressed(lattice, U, D), memo):
+            _widen(built, reads(u, dp), spec.margin)
     rounds = []
-    every = list(range(len(goal.forces_N) + 1))       # the lifetimes, then the largest force
+    # the lifetimes, then (unless the goal leaves it out) the largest force
+    every = list(range(len(goal.forces_N) + int(goal.largest)))
     pending = every
     for _ in range(spec.max_rounds):
         asked |= built
@@ -123,17 +131,23 @@ class _Reads:
 
 
 def _reach_down(built: np.ndarray, nodes, u: np.ndarray, reach: int) -> None:
-    """Mark, for every node in a raised row (u <= 0), the `reach` rows below it in its column."""
-    for i, j in nodes:
-        if u[i] <= 0:
-            built[max(i - reach, 0):i, j] = True
+    """Mark the `reach` rows below the missing nodes (the paths run down in u) in their columns
+    and two more either side."""
+    if not nodes:
+        return
+    rows = [i for i, _ in nodes]
+    cols = [j for _, j in nodes]
+    lo, hi = max(min(cols) - 2, 0), min(max(cols) + 3, built.shape[1])
+    built[max(min(rows) - reach, 0):max(rows) + 1, lo:hi] = True
 
 
-def _widen(built: np.ndarray, nodes, margin: int) -> None:
-    """Mark `nodes` and every node within `margin` cells of one as built."""
+def _widen(built: np.ndarray, nodes, margin: int, cols: int | None = None) -> None:
+    """Mark `nodes` and every node within `margin` cells of one as built (`cols` along dp, if
+    given)."""
     n_u, n_dp = built.shape
+    c = margin if cols is None else cols
     for i, j in nodes:
-        built[max(i - margin, 0):min(i + margin + 1, n_u), max(j - margin, 0):min(j + margin + 1, n_dp)] = True
+        built[max(i - margin, 0):min(i + margin + 1, n_u), max(j - c, 0):min(j + c + 1, n_dp)] = True
 
 
 def _compressed(table, U: list[int], D: list[int]):

@@ -20,13 +20,17 @@ def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -
     converted as the stiffness sidecar's are (`profiles_from_lists`: a node shared by
     two facets merged, fewer than two points or no pressure is None). A state without a seal
     (`fem.suction`: no node of the cavity chain on the plane) is null in every grid and profile
-    and False in `sealed`: its numbers are not those of a cup under suction."""
+    and False in `sealed`: its numbers are not those of a cup under suction; so is a state whose
+    plane carries no pressure (the rim touching at zero force)."""
     prov = _provenance(grid.contact_law, grid.material, grid.h1_m, grid.stats, provenance)
-    sealed = np.asarray(grid.sealed, dtype=bool)
+    converted = [profiles_from_lists([1e3 * p.r_m for p in row], [1e-3 * p.p_Pa for p in row])
+                 for row in grid.profiles]
+    # a state whose plane carries no pressure (the rim touching at zero force, u = 0 and dp = 0)
+    # holds no seal either
+    sealed = np.asarray(grid.sealed, dtype=bool) & np.array(
+        [[p is not None for p in row] for row in converted]).reshape(np.shape(grid.sealed))
     cut = {name: np.where(sealed, getattr(grid, name), np.nan) for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
-    profiles = tuple(tuple(p if ok else None for p, ok in zip(
-        profiles_from_lists([1e3 * p.r_m for p in row], [1e-3 * p.p_Pa for p in row]), sealed[i]))
-        for i, row in enumerate(grid.profiles))
+    profiles = tuple(tuple(p if ok else None for p, ok in zip(row, sealed[i])) for i, row in enumerate(converted))
     return SuctionTable(u_m=grid.u_m, dp_Pa=grid.dp_Pa, **cut, profiles=profiles,
                         E_Pa=grid.material.E_Pa, provenance=prov, sealed=None if sealed.all() else sealed)
 
@@ -60,12 +64,13 @@ def holed_suction_table(states: SuctionStates, u_m: np.ndarray, dp_Pa: np.ndarra
     nodes = sorted(zip(*np.nonzero(built)), key=lambda n: (u_m[n[0]] <= 0, abs(u_m[n[0]]), n[1]))
     for i, j in nodes:
         F1, _, V, r_k, r_cut, _, _, p, closed = states.state(float(u_m[i]), float(dp_Pa[j]))
-        if not closed:
+        profile = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0]
+        if not closed or profile is None:
             sealed[i, j] = False
             continue
         for name, x in zip(grids, (F1, V, r_k, r_cut)):
             grids[name][i, j] = x
-        profiles[i][j] = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0]
+        profiles[i][j] = profile
     prov = _provenance(contact, states.material, states.h1_m, states.stats, provenance)
     return SuctionTable(u_m=np.asarray(u_m, float), dp_Pa=np.asarray(dp_Pa, float), **grids,
                         profiles=tuple(tuple(row) for row in profiles), E_Pa=states.material.E_Pa,
