@@ -1,8 +1,9 @@
 """Compute a cup's response to the cavity's suction on a (u, dp) grid: the input of the coupled route.
 
-For every plate displacement u the cup is pressed onto the plane without suction, then the
-pressure difference dp = p_a - p_b is ramped on its cavity surface with the plate held
-(`fem.suction`). Writes a JSON table (`reduced.suction_table.SuctionTable`: per (u, dp) the pull
+For every plate displacement u > 0 the cup is pressed onto the plane without suction, then the
+pressure difference dp = p_a - p_b is ramped on its cavity surface with the plate held; at
+u <= 0 (the plate above the free cup's touching height) the plate is raised at fixed dp, and a
+state whose rim has left the plane is marked as holding no seal (`fem.suction`). Writes a JSON table (`reduced.suction_table.SuctionTable`: per (u, dp) the pull
 on the handle F1, the cavity volume, the seal radius and the contact-pressure profile) that
 `cupcheck lifetime --route coupled --suction-table FILE` reads. Every input is checked before the
 solve (one line, exit 2); a solve that fails exits 1; no file is left behind either way.
@@ -48,8 +49,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default="medium",
                    help="mesh level (default medium)")
     r.add_argument("--u-mm", type=float, nargs="+", default=None, dest="u_mm", metavar="U",
-                   help="plate displacements [mm], increasing, in (0, h1] (default: 105 values "
-                        "from 0.001 to 0.8 h1, graded towards 0)")
+                   help="plate displacements [mm], increasing, in (-h1, h1]; u <= 0 is the plate "
+                        "above the free cup's touching height, raised at fixed dp (default: 226 "
+                        "values, -0.6 ... 0 h1 every 0.005 h1 and 105 from 0.001 to 0.8 h1, graded "
+                        "towards 0)")
     r.add_argument("--dp-kPa", type=float, nargs="+", default=list(DEFAULT_GRID.dp_kPa), dest="dp_kPa",
                    metavar="DP",
                    help="pressure differences p_a - p_b [kPa], from 0, increasing, at most 1000 "
