@@ -131,14 +131,10 @@ class _Reads:
 
 
 def _reach_down(built: np.ndarray, nodes, u: np.ndarray, reach: int) -> None:
-    """Mark the `reach` rows below the missing nodes (the paths run down in u) in their columns
-    and two more either side."""
-    if not nodes:
-        return
-    rows = [i for i, _ in nodes]
-    cols = [j for _, j in nodes]
-    lo, hi = max(min(cols) - 2, 0), min(max(cols) + 3, built.shape[1])
-    built[max(min(rows) - reach, 0):max(rows) + 1, lo:hi] = True
+    """Mark the `reach` rows below each missing node (the paths run down in u) in its column and
+    two more either side."""
+    for i, j in nodes:
+        built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
 
 
 def _widen(built: np.ndarray, nodes, margin: int, cols: int | None = None) -> None:
