@@ -8,11 +8,15 @@ pull balances and the gas fills the cavity:
 two equations for the plate displacement u and dp = p_a - p_b (`SuctionTable`: F1 and V as the
 FEM computes them with the suction acting on the deformed cup, so the rigid cone of eqs 3-4, the
 force balance of eq 5 and eq 6's beta are all replaced). At fixed F1 the states form a branch
-parametrised by dp: u(dp) from the first equation (F1 rises with dp and falls with u), N(dp) from
-the second; gas leaks in, N rises, dp falls. The cup starts like the paper's (Sec. 3): released at
-u_start with F1 = 0, which fixes N0; F1 is then applied at fixed N0. It lets go where the branch
-ends: at a fold of N(dp) (no state holds more gas), or where u reaches the table's smallest u (the
-plate back near its free height: the end of the data, reported as such).
+parametrised by u, as the fem route walks it: dp(u) from the first equation (F1 rises with dp),
+N(u) from the second; gas leaks in, N rises, the plate rises (u falls). The cup starts like the
+paper's (Sec. 3): released at u_start with F1 = 0, which fixes N0; it is then raised at fixed N0
+until the handle pulls F1 (the largest pull along that raise is the largest holdable force). It
+lets go where the branch ends: at a fold of N(u) (no state holds more gas), where the seal opens
+(the branch would read a state whose rim has left the plane, `SuctionTable.sealed`: "reached_r1",
+as the fem route's seal opening; the end is the last sample of the branch that reads only sealed
+states, so it lies within the interpolation's reach of the table's last sealed row), or where it
+leaves the table (its smallest u, or more suction than its largest dp: "table_edge").
 
 The leak rate at a state is the series flow through its own contact-pressure profile
 (`reduced.profile_leak`), computed at the table's nodes (p_b = p_a - dp_j exactly there) as the
@@ -33,15 +37,17 @@ every state the interpolation reads is built (`reduced.coupled_holes`); the root
 inside built cells, and a value that would read a hole raises `MissingStates` naming the states
 to add. Where they are built the values are the full table's; without relaxation only.
 
-The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a dp
-grid of `samples` points. A stiffness factor kappa makes the cup kappa times stiffer, as the
+The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a u
+grid of `samples` points from the start to the branch's end (found by a first walk of samples/8). A stiffness factor kappa makes the cup kappa times stiffer, as the
 paper's kappa multiplies F0 (Fig. 1stiffnessFactor): a neo-Hookean body in frictionless contact
 with modulus kappa E answers dp exactly as the table's body answers dp / kappa, so F1(u, dp) =
 kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa) and the contact pressures scale
 likewise, while u_c(p/E) keeps the table's E (the same rubber at the interface, as in the paper
 route). With a relaxation modulus (`relaxation`, `phi0_s`) kappa follows the contact time,
 kappa(phi) = kappa E_eff(phi) / E_eff(phi0) with eq (10), the interface sees E_eff(phi) as on the
-paper route, and (N, phi) is integrated in time: `reduced.coupled_relax`.
+paper route, and (N, phi) is integrated in time: `reduced.coupled_relax`, on the table's rows
+u > 0 only (every state there sealed; that integration does not follow the seal's opening, so its
+branch ends at the table's edge u > 0, as before the raised rows).
 """
 
 from __future__ import annotations
