@@ -46,8 +46,8 @@ likewise, while u_c(p/E) keeps the table's E (the same rubber at the interface, 
 route). With a relaxation modulus (`relaxation`, `phi0_s`) kappa follows the contact time,
 kappa(phi) = kappa E_eff(phi) / E_eff(phi0) with eq (10), the interface sees E_eff(phi) as on the
 paper route, and (N, phi) is integrated in time: `reduced.coupled_relax`, on the table's rows
-u > 0 only (every state there sealed; that integration does not follow the seal's opening, so its
-branch ends at the table's edge u > 0, as before the raised rows).
+above its last row with an unsealed state only (the pressed rows; that integration does not
+follow the seal's opening, so its branch ends at that edge, as before the raised rows).
 """
 
 from __future__ import annotations
@@ -113,9 +113,10 @@ class CoupledCavity:
             raise ValueError("phi0_s: the measurement contact time is used only with relaxation; "
                              "give relaxation or drop phi0_s")
         if self.relaxation is not None and not self.table.all_sealed:
-            # the time integration does not follow the seal's opening: the rows where every state
-            # is sealed (u > 0), so the relaxed branch ends at the table's edge there
-            object.__setattr__(self, "table", self.table.rows(self.table.u_m > 0))
+            # the time integration does not follow the seal's opening: the rows above the last one
+            # with a state without a seal (the pressed rows), so the relaxed branch ends there
+            last_open = int(np.flatnonzero(~self.table.sealed.all(axis=1))[-1])
+            object.__setattr__(self, "table", self.table.rows(np.arange(self.table.u_m.size) > last_open))
         if self.relaxation is not None and not self.table.complete:
             raise ValueError("suction table: relaxation needs a table without holes (its paths "
                              "follow the contact time, not the built states)")
