@@ -10,7 +10,9 @@ solve (one line, exit 2); a solve that fails exits 1; no file is left behind eit
 
 --grid adaptive builds only the rows and columns of that grid which the lifetimes at --force on
 --surface need (`validation.bridge.coupled.adaptive`: refined where the interpolation changes
-those lifetimes); --grid full (the default) builds every state.
+those lifetimes), among its pressed rows u > 0 (its lifetimes end at that edge); --grid full (the
+default) builds every state. Lifetimes past the touching height build their table around their
+paths (`validation.bridge.coupled.around`, as `lifetime --route coupled` does).
 
 The contact law is --contact (with --friction for coulomb), else the --geometry file's [contact]
 table, else frictionless; the table's provenance records it and where it came from.
@@ -102,7 +104,9 @@ def _adaptive(args: argparse.Namespace, job: dict, provenance: dict, progress):
     from validation.bridge.coupled.table import suction_table
 
     states = SuctionStates(job["mesh"], job["material"], job["contact"].contact)
-    u, dp = job["u_m"], job["dp_Pa"]
+    # the adaptive rows and columns follow the branches to the pressed rows' edge (u > 0): its
+    # refinement reads the branch's end at the table's smallest u, not the seal's opening
+    u, dp = job["u_m"][job["u_m"] > 0], job["dp_Pa"]
 
     def table_on(iu, jd):
         return suction_table(states.grid(u[list(iu)], dp[list(jd)], progress=progress), provenance)
