@@ -29,6 +29,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--half", action="store_true", help="halve the raised rows' u spacing")
     parser.add_argument("--forces", type=float, nargs="+", default=[5.0, 10.0, 20.0])
+    parser.add_argument("--out", default=None, help="also write the table (JSON) here")
     args = parser.parse_args()
     model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
     route, cup = register(), FemCup("A", "coarse")
@@ -54,6 +55,8 @@ def main() -> None:
     table = suction_table_for("A", fidelity="coarse", goal=goal, grid=grid)
     print(f"table {table.provenance['grid']}: {table.provenance['states_solved']} states solved, "
           f"{int((~table.sealed).sum())} without a seal, {time.process_time() - t:.1f} s CPU", flush=True)
+    if args.out:
+        table.to_json(args.out)
     for F in args.forces:
         c = table_lifetime(model, table, F, u_start)
         print(f"table route F1 = {F:g} N: {c.lifetime_s:.4g} s, {c.reason}, u_end = "
