@@ -107,8 +107,10 @@ class Holes:
         MissingStates (`gap_missing`) where the crossing lies in cells not built."""
         xs = self._u_list if axis == "u" else self._dp_list
         last, ok, nodes = self.line(axis, fixed, top)
-        if not nodes:
-            self.unreadable(self.cell_missing(axis, 0, fixed), f"along {axis} at {fixed:.6g}: nothing built")
+        if not nodes:                  # no readable cell: the states not built come first
+            cells = [self.cell_missing(axis, k, fixed) for k in range(max(last, 1))]
+            unsolved = sorted({n for c in cells for n in c if not self.solved[n]})
+            self.unreadable(unsolved or cells[0], f"along {axis} at {fixed:.6g}: nothing built")
         sign = 1.0 if rising else -1.0
         at = lambda k: min(xs[k], top)                                    # noqa: E731
         g = lambda k: sign * (value(at(k)) - target)                       # noqa: E731
