@@ -34,7 +34,7 @@ from validation.bridge.coupled.around import AroundSpec, around_paths
 if TYPE_CHECKING:
     from fem.interface import ContactLaw
 
-__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "QUICK_GRID", "SuctionGoal", "AdaptiveSpec", "AroundSpec",
+__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "PRESSED_GRID", "QUICK_GRID", "SuctionGoal", "AdaptiveSpec", "AroundSpec",
            "suction_table_for"]
 
 _U_COARSE = (0.001, 0.0025, 0.005, 0.0075, 0.01, 0.0175, 0.025, 0.0375, 0.05, 0.075, 0.1, 0.125,
@@ -68,6 +68,8 @@ def _halved(u: tuple[float, ...]) -> tuple[float, ...]:
 _U_RAISED = tuple(round(-0.005 * k, 4) + 0.0 for k in range(120, -1, -1))
 
 DEFAULT_GRID = SuctionGridSpec(_U_RAISED + _halved(_halved(_U_COARSE)), tuple(float(x) for x in range(0, 101)))
+#: the default grid's pressed rows only (u > 0): its branches end at the table's edge u > 0
+PRESSED_GRID = SuctionGridSpec(_halved(_halved(_U_COARSE)), DEFAULT_GRID.dp_kPa)
 QUICK_GRID = SuctionGridSpec(_U_COARSE, tuple(float(x) for x in range(0, 101, 5)))
 
 
