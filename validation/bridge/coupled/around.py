@@ -16,9 +16,10 @@ a state reached by another dp ramp is the same state for frictionless contact). 
 2. on the lattice, the states the interpolation of those paths reads, widened by `margin` cells;
 3. the goal's lifetimes and largest holdable force on that table; where they read a hole, the
    missing states (widened by `margin`) are added and they are computed again, until they run
-   through. The missing states of a round bring with them the `reach` rows below them, in
-   their columns and two more either side: the paths run down in u (the plate rising as the gas
-   leaks in), and a round that adds one row at a time would need one round per row. What they read then is built, and nothing else is asked of the table.
+   through. A missing state in a raised row (u <= 0) brings with it the `reach` rows below it,
+   in its column and two more either side: there the paths run down in u at nearly constant dp
+   (the plate rising as the gas leaks in), and a round that adds one row at a time would need one
+   round per row. What they read then is built, and nothing else is asked of the table.
 
 The cost and the lifetimes against the full grid: benchmarks/bench_coupled.py --around.
 """
@@ -131,10 +132,11 @@ class _Reads:
 
 
 def _reach_down(built: np.ndarray, nodes, u: np.ndarray, reach: int) -> None:
-    """Mark the `reach` rows below each missing node (the paths run down in u) in its column and
-    two more either side."""
+    """Mark the `reach` rows below each missing node in a raised row (u <= 0: the paths run down
+    in u there at nearly constant dp) in its column and two more either side."""
     for i, j in nodes:
-        built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
+        if u[i] <= 0:
+            built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
 
 
 def _widen(built: np.ndarray, nodes, margin: int, cols: int | None = None) -> None:
