@@ -1,20 +1,30 @@
 """The cup under suction: its response on a grid of plate displacement u and cavity pressure dp.
 
-    grid = suction_grid(mesh, NeoHookean(), u_m=[0.5e-3, 1e-3, 2e-3], dp_Pa=[0, 2e4, 5e4, 1e5])
-    grid.F1_N[i, j], grid.V_m3[i, j], grid.seal_r_m[i, j], grid.profiles[i][j]
+    grid = suction_grid(mesh, NeoHookean(), u_m=[-1e-3, 0.5e-3, 1e-3, 2e-3], dp_Pa=[0, 2e4, 5e4, 1e5])
+    grid.F1_N[i, j], grid.V_m3[i, j], grid.seal_r_m[i, j], grid.profiles[i][j], grid.sealed[i, j]
 
-For every u_i the cup is pressed to u_i with no suction (one displacement-controlled path
+For every u_i > 0 the cup is pressed to u_i with no suction (one displacement-controlled path
 through all the u_i), then, with the plate held, dp = p_a - p_b is ramped through the dp_j on
-the cavity surface (`fem.cavity`: the conservative load dp V_cav). Each grid value is a
+the cavity surface (`fem.cavity`: the conservative load dp V_cav). At u <= 0 the plate is at or
+above the free cup's touching height: without suction the rim does not touch, so a ramp in dp
+there would start from a cavity that is not closed. Such a state (u, dp) is reached the way the
+sealed cup gets there: from the state at the same dp and the next larger u (ultimately from the
+row u_anchor > 0, pressed and ramped as above), the plate raised at fixed dp. Each grid value is a
 converged state reached exactly (the paths are cut at the grid points), so no interpolation
-enters here. Ramping dp at fixed u keeps the plate's reaction continuous; at u = 0 only the
-rim corner touches and the ramp is degenerate, so u must be > 0.
+enters here.
+
+Sealed (the criterion): a state is sealed when at least one node of the cavity chain lies on the
+plane (`fem.cavity`'s tolerance), as the FEM branch at fixed N decides that its seal opened
+(`fem.gas_branch`). At u > 0 every state is. At u <= 0 and small dp the rim hangs above the plane:
+the load dp V_cav then acts on a cavity closed only by the vertical drop from the rim to the
+plane, which no seal holds; `sealed` is False there and the numbers of such a state are not a
+cup under suction (the hand-off gives them as no-seal markers, `validation.bridge.coupled.table`).
 
 The state (u, dp) is what the coupled reduced model needs (`reduced.coupled`): the pull on the
 handle F1 = dp pi r_k^2 - N (eq. 5 with the FEM's contact force N and seal radius r_k), the gas
 volume V, and the contact-pressure profile through which the gas leaks. Frictionless contact is
-path independent, so the order of loading (press, then suck) does not matter; with sticking or
-Coulomb contact it does, and the grid is the response to that order.
+path independent, so the order of loading (press, then suck, then raise) does not matter; with
+sticking or Coulomb contact it does, and the grid is the response to that order.
 """
 
 from __future__ import annotations
@@ -54,6 +64,7 @@ class SuctionGrid:
     cut_r_m: np.ndarray         # outer end of the outermost contact zone (the load's extent)
     r_c_m: np.ndarray           # inner contact radius of the pressure profile
     potential_J: np.ndarray     # W + dp V_cav at the state (its dp-derivative is V_cav)
+    sealed: np.ndarray          # bool: a node of the cavity chain on the plane (module docstring)
     profiles: tuple[tuple[PressureProfile, ...], ...] = field(repr=False)
     stats: SolverStats = field(repr=False)
 
@@ -66,14 +77,14 @@ class SuctionGrid:
 def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: Sequence[float],
                  contact: ContactLaw | str = ContactLaw(),
                  friction: float = 0.0, wetting_m: float = 0.0,
-                 progress: Callable[[float, str], None] | None = None,
+                 progress: Callable[[float, str], None] | None = None, anchor_m: float | None = None,
                  **solver_opts: Any) -> SuctionGrid:
     """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in (0, h1];
-    dp_Pa: increasing, starting at 0. contact: a `fem.interface.ContactLaw`, or the law's name
+    dp_Pa: increasing, starting at 0. u_m: increasing, in (-h1, h1] (u <= 0: raised, module docstring). contact: a `fem.interface.ContactLaw`, or the law's name
     with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input,
     `fem.solver.ConvergenceError` naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
     converged state violates contact between the nodes or folds onto itself."""
-    states = SuctionStates(mesh, material, contact, friction, wetting_m, **solver_opts)
+    states = SuctionStates(mesh, material, contact, friction, wetting_m, anchor_m, **solver_opts)
     return states.grid(u_m, dp_Pa, progress=progress)
 
 
@@ -84,12 +95,18 @@ class SuctionStates:
     it in that row; asked in increasing u and dp, as `grid` does, the solves are exactly
     `suction_grid`'s. Frictionless contact is path independent, so any order reaches the same
     states to the solver's tolerance; with sticking or Coulomb contact a state is the response
-    to the path that reached it."""
+    to the path that reached it. A state at u <= 0 is raised from the kept state at the same dp
+    and the next larger u up to `anchor_m` (default 0.001 h1, the default grid's smallest u > 0)."""
 
     def __init__(self, mesh: Mesh, material: NeoHookean, contact: ContactLaw | str = ContactLaw(),
-                 friction: float = 0.0, wetting_m: float = 0.0, **solver_opts: Any):
+                 friction: float = 0.0, wetting_m: float = 0.0, anchor_m: float | None = None,
+                 **solver_opts: Any):
         self.mesh, self.material = mesh, material
         self.h1_m = cup_height(mesh)
+        # the row u > 0 from which the states at u <= 0 are raised (module docstring)
+        self.anchor_m = 1e-3 * self.h1_m if anchor_m is None else float(anchor_m)
+        if not 0.0 < self.anchor_m <= self.h1_m:
+            raise ValueError(f"anchor_m: must lie in (0, h1] = (0, {self.h1_m * 1e3:.4g} mm], got {anchor_m}")
         self._cup = CupSetup.of(mesh, material, contact, friction)
         self._options = SolverOptions(**solver_opts)
         # a dp interval is one load step unless it needs cutting: the grid itself is the sampling
@@ -116,30 +133,35 @@ class SuctionStates:
         todo = sum(not self.has(float(a), float(b)) for a in u for b in dp[1:])
         done = 0
         outputs = np.empty((u.size, dp.size), dtype=object)
-        for i, u_i in enumerate(u):
+        # pressed rows upwards in u, then the raised rows (u <= 0) downwards, each from the last
+        order = [i for i in range(u.size) if u[i] > 0] + [i for i in range(u.size) if u[i] <= 0][::-1]
+        for i in order:
+            u_i = u[i]
             for j, dp_j in enumerate(dp):
                 new = not self.has(float(u_i), float(dp_j))
                 outputs[i, j] = self.state(float(u_i), float(dp_j))
                 if new and j > 0 and progress:
                     done += 1
-                    progress(done / todo, f"u = {u_i * 1e3:.4g} mm, dp = {dp_j / 1e3:.4g} kPa")
+                    progress(done / max(todo, 1), f"u = {u_i * 1e3:.4g} mm, dp = {dp_j / 1e3:.4g} kPa")
         take = np.vectorize(lambda o, k: o[k], otypes=[float])
         cup = self._cup
         return SuctionGrid(
             h1_m=self.h1_m, contact=cup.plane.law.name, friction=cup.plane.law.mu, material=self.material,
             u_m=u, dp_Pa=dp, F1_N=take(outputs, 0), contact_force_N=take(outputs, 1), V_m3=take(outputs, 2),
             seal_r_m=take(outputs, 3), cut_r_m=take(outputs, 4), r_c_m=take(outputs, 5),
-            potential_J=take(outputs, 6),
+            potential_J=take(outputs, 6), sealed=take(outputs, 8).astype(bool),
             profiles=tuple(tuple(o[7] for o in row) for row in outputs), stats=self.stats)
 
     def state(self, u: float, dp: float) -> tuple:
-        """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile) at (u, dp), solved if not kept."""
+        """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile, sealed) at (u, dp), solved if not kept."""
+        if u <= 0.0:
+            return self._raised(u, dp)
         row = self._rows.setdefault(u, {})
         if dp not in row:
             below = [d for d in row if d < dp]
             if not below:
                 state = self._press(u)
-                row[0.0] = (state, _outputs(state, self._cup.mech, self._cup, self._cavity))
+                row[0.0] = (state, _measured(state, self._cup.mech, self._cup, self._cavity))
                 below = [0.0]
             if dp > 0.0:
                 lo = max(below)
@@ -147,7 +169,26 @@ class SuctionStates:
                                             schedule=lambda t, lo=lo, hi=dp: lo + t * (hi - lo))
                 state = self._segment(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
                                       f"u = {u * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa")
-                row[dp] = (state, _outputs(state, mech.at(1.0), self._cup, self._cavity))
+                row[dp] = (state, _measured(state, mech.at(1.0), self._cup, self._cavity))
+        return row[dp][1]
+
+    def _raised(self, u: float, dp: float) -> tuple:
+        """The state at u <= 0: the plate raised at fixed dp from the kept state at dp with the
+        next larger u (the anchor row's if none is kept; module docstring)."""
+        row = self._rows.setdefault(u, {})
+        if dp not in row:
+            above = [a for a, r in self._rows.items() if a > u and dp in r and a <= self.anchor_m]
+            if not above:
+                self.state(self.anchor_m, dp)
+                above = [self.anchor_m]
+            a = min(above)
+            start = self._rows[a][dp][0]
+            mech = (PressurizedMechanics(self._cup.mech, self._cavity, dp, schedule=lambda t, dp=dp: dp)
+                    if dp > 0.0 else self._cup.mech)
+            state = self._segment(mech, _raising(self._cup, a), a - u, start, u,
+                                  f"plate raised from u = {a * 1e3:.4g} to {u * 1e3:.4g} mm at dp = {dp / 1e3:.4g} kPa",
+                                  options=self._options)
+            row[dp] = (state, _measured(state, mech.at(1.0) if dp > 0.0 else mech, self._cup, self._cavity))
         return row[dp][1]
 
     def _press(self, u: float) -> StepResult:
@@ -160,10 +201,12 @@ class SuctionStates:
         self._pressed[u] = state
         return state
 
-    def _segment(self, mech, dirichlet, t_max, start, u_plate, where) -> StepResult:
-        """The converged state at the end of one path (pressing, or a dp interval at u_plate)."""
+    def _segment(self, mech, dirichlet, t_max, start, u_plate, where, options=None) -> StepResult:
+        """The converged state at the end of one path (pressing, a dp interval at u_plate, or a
+        raise at fixed dp)."""
         last: list[StepResult] = []
-        options = self._ramp_options if isinstance(mech, PressurizedMechanics) else self._options
+        if options is None:
+            options = self._ramp_options if isinstance(mech, PressurizedMechanics) else self._options
         try:
             stats = follow_path(mech, dirichlet, t_max, plane=self._cup.plane, start=start,
                                 options=options, on_step=last.append)
@@ -174,6 +217,13 @@ class SuctionStates:
         end = last[-1]
         check_state(self.mesh, end.u, u_plate, 0, u_plate)     # contact kept between the nodes
         return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0)
+
+
+def _raising(cup: CupSetup, u_from: float) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
+    """The plate raised from u_from: u_z = -(u_from - t) (`fem.solver.follow_path`'s dirichlet(t))."""
+    dofs = np.concatenate([2 * cup.top, 2 * cup.top + 1])
+    zeros = np.zeros(len(cup.top))
+    return lambda t: (dofs, np.concatenate([zeros, np.full(len(cup.top), -(u_from - t))]))
 
 
 def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:
@@ -191,11 +241,18 @@ def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> t
     return (-m.F0_N, N, cavity.volume(x), r_k, r_cut, m.r_c_m, state.energy_J, m.pressure)
 
 
+def _measured(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:
+    """`_outputs` and whether the state is sealed (module docstring: a node of the cavity chain
+    on the plane)."""
+    x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])
+    return (*_outputs(state, mech, cup, cavity), bool(np.any(x[1, cavity.nodes] <= cavity.tolerance_m)))
+
+
 def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, material: NeoHookean) -> None:
     if u.ndim != 1 or u.size == 0 or not np.all(np.isfinite(u)) or np.any(np.diff(u) <= 0) \
-            or u[0] <= 0.0 or u[-1] > h1:
-        raise ValueError(f"u_m: plate displacements must increase within (0, h1] = (0, "
-                         f"{h1 * 1e3:.4g} mm], got {np.round(u * 1e3, 4).tolist()} mm")
+            or u[0] <= -h1 or u[-1] > h1:
+        raise ValueError(f"u_m: plate displacements must increase within (-h1, h1] = ("
+                         f"{-h1 * 1e3:.4g}, {h1 * 1e3:.4g} mm], got {np.round(u * 1e3, 4).tolist()} mm")
     if dp.ndim != 1 or dp.size == 0 or not np.all(np.isfinite(dp)) or dp[0] != 0.0 \
             or np.any(np.diff(dp) <= 0) or dp[-1] > 10.0 * material.E_Pa:
         raise ValueError(f"dp_Pa: cavity pressures must start at 0 and increase, at most 10 E = "

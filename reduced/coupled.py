@@ -8,11 +8,15 @@ pull balances and the gas fills the cavity:
 two equations for the plate displacement u and dp = p_a - p_b (`SuctionTable`: F1 and V as the
 FEM computes them with the suction acting on the deformed cup, so the rigid cone of eqs 3-4, the
 force balance of eq 5 and eq 6's beta are all replaced). At fixed F1 the states form a branch
-parametrised by dp: u(dp) from the first equation (F1 rises with dp and falls with u), N(dp) from
-the second; gas leaks in, N rises, dp falls. The cup starts like the paper's (Sec. 3): released at
-u_start with F1 = 0, which fixes N0; F1 is then applied at fixed N0. It lets go where the branch
-ends: at a fold of N(dp) (no state holds more gas), or where u reaches the table's smallest u (the
-plate back near its free height: the end of the data, reported as such).
+parametrised by u, as the fem route walks it: dp(u) from the first equation (F1 rises with dp),
+N(u) from the second; gas leaks in, N rises, the plate rises (u falls). The cup starts like the
+paper's (Sec. 3): released at u_start with F1 = 0, which fixes N0; it is then raised at fixed N0
+until the handle pulls F1 (the largest pull along that raise is the largest holdable force). It
+lets go where the branch ends: at a fold of N(u) (no state holds more gas), where the seal opens
+(the branch would read a state whose rim has left the plane, `SuctionTable.sealed`: "reached_r1",
+as the fem route's seal opening; the end is the last sample of the branch that reads only sealed
+states, so it lies within the interpolation's reach of the table's last sealed row), or where it
+leaves the table (its smallest u, or more suction than its largest dp: "table_edge").
 
 The leak rate at a state is the series flow through its own contact-pressure profile
 (`reduced.profile_leak`), computed at the table's nodes (p_b = p_a - dp_j exactly there) as the
@@ -33,15 +37,17 @@ every state the interpolation reads is built (`reduced.coupled_holes`); the root
 inside built cells, and a value that would read a hole raises `MissingStates` naming the states
 to add. Where they are built the values are the full table's; without relaxation only.
 
-The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a dp
-grid of `samples` points. A stiffness factor kappa makes the cup kappa times stiffer, as the
+The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a u
+grid of `samples` points from the start to the branch's end (found by a first walk of samples/8). A stiffness factor kappa makes the cup kappa times stiffer, as the
 paper's kappa multiplies F0 (Fig. 1stiffnessFactor): a neo-Hookean body in frictionless contact
 with modulus kappa E answers dp exactly as the table's body answers dp / kappa, so F1(u, dp) =
 kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa) and the contact pressures scale
 likewise, while u_c(p/E) keeps the table's E (the same rubber at the interface, as in the paper
 route). With a relaxation modulus (`relaxation`, `phi0_s`) kappa follows the contact time,
 kappa(phi) = kappa E_eff(phi) / E_eff(phi0) with eq (10), the interface sees E_eff(phi) as on the
-paper route, and (N, phi) is integrated in time: `reduced.coupled_relax`.
+paper route, and (N, phi) is integrated in time: `reduced.coupled_relax`, on the table's rows
+above its last row with an unsealed state only (the pressed rows; that integration does not
+follow the seal's opening, so its branch ends at that edge, as before the raised rows).
 """
 
 from __future__ import annotations
@@ -52,7 +58,7 @@ from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from reduced import coupled_holes as holes
 from reduced.coupled_holes import Holes
@@ -60,7 +66,7 @@ from reduced.coupled_relax import RelaxedParts, relaxed_lifetime, relaxed_parts
 from reduced.coupled_result import _CoupledRecord
 from reduced.gas import AIR, Gas
 from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
-from reduced.suction_table import SuctionTable
+from reduced.suction_table import SealOpen, SuctionTable
 from reduced.table_surface import INTERFACES, TableSurface, solid_profile
 from reduced.viscoelastic import RelaxationModulus
 
@@ -106,6 +112,11 @@ class CoupledCavity:
         if self.relaxation is None and self.phi0_s is not None:
             raise ValueError("phi0_s: the measurement contact time is used only with relaxation; "
                              "give relaxation or drop phi0_s")
+        if self.relaxation is not None and not self.table.all_sealed:
+            # the time integration does not follow the seal's opening: the rows above the last one
+            # with a state without a seal (the pressed rows), so the relaxed branch ends there
+            last_open = int(np.flatnonzero(~self.table.sealed.all(axis=1))[-1])
+            object.__setattr__(self, "table", self.table.rows(np.arange(self.table.u_m.size) > last_open))
         if self.relaxation is not None and not self.table.complete:
             raise ValueError("suction table: relaxation needs a table without holes (its paths "
                              "follow the contact time, not the built states)")
@@ -147,11 +158,14 @@ class CoupledCavity:
     @cached_property
     def _holes(self) -> Holes | None:
         """The table's built states (None: a complete table)."""
-        return None if self.table.complete else Holes(self.table.built, self._u, self._dp, self.along_u)
+        if self.table.complete and self.table.all_sealed:
+            return None
+        return Holes(self.table.built, self._u, self._dp, self.along_u, self.table.sealed)
 
     def _filled(self, z: np.ndarray) -> np.ndarray:
-        """z with 0 at the holes: the surfaces need numbers there; `Holes.need` keeps them unread."""
-        return z if self._holes is None else np.where(self.table.built, z, 0.0)
+        """z with 0 at the holes and the states without a seal: the surfaces need numbers there;
+        `Holes.need` keeps them unread."""
+        return z if self._holes is None else np.where(self._holes.built, z, 0.0)
 
     def Ndot(self, u: float, dp: float) -> float:
         """Molecules per second leaking in at (u, dp): dp times the conductance Ndot / dp,
@@ -186,7 +200,7 @@ class CoupledCavity:
         at dp = 0 its limit, from a 1 Pa difference (nan beyond p_a and at a hole)."""
         E = self.table.E_Pa
         out = np.full((self._u.size, self._dp.size), np.nan)
-        built, memo = self.table.built, self.conductances
+        built, memo = self.table.built & self.table.sealed, self.conductances
         for i in range(self._u.size):
             for j, dp in enumerate(self._dp):
                 if dp > self.p_a_Pa or not built[i, j]:
@@ -274,46 +288,101 @@ class CoupledCavity:
         dp = brentq(lambda d: self.F1(u_start_m, d), 0.0, top, xtol=1e-9)
         return dp, (self.p_a_Pa - dp) * self.V(u_start_m, dp) / self.gas.kT_J
 
-    def loaded(self, F1: float, u_start_m: float) -> tuple[float, float | None, float]:
-        """(N0, dp0, dp_lo): the start content of the cup released at u_start (`start`), the dp of
-        the F1 branch's state that holds it (None if F1 is more than the cup holds with it: the
-        over-force), and the branch's low-dp end inside the table."""
-        _, N0 = self.start(u_start_m)
-        lo, hi = self._dp_range(F1)
-        if not np.isfinite(lo) or N0 > self.content(F1, lo)[1]:
-            return N0, None, lo
+    def dp_holding(self, u: float, value: Callable[[float], float], target: float, rising: bool) -> float | None:
+        """dp in [0, top] with value(dp) = target at the plate displacement u (value monotone in
+        dp, rising or falling); None if the target lies beyond the table's dp range. SealOpen
+        (`reduced.suction_table`) where the crossing lies among states without a seal."""
+        top = self._dp_top
         if self._holes is not None:
-            return N0, holes.holding_dp(self, F1, N0, lo), lo
-        if N0 < self.content(F1, hi)[1]:
-            raise ValueError(f"F1 = {F1:g} N presses the cup beyond the table's u = "
-                             f"{1e3 * self._u[-1]:.4g} mm; extend the table")
-        return N0, brentq(lambda d: self.content(F1, d)[1] - N0, lo, hi, xtol=1e-10 * max(hi, 1.0)), lo
+            found = self._holes.root_cell("dp", u, value, target, rising=rising, top=top)
+            if not isinstance(found, tuple):
+                return None
+            a, b = found
+        else:
+            a, b = 0.0, top
+        sign = 1.0 if rising else -1.0
+        ga, gb = sign * (value(a) - target), sign * (value(b) - target)
+        if ga > 0 or gb < 0:
+            return None
+        if ga == 0 or a == b:
+            return a
+        return brentq(lambda d: value(d) - target, a, b, xtol=1e-9 * max(top, 1.0))
+
+    def _gas(self, u: float, dp: float) -> float:
+        """N [molecules] of the state (u, dp): the gas law (p_a - dp) V = N k_B T."""
+        return (self.p_a_Pa - dp) * self.V(u, dp) / self.gas.kT_J
+
+    def _walk(self, u_from: float, u_to: float, dp_of: Callable[[float], float | None],
+              samples: int, stop: Callable[[float, float], bool] | None = None
+              ) -> tuple[np.ndarray, np.ndarray, str]:
+        """The states (u, dp(u)) from u_from down to u_to on `samples` points, as far as they
+        exist: (u, dp, end) with end "table_edge" (u_to reached, or dp(u) beyond the table's dp),
+        "reached_r1" (the next state reads one without a seal: the seal has opened), or "stop"
+        (stop(u, dp) true at the last state)."""
+        us, dps = [], []
+        end = "table_edge"
+        for u in np.linspace(u_from, u_to, samples):
+            try:
+                dp = dp_of(float(u))
+            except SealOpen:
+                end = "reached_r1"
+                break
+            if dp is None:
+                break
+            us.append(float(u))
+            dps.append(dp)
+            if stop is not None and stop(float(u), dp):
+                end = "stop"
+                break
+        return np.array(us), np.array(dps), end
+
+    def _raised_at(self, N0: float, u_start_m: float, F1: float | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+        """The cup sealed with N0 at u_start and raised at fixed N0 (the plate from u_start to
+        the table's smallest u, or until it pulls F1): (u, dp, F1 along it, how it ends, as `_walk`)."""
+        def dp_of(u: float) -> float | None:
+            return self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False)
+        stop = None if F1 is None else (lambda u, d: self.F1(u, d) >= F1)
+        us, dps, end = self._walk(u_start_m, float(self._u[0]), dp_of, self.samples, stop)
+        return us, dps, np.array([self.F1(u, d) for u, d in zip(us, dps)]), end
+
+    def loaded(self, F1: float, u_start_m: float) -> tuple[float, float | None, float]:
+        """(N0, dp0, u0): the start content of the cup released at u_start (`start`), and the state
+        that holds F1 with it: the cup raised at fixed N0 until the handle pulls F1 (dp0 None if
+        no state on that path pulls F1: more than the cup holds, the over-force)."""
+        _, N0 = self.start(u_start_m)
+        us, dps, pull, _ = self._raised_at(N0, u_start_m, F1)
+        above = np.flatnonzero(pull >= F1)
+        if above.size == 0:
+            return N0, None, math.nan
+        k = int(above[0])
+        if k == 0:
+            return N0, float(dps[0]), float(us[0])
+        def excess(u: float) -> float:
+            return self.F1(u, self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False)) - F1
+        u0 = brentq(excess, us[k], us[k - 1], xtol=1e-13, rtol=1e-12)
+        return N0, self.dp_holding(u0, lambda d: self._gas(u0, d), N0, rising=False), u0
 
     def _largest_force(self, u_start_m: float) -> float:
-        """The largest F1 [N] the cup released at u_start holds at t = 0: the branch at that F1
-        just reaches the start content at its low-dp end (bisection on F1). With relaxation: the
-        cup at t = 0, kappa(phi = 0)."""
+        """The largest F1 [N] the cup released at u_start holds at t = 0: the largest pull of the
+        cup raised at fixed N0 (`loaded`), refined between the samples around it. With
+        relaxation: the cup at t = 0, kappa(phi = 0)."""
         if self.relaxation is not None:
             k0 = self._relaxed.kappa(0.0)[0]
             return replace(self, kappa=k0, relaxation=None, phi0_s=None)._largest_force(u_start_m)
         _, N0 = self.start(u_start_m)
+        us, _, pull, _ = self._raised_at(N0, u_start_m)
+        if pull.size == 0:
+            return 0.0
+        k = int(np.argmax(pull))
+        if k == 0 or k == pull.size - 1:
+            return max(float(pull[k]), 0.0)
 
-        def holds(F1: float) -> bool:
-            lo, _ = self._dp_range(F1)
-            return bool(np.isfinite(lo)) and N0 <= self.content(F1, lo)[1]
-        if self._holes is not None:
-            found = holes.force_cell(self, holds)
-            if not isinstance(found, tuple):
-                return found
-            lo, hi = found
-        else:
-            lo, hi = 0.0, self.F1(self._u[0], self._dp_top)
-            if holds(hi):
-                return hi
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if holds(mid) else (lo, mid)
-        return lo
+        def minus_pull(u: float) -> float:
+            return -self.F1(u, self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False))
+        best = minimize_scalar(minus_pull, bounds=(us[k + 1], us[k - 1]), method="bounded",
+                               options={"xatol": 1e-12})
+        return max(float(-best.fun), float(pull[k]))
 
     def _lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
                   rtol: float = 1e-6) -> _CoupledRecord:
@@ -327,19 +396,27 @@ class CoupledCavity:
             if not (t_max_s > 0 and 0 < rtol < 1e-2):
                 raise ValueError(f"t_max_s, rtol: need t_max_s > 0 and 0 < rtol < 0.01, got {t_max_s}, {rtol}")
             return relaxed_lifetime(self, F1, u_start_m, t_max_s, rtol)
-        N0, dp0, lo = self.loaded(F1, u_start_m)
+        N0, dp0, u0 = self.loaded(F1, u_start_m)
         if dp0 is None:
             return _CoupledRecord(F1, 0.0, "over_force", f"F1 = {F1:g} N exceeds what the cup holds "
                                    f"with its start content: it detaches at once", N0,
                                    *(np.zeros(0),) * 6, p_a_Pa=self.p_a_Pa)
-        dps = np.linspace(dp0, lo, self.samples)
-        u, V = np.array([self._on_branch(F1, d) for d in dps]).T
+
+        def dp_of(u: float) -> float | None:
+            return dp0 if u == u0 else self.dp_holding(u, lambda d: self.F1(u, d), F1, rising=True)
+        # a first walk finds where the branch ends, the second samples it up to there
+        u_end = float(self._u[0])
+        u, _, _ = self._walk(u0, u_end, dp_of, max(self.samples // 8, 11))
+        if u.size < max(self.samples // 8, 11):
+            u_end = float(np.linspace(u0, u_end, max(self.samples // 8, 11))[u.size])
+        u, dps, reason = self._walk(u0, u_end, dp_of, self.samples)
+        V = np.array([self.V(a, b) for a, b in zip(u, dps)])
         N = (self.p_a_Pa - dps) * V / self.gas.kT_J
         rising = np.diff(N) > 0
-        end, reason = self.samples, "table_edge"
         if not np.all(rising):
-            end, reason = int(np.argmin(rising)) + 1, "fold"
-        dps, u, N, V = dps[:end], u[:end], N[:end], V[:end]
+            end = int(np.argmin(rising)) + 1
+            reason = "fold"
+            dps, u, N, V = dps[:end], u[:end], N[:end], V[:end]
         q = np.array([self.Ndot(a, b) for a, b in zip(u, dps)])
         if np.any(q <= 0):
             k = int(np.argmax(q <= 0))
@@ -347,8 +424,10 @@ class CoupledCavity:
                                    f"{1e3 * u[k]:.4g} mm, dp = {dps[k] / 1e3:.4g} kPa", N0,
                                    np.zeros(1), u[:1], dps[:1], N[:1], q[:1], V[:1], p_a_Pa=self.p_a_Pa)
         t = np.concatenate([[0.0], np.cumsum(0.5 * (1 / q[1:] + 1 / q[:-1]) * np.diff(N))])
-        where = ("u reached the table's smallest u = " f"{1e3 * self._u[0]:.4g} mm" if reason == "table_edge"
-                 else "the branch folds: no state holds more gas")
+        where = {"table_edge": "the branch leaves the table (its smallest u = "
+                               f"{1e3 * self._u[0]:.4g} mm or its largest dp)",
+                 "fold": "the branch folds: no state holds more gas",
+                 "reached_r1": f"the seal opens: past u = {1e3 * u[-1]:.4g} mm the rim leaves the plane"}[reason]
         return _CoupledRecord(F1, float(t[-1]), reason, f"detached at t = {t[-1]:.4g} s: {where}", N0,
                                t, u, dps, N, q, V, p_a_Pa=self.p_a_Pa)
 

@@ -9,7 +9,9 @@ one is missing `Holes.need` raises `MissingStates` naming the missing nodes, so 
 can add them, instead of reading a hole. `Holes.root_cell` finds, along one line of the grid,
 the built cell in which a monotone quantity crosses a target; the functions below are the root
 finders of `reduced.coupled.CoupledCavity` (`cc`) on a table with holes, bracketed there instead
-of across the whole table, with its tolerances.
+of across the whole table, with its tolerances. A state without a seal (`SuctionTable.sealed`
+False) is built but not readable: a value that reads one raises `SealOpen` (the cup has let go
+there) instead of `MissingStates`, unless it also reads a hole.
 """
 
 from __future__ import annotations
@@ -23,17 +25,20 @@ import numpy as np
 
 from scipy.optimize import brentq
 
-from reduced.suction_table import MissingStates
+from reduced.suction_table import MissingStates, SealOpen
 from reduced.table_surface import cell
 
 __all__ = ["Holes", "dp_low", "force_cell", "holding_dp", "start_dp", "u_at"]
 
 
 class Holes:
-    """The built nodes of a table on the axes u [m] and dp [Pa] (module docstring)."""
+    """The built nodes of a table on the axes u [m] and dp [Pa], and which of them hold a seal
+    (None: all; module docstring)."""
 
-    def __init__(self, built: np.ndarray, u: np.ndarray, dp: np.ndarray, along_u: str):
-        self.built = np.asarray(built, dtype=bool)
+    def __init__(self, built: np.ndarray, u: np.ndarray, dp: np.ndarray, along_u: str,
+                 sealed: np.ndarray | None = None):
+        self.solved = np.asarray(built, dtype=bool)
+        self.built = self.solved if sealed is None else self.solved & np.asarray(sealed, dtype=bool)
         self.u, self.dp, self.cubic = u, dp, along_u == "pchip"
         self._u_list, self._dp_list = u.tolist(), dp.tolist()
         self._lines: dict[tuple, tuple[int, list[bool], list[int]]] = {}
@@ -51,7 +56,7 @@ class Holes:
         return range(j, j + 1) if t == 0.0 else range(j + 1, j + 2) if t == 1.0 else range(j, j + 2)
 
     def missing(self, u: float, dp: float) -> list[tuple[int, int]]:
-        """The nodes (i, j) the value at (u, dp) reads that the table lacks."""
+        """The nodes (i, j) the value at (u, dp) reads that the table lacks or that hold no seal."""
         i, j, s, t = cell(self.u, self.dp, u, dp)
         rows, cols = self.rows(i, s), self.cols(j, t)
         block = self.built[rows.start:rows.stop, cols.start:cols.stop]
@@ -60,10 +65,18 @@ class Holes:
         return [(rows.start + a, cols.start + b) for a, b in zip(*np.nonzero(~block))]
 
     def need(self, u: float, dp: float) -> None:
-        """MissingStates if the value at (u, dp) reads a hole."""
+        """MissingStates if the value at (u, dp) reads a hole, else SealOpen if it reads a state
+        without a seal."""
         lacking = self.missing(u, dp)
         if lacking:
-            raise MissingStates(lacking, self.u, self.dp, f"at u = {1e3 * u:.4g} mm, dp = {dp / 1e3:.4g} kPa")
+            self.unreadable(lacking, f"at u = {1e3 * u:.4g} mm, dp = {dp / 1e3:.4g} kPa")
+
+    def unreadable(self, nodes, where: str):
+        """Raise MissingStates for the nodes not built, else SealOpen for those without a seal."""
+        holes = [(i, j) for i, j in nodes if not self.solved[i, j]]
+        if holes:
+            raise MissingStates(holes, self.u, self.dp, where)
+        raise SealOpen(nodes, self.u, self.dp, where)
 
     def cell_missing(self, axis: str, k: int, fixed: float) -> list[tuple[int, int]]:
         """The missing nodes of interval k of `axis` on the line where the other coordinate is `fixed`."""
@@ -94,9 +107,10 @@ class Holes:
         MissingStates (`gap_missing`) where the crossing lies in cells not built."""
         xs = self._u_list if axis == "u" else self._dp_list
         last, ok, nodes = self.line(axis, fixed, top)
-        if not nodes:
-            raise MissingStates(self.cell_missing(axis, 0, fixed), self.u, self.dp,
-                                f"along {axis} at {fixed:.6g}: nothing built")
+        if not nodes:                  # no readable cell: the states not built come first
+            cells = [self.cell_missing(axis, k, fixed) for k in range(max(last, 1))]
+            unsolved = sorted({n for c in cells for n in c if not self.solved[n]})
+            self.unreadable(unsolved or cells[0], f"along {axis} at {fixed:.6g}: nothing built")
         sign = 1.0 if rising else -1.0
         at = lambda k: min(xs[k], top)                                    # noqa: E731
         g = lambda k: sign * (value(at(k)) - target)                       # noqa: E731
@@ -123,14 +137,18 @@ class Holes:
             if nodes[hi] == k + 1 and ok[k]:
                 return at(k), at(k + 1)
             gap = (k, nodes[hi] - 1, "")
-        raise MissingStates(self.gap_missing(axis, fixed, *gap), self.u, self.dp,
-                            f"along {axis} at {fixed:.6g}, where the value crosses {target:.6g}")
+        self.unreadable(self.gap_missing(axis, fixed, *gap),
+                        f"along {axis} at {fixed:.6g}, where the value crosses {target:.6g}")
 
     def gap_missing(self, axis: str, fixed: float, a: int, b: int, runs: str = "") -> list[tuple[int, int]]:
         """The missing nodes of the cells a ... b of a line in which a crossing lies unseen: of
         the cells next to built ones (the gap `runs` 'down' to the line's start or 'up' to its
-        end: only b, or only a, is) and the middle one (a builder bisects a long gap)."""
-        cells = {(a + b) // 2} | ({b} if runs == "down" else {a} if runs == "up" else {a, b})
+        end: only b, or only a, is) and the middle one (a builder bisects a long gap); every cell
+        of a gap of at most 24 cells (a short gap is filled in one round)."""
+        if b - a <= 24:                                   # a short gap: all of it, in one round
+            cells = set(range(a, b + 1))
+        else:
+            cells = {(a + b) // 2} | ({b} if runs == "down" else {a} if runs == "up" else {a, b})
         return sorted({n for k in cells for n in self.cell_missing(axis, k, fixed)})
 
 
@@ -191,7 +209,7 @@ def force_cell(cc: Any, holds: Callable[[float], bool]) -> tuple[float, float] |
     last, ok, nodes = holes.line("dp", u0, top)
     force = lambda k: cc.F1(u0, min(float(cc._dp[k]), top))          # noqa: E731
     if not nodes:
-        raise MissingStates(holes.cell_missing("dp", 0, u0), cc._u, cc._dp, "on the smallest u's row")
+        holes.unreadable(holes.cell_missing("dp", 0, u0), "on the smallest u's row")
     a, b = 0, len(nodes) - 1
     if holds(force(nodes[b])):
         if nodes[b] == last:
@@ -209,4 +227,4 @@ def force_cell(cc: Any, holds: Callable[[float], bool]) -> tuple[float, float] |
         if nodes[b] == k + 1 and ok[k]:
             return force(k), force(k + 1)
         gap = (k, nodes[b] - 1, "")
-    raise MissingStates(holes.gap_missing("dp", u0, *gap), cc._u, cc._dp, "where the largest holdable force lies")
+    holes.unreadable(holes.gap_missing("dp", u0, *gap), "where the largest holdable force lies")

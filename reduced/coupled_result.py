@@ -20,7 +20,8 @@ class _CoupledRecord:
 
     force_N: float
     lifetime_s: float
-    reason: str              # "table_edge", "fold", "sealed", "over_force" (relaxed: also "horizon")
+    reason: str              # "table_edge", "fold", "reached_r1" (the seal opened), "sealed", "over_force"
+    #                          (relaxed: also "horizon")
     message: str
     N0: float
     t_s: np.ndarray

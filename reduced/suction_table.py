@@ -2,7 +2,10 @@
 cavity pressure difference dp = p_a - p_b, as plain data (a `SuctionTable`).
 
 For every (u_i, dp_j) the table holds (a table may have holes: states only where the cup's
-paths go, the others null in every grid and profile; `built`): the pull on the handle F1 (eq. 5's F1 with the suction acting on the
+paths go, the others null in every grid and profile; `built`; and states without a seal: at
+u <= 0, the plate above the free cup's touching height, and small dp the rim does not reach the
+plane, `sealed` False there and null in every grid and profile, no numbers for a cup that holds
+no suction; `SealOpen` where a value would read one): the pull on the handle F1 (eq. 5's F1 with the suction acting on the
 deformed cup), the cavity volume V, the seal radius r_k (the cavity's edge), the outer edge r_cut
 of the contact zone next to it, and the contact-pressure profile p(r) across that zone, the
 pressure the plane carries with the interface gas at p_b. It comes from the FEM
@@ -13,6 +16,7 @@ JSON (one file; units in the key names)::
 
     {"u_mm": [...], "dp_kPa": [...], "F1_N": [[...]], "V_mm3": [[...]], "seal_r_mm": [[...]],
      "cut_r_mm": [[...]], "E_Pa": 4e6, "profiles": [[{"r_mm": [...], "p_kPa": [...]}, ...]],
+     "sealed": [[true, false, ...]],          (optional: absent means every state is sealed)
      "provenance": {...}}
 """
 
@@ -30,7 +34,7 @@ import numpy as np
 
 from reduced.profile_leak import ContactProfile
 
-__all__ = ["MissingStates", "SuctionTable"]
+__all__ = ["MissingStates", "SealOpen", "SuctionTable"]
 
 _GRIDS = {"F1_N": ("F1_N", 1.0), "V_mm3": ("V_m3", 1e-9), "seal_r_mm": ("seal_r_m", 1e-3),
           "cut_r_mm": ("cut_r_m", 1e-3)}
@@ -49,10 +53,24 @@ class MissingStates(LookupError):
                          + (", ..." if len(self.nodes) > 3 else ""))
 
 
+class SealOpen(LookupError):
+    """A value read at a state without a seal (`SuctionTable.sealed` False): the cup there holds
+    no suction, so a path reaching it has let go. `nodes`, `u_m`, `dp_Pa` as `MissingStates`."""
+
+    def __init__(self, nodes, u_axis: np.ndarray, dp_axis: np.ndarray, where: str = ""):
+        self.nodes = tuple(sorted({(int(i), int(j)) for i, j in nodes}))
+        self.u_m = tuple(float(u_axis[i]) for i, _ in self.nodes)
+        self.dp_Pa = tuple(float(dp_axis[j]) for _, j in self.nodes)
+        first = ", ".join(f"({1e3 * u:.4g} mm, {d / 1e3:.4g} kPa)" for u, d in zip(self.u_m[:3], self.dp_Pa[:3]))
+        super().__init__(f"suction table: the seal is open {where}: (u, dp) = {first}"
+                         + (", ..." if len(self.nodes) > 3 else ""))
+
+
 @dataclass(frozen=True, eq=False)
 class SuctionTable:
     """The cup's states on the (u, dp) grid (module docstring); grids are [len(u), len(dp)],
-    nan in each of them (and None in profiles) where the table has a hole."""
+    nan in each of them (and None in profiles) where the table has a hole or the state holds no
+    seal (`sealed` False; None: every state is sealed)."""
 
     u_m: np.ndarray
     dp_Pa: np.ndarray
@@ -63,11 +81,12 @@ class SuctionTable:
     profiles: tuple[tuple[ContactProfile | None, ...], ...]
     E_Pa: float
     provenance: dict[str, Any] = field(default_factory=dict)
+    sealed: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         u, dp = (np.array(a, dtype=float) for a in (self.u_m, self.dp_Pa))
-        if u.ndim != 1 or u.size < 2 or np.any(np.diff(u) <= 0) or u[0] < 0:
-            raise ValueError("u_mm: the plate displacements must be >= 0 and strictly increasing (>= 2)")
+        if u.ndim != 1 or u.size < 2 or np.any(np.diff(u) <= 0) or not np.all(np.isfinite(u)):
+            raise ValueError("u_mm: the plate displacements must be finite and strictly increasing (>= 2)")
         if dp.ndim != 1 or dp.size < 2 or np.any(np.diff(dp) <= 0) or dp[0] != 0.0:
             raise ValueError("dp_kPa: the pressure differences must start at 0 and strictly increase (>= 2)")
         hole = None
@@ -82,6 +101,13 @@ class SuctionTable:
                                  f"(nan only at a hole, and there in every grid{holes}), got other non-finite values")
             a.flags.writeable = False
             object.__setattr__(self, name, a)
+        sealed = np.ones(hole.shape, dtype=bool) if self.sealed is None else np.array(self.sealed)
+        if sealed.shape != hole.shape or sealed.dtype != bool:
+            raise ValueError(f"sealed: expected true/false on the {u.size} x {dp.size} grid")
+        if not np.all(hole[~sealed]):
+            raise ValueError("sealed: a state without a seal must be null in every grid and profile")
+        sealed.flags.writeable = False
+        object.__setattr__(self, "sealed", sealed)
         if np.any(self.V_m3[~hole] <= 0):
             raise ValueError("V_mm3: cavity volumes must be > 0")
         if len(self.profiles) != u.size or any(len(row) != dp.size for row in self.profiles):
@@ -96,8 +122,8 @@ class SuctionTable:
 
     @cached_property
     def built(self) -> np.ndarray:
-        """[len(u), len(dp)] True where the table holds the state (False: a hole)."""
-        built = np.isfinite(self.F1_N)
+        """[len(u), len(dp)] True where the table holds the state, sealed or not (False: a hole)."""
+        built = np.isfinite(self.F1_N) | ~self.sealed
         built.flags.writeable = False
         return built
 
@@ -105,6 +131,18 @@ class SuctionTable:
     def complete(self) -> bool:
         """Whether the table holds every state of its grid (no holes)."""
         return bool(self.built.all())
+
+    @cached_property
+    def all_sealed(self) -> bool:
+        """Whether every state of the table holds a seal."""
+        return bool(self.sealed.all())
+
+    def rows(self, keep: np.ndarray) -> "SuctionTable":
+        """The table on the rows of u where `keep` is True."""
+        k = np.asarray(keep, dtype=bool)
+        return SuctionTable(u_m=self.u_m[k], dp_Pa=self.dp_Pa, **{name: getattr(self, name)[k] for name, _ in _GRIDS.values()},
+                            profiles=tuple(row for row, ok in zip(self.profiles, k) if ok), E_Pa=self.E_Pa,
+                            provenance=self.provenance, sealed=None if self.sealed[k].all() else self.sealed[k])
 
     @property
     def h1_m(self) -> float:
@@ -121,6 +159,7 @@ class SuctionTable:
                 "profiles": [[None if p is None else {"r_mm": (p.r_m * 1e3).tolist(),
                                                       "p_kPa": (p.p_Pa / 1e3).tolist()} for p in row]
                              for row in self.profiles],
+                **({} if self.all_sealed else {"sealed": self.sealed.tolist()}),
                 "provenance": self.provenance}
         tmp = path.with_name(path.name + ".tmp")
         tmp.write_text(json.dumps(data))
@@ -150,9 +189,14 @@ class SuctionTable:
             profiles = tuple(tuple(_profile(p, f"profiles[{i}][{j}]") for j, p in enumerate(row))
                              for i, row in enumerate(data["profiles"]))
             grids = {name: _numbers(data[key], key) * scale for key, (name, scale) in _GRIDS.items()}
+            sealed = data.get("sealed")
+            if sealed is not None and not (isinstance(sealed, list) and all(
+                    isinstance(row, list) and all(isinstance(x, bool) for x in row) for row in sealed)):
+                raise ValueError("sealed: expected rows (lists) of true/false")
             return cls(u_m=_numbers(data["u_mm"], "u_mm") * 1e-3, dp_Pa=_numbers(data["dp_kPa"], "dp_kPa") * 1e3,
                        **grids, profiles=profiles, E_Pa=float(_numbers(data["E_Pa"], "E_Pa", scalar=True)),
-                       provenance=provenance)
+                       provenance=provenance,
+                       sealed=None if sealed is None else np.array(sealed, dtype=bool).reshape(len(sealed), -1))
         except ValueError as err:
             field_, _, rest = str(err).partition(": ")
             spelled = {name: key for key, (name, _) in _GRIDS.items()}.get(field_, field_)   # as the file spells it

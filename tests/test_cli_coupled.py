@@ -88,7 +88,7 @@ def test_coupled_route_bad_input(capsys, table_path, tmp_path, argv, field):
 
 @pytest.mark.parametrize("extra, field", [
     (["--dp-kPa", "10", "20"], "dp_kPa"), (["--dp-kPa", "0", "2000"], "dp_kPa"),
-    (["--u-mm", "0", "1"], "u_mm"), (["--u-mm", "3", "1"], "u_mm"), (["--u-mm", "50"], "u_mm"),
+    (["--u-mm", "-50", "1"], "u_mm"), (["--u-mm", "3", "1"], "u_mm"), (["--u-mm", "50"], "u_mm"),
     (["--nu", "0.499"], "nu"), (["--E-MPa", "-1"], "E"),
     (["--force", "5"], "--force: applies to --grid adaptive only"),
     (["--surface", "pmma-1.89"], "--surface: applies to --grid adaptive only"),

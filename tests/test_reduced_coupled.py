@@ -248,3 +248,29 @@ def test_the_coupled_leak_through_a_lone_loaded_node_converges_with_its_spacing(
     assert d2 < 0.5 * d1 and d2 < 0.02
     raw = replace(uc, patch_length_m=None)
     assert conductance(L / 256, raw) == 0.0                 # the lumped peak seals
+
+
+def test_unsealed_row_ends_the_branch_and_relaxation_reads_the_pressed_rows(model):
+    """A row below the table whose states hold no seal (the rim off the plane): the branch that
+    would read it ends there ("reached_r1", before the table without the row ends at its edge; a
+    value there raises SealOpen, never a number), and the relaxed integration keeps to the rows
+    above it (the same lifetime as without the row)."""
+    from reduced.suction_table import SealOpen
+
+    t = paper_table(model, 21, 21)
+    n = t.dp_Pa.size
+    grids = {k: np.vstack([np.full((1, n), np.nan), getattr(t, k)]) for k in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
+    sealed = np.vstack([np.zeros((1, n), bool), np.ones(t.F1_N.shape, bool)])
+    raised = SuctionTable(u_m=np.concatenate([[t.u_m[0] - 1e-3], t.u_m]), dp_Pa=t.dp_Pa, **grids,
+                          profiles=((None,) * n,) + t.profiles, E_Pa=t.E_Pa, provenance=t.provenance,
+                          sealed=sealed)
+    base = solve_lifetime(replace(model, suction=t), 10.0, route="coupled")
+    opened = solve_lifetime(replace(model, suction=raised), 10.0, route="coupled")
+    assert base.reason == "table_edge" and opened.reason == "reached_r1"
+    assert opened.lifetime_s < base.lifetime_s
+    cavity = CoupledCavity(raised, model.u_c)
+    with pytest.raises(SealOpen):
+        cavity.F1(float(raised.u_m[0]), float(raised.dp_Pa[5]))
+    relax = dict(relaxation=default_relaxation(), phi0_s=measurement_contact_time(model.cup))
+    assert solve_lifetime(replace(model, suction=raised, **relax), 10.0, route="coupled").lifetime_s == \
+        solve_lifetime(replace(model, suction=t, **relax), 10.0, route="coupled").lifetime_s

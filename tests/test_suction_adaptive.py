@@ -112,24 +112,25 @@ def test_refinement_goes_only_where_the_estimate_asks(paper_lattice):
 # ---------------------------------------------------------------- cup A's FEM table (slow)
 @pytest.mark.slow
 def test_adaptive_lifetimes_are_the_full_tables():
-    """Cup A, coarse, frictionless, pmma-1.89, built for 5, 10, 20, 40 N: the table with holes
-    around the paths (the default) gives the full default grid's lifetimes and largest holdable
+    """Cup A, coarse, frictionless, pmma-1.89, built for 5, 10, 20, 40 N on the default grid's
+    pressed rows (u > 0; the raised rows: tests/test_fem_route.py's mu0 check): the table with holes
+    around the paths (the default) gives the full grid's lifetimes and largest holdable
     force to the FEM solver's tolerance (its states are the grid's, reached by other ramps) from
     a tenth of its states; the tensor sub-grid (AdaptiveSpec) to 0.5 %, from a third."""
-    from validation.bridge.coupled.build import AdaptiveSpec, suction_table_for
+    from validation.bridge.coupled.build import PRESSED_GRID, AdaptiveSpec, suction_table_for
     from validation.cli import build_parser
     from validation.commands.lifetime import build_model, build_uc
 
     args = build_parser().parse_args(["lifetime", "--surface", "pmma-1.89"])
     model = build_model(args).model
     goal = SuctionGoal(replace(model, stiffness=None, u_c=build_uc(args)), (5.0, 10.0, 20.0, 40.0))
-    full = suction_table_for("A", fidelity="coarse")
+    full = suction_table_for("A", fidelity="coarse", grid=PRESSED_GRID)
     expected = _lifetimes(goal, full)
     assert np.all(expected[:3] > 0) and expected[3] == 0.0      # 40 N: over the largest force
-    around = suction_table_for("A", fidelity="coarse", goal=goal)
+    around = suction_table_for("A", fidelity="coarse", goal=goal, grid=PRESSED_GRID)
     np.testing.assert_allclose(_lifetimes(goal, around), expected, rtol=SolverOptions().rtol, atol=0)
     assert around.provenance["states_solved"] < full.u_m.size * full.dp_Pa.size / 10 and not around.complete
-    tensor = suction_table_for("A", fidelity="coarse", goal=goal, adaptive=AdaptiveSpec())
+    tensor = suction_table_for("A", fidelity="coarse", goal=goal, adaptive=AdaptiveSpec(), grid=PRESSED_GRID)
     np.testing.assert_allclose(_lifetimes(goal, tensor), expected, rtol=5e-3)
     assert tensor.provenance["states_solved"] < full.u_m.size * full.dp_Pa.size / 3
 
@@ -147,3 +148,43 @@ def test_goal_only_where_the_adaptive_table_holds():
     assert goal_for(replace(model, relaxation=default_relaxation(), phi0_s=13.0), [5]) is None
     with pytest.raises(ValueError, match="forces_N"):
         goal_for(model, [0.0])
+
+
+# ---------------------------------------------------------------- raised states (u <= 0)
+def test_raised_states_are_the_sealed_gas_cups_and_open_without_suction(coarse_cup, tmp_path):
+    """Above the touching height (u < 0) a dp-driven state, reached by raising the plate at fixed
+    dp, is the state of the sealed cup raised at fixed gas content N (`fem.gas_path`, a path in
+    N, not in dp) at that state's dp: frictionless states do not depend on the path. Without
+    suction the raised cup hangs free: no seal, no pull. Unsealed states are null in the table
+    and a value that reads one raises SealOpen."""
+    from fem.gas_branch import equilibrium_branch
+    from fem.gas_path import CupWithGas
+    from reduced.suction_table import SealOpen, SuctionTable
+    from reduced.coupled import CoupledCavity
+    from validation.bridge.coupled.table import suction_table
+
+    mesh, h1 = coarse_cup
+    gas = CupWithGas.of(mesh, NeoHookean())
+    branch = equilibrium_branch(gas, gas.press(0.5 * h1)[-1], F1_N=10.0)   # held at 10 N, N rising
+    raised = next(s for s in branch.states if s.u_m < 0)
+    dp = gas.p_a_Pa - raised.p_b_Pa
+    assert dp > 0 and raised.F1_N == pytest.approx(10.0, rel=0.01)
+    states = SuctionStates(mesh, NeoHookean())
+    F1, N, V, r_k, *_, closed = states.state(raised.u_m, dp)
+    assert closed and N > 0
+    assert F1 == pytest.approx(raised.F1_N, rel=1e-5, abs=1e-5 * abs(raised.F1_N) + 1e-6)
+    assert V == pytest.approx(raised.V_m3, rel=1e-6) and r_k == pytest.approx(raised.seal_r_m, rel=1e-6)
+
+    u, dps = np.array([raised.u_m, 0.1 * h1]), np.array([0.0, dp])
+    grid = SuctionStates(mesh, NeoHookean()).grid(u, dps)
+    assert grid.sealed.tolist() == [[False, True], [True, True]]
+    assert abs(grid.F1_N[0, 0]) < 1e-9                       # the free cup carries nothing
+    assert grid.F1_N[0, 1] == pytest.approx(F1, rel=1e-9)      # raised from the anchor, then kept
+    table = suction_table(grid)
+    assert np.isnan(table.F1_N[0, 0]) and table.profiles[0][0] is None and table.built.all()
+    back = SuctionTable.from_json(table.to_json(tmp_path / "table.json"))
+    assert back.sealed.tolist() == table.sealed.tolist() and np.isnan(back.V_m3[0, 0])
+    cavity = CoupledCavity(table, lambda x: 1e-6, along_u="linear")
+    with pytest.raises(SealOpen, match="seal is open"):
+        cavity.F1(u[0], 0.5 * dp)
+    assert cavity.F1(u[0], dp) == pytest.approx(F1, rel=1e-12)

@@ -1,15 +1,18 @@
 """Compute a cup's response to the cavity's suction on a (u, dp) grid: the input of the coupled route.
 
-For every plate displacement u the cup is pressed onto the plane without suction, then the
-pressure difference dp = p_a - p_b is ramped on its cavity surface with the plate held
-(`fem.suction`). Writes a JSON table (`reduced.suction_table.SuctionTable`: per (u, dp) the pull
+For every plate displacement u > 0 the cup is pressed onto the plane without suction, then the
+pressure difference dp = p_a - p_b is ramped on its cavity surface with the plate held; at
+u <= 0 (the plate above the free cup's touching height) the plate is raised at fixed dp, and a
+state whose rim has left the plane is marked as holding no seal (`fem.suction`). Writes a JSON table (`reduced.suction_table.SuctionTable`: per (u, dp) the pull
 on the handle F1, the cavity volume, the seal radius and the contact-pressure profile) that
 `cupcheck lifetime --route coupled --suction-table FILE` reads. Every input is checked before the
 solve (one line, exit 2); a solve that fails exits 1; no file is left behind either way.
 
 --grid adaptive builds only the rows and columns of that grid which the lifetimes at --force on
 --surface need (`validation.bridge.coupled.adaptive`: refined where the interpolation changes
-those lifetimes); --grid full (the default) builds every state.
+those lifetimes), among its pressed rows u > 0 (its lifetimes end at that edge); --grid full (the
+default) builds every state. Lifetimes past the touching height build their table around their
+paths (`validation.bridge.coupled.around`, as `lifetime --route coupled` does).
 
 The contact law is --contact (with --friction for coulomb), else the --geometry file's [contact]
 table, else frictionless; the table's provenance records it and where it came from.
@@ -48,8 +51,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default="medium",
                    help="mesh level (default medium)")
     r.add_argument("--u-mm", type=float, nargs="+", default=None, dest="u_mm", metavar="U",
-                   help="plate displacements [mm], increasing, in (0, h1] (default: 105 values "
-                        "from 0.001 to 0.8 h1, graded towards 0)")
+                   help="plate displacements [mm], increasing, in (-h1, h1]; u <= 0 is the plate "
+                        "above the free cup's touching height, raised at fixed dp (default: 226 "
+                        "values, -0.6 ... 0 h1 every 0.005 h1 and 105 from 0.001 to 0.8 h1, graded "
+                        "towards 0)")
     r.add_argument("--dp-kPa", type=float, nargs="+", default=list(DEFAULT_GRID.dp_kPa), dest="dp_kPa",
                    metavar="DP",
                    help="pressure differences p_a - p_b [kPa], from 0, increasing, at most 1000 "
@@ -99,7 +104,9 @@ def _adaptive(args: argparse.Namespace, job: dict, provenance: dict, progress):
     from validation.bridge.coupled.table import suction_table
 
     states = SuctionStates(job["mesh"], job["material"], job["contact"].contact)
-    u, dp = job["u_m"], job["dp_Pa"]
+    # the adaptive rows and columns follow the branches to the pressed rows' edge (u > 0): its
+    # refinement reads the branch's end at the table's smallest u, not the seal's opening
+    u, dp = job["u_m"][job["u_m"] > 0], job["dp_Pa"]
 
     def table_on(iu, jd):
         return suction_table(states.grid(u[list(iu)], dp[list(jd)], progress=progress), provenance)
@@ -137,8 +144,8 @@ def _prepare(args: argparse.Namespace) -> dict:
     mesh = cup_mesh(geo, args.fidelity)
     h1 = cup_height(mesh)
     u = DEFAULT_GRID.u_m(h1) if args.u_mm is None else 1e-3 * np.array(args.u_mm, float)
-    if not (np.all(np.isfinite(u)) and np.all(np.diff(u) > 0) and u[0] > 0 and u[-1] <= h1 * (1 + 1e-9)):
-        raise ValueError(f"u_mm: plate displacements must increase within (0, h1] = (0, "
+    if not (np.all(np.isfinite(u)) and np.all(np.diff(u) > 0) and u[0] > -h1 and u[-1] <= h1 * (1 + 1e-9)):
+        raise ValueError(f"u_mm: plate displacements must increase within (-h1, h1] = ({-1e3 * h1:.6g}, "
                          f"{1e3 * h1:.6g}] mm, got {args.u_mm}")
     dp = np.array(args.dp_kPa, float)
     if not (np.all(np.isfinite(dp)) and dp[0] == 0 and np.all(np.diff(dp) > 0) and dp[-1] <= 1000

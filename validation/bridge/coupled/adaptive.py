@@ -59,16 +59,24 @@ class AdaptiveSpec:
 @dataclass(frozen=True)
 class SuctionGoal:
     """What the table is for: a `reduced.LeakageModel` without its table (cup, u_c, gas, kappa,
-    interface) and the pull forces [N] whose lifetimes it must give."""
+    interface), the pull forces [N] whose lifetimes it must give, and the plate displacement [m]
+    the cup is released at (None: the route's default, from the cup's h_start). For the build
+    around the paths (`validation.bridge.coupled.around`): `hint`, points (u [m], dp [Pa]) near
+    which the paths are expected (empty: found on a seed grid), and whether the largest holdable
+    force is asked too (`largest`)."""
 
     model: Any
     forces_N: tuple[float, ...]
+    u_start_m: float | None = None
+    hint: tuple[tuple[float, float], ...] = ()
+    largest: bool = True
 
     def __post_init__(self) -> None:
         forces = tuple(float(f) for f in self.forces_N)
         if not forces or not all(math.isfinite(f) and f > 0 for f in forces):
             raise ValueError(f"forces_N: need pull forces > 0 N, got {self.forces_N}")
         object.__setattr__(self, "forces_N", forces)
+        object.__setattr__(self, "hint", tuple((float(u), float(dp)) for u, dp in self.hint))
 
 
 @dataclass(frozen=True)
@@ -120,7 +128,7 @@ def lattice_subtable(table, u_index: Sequence[int], dp_index: Sequence[int]):
     cut = {name: getattr(table, name)[np.ix_(iu, jd)] for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
     return SuctionTable(u_m=table.u_m[iu], dp_Pa=table.dp_Pa[jd], **cut, E_Pa=table.E_Pa,
                         profiles=tuple(tuple(table.profiles[i][j] for j in jd) for i in iu),
-                        provenance=table.provenance)
+                        provenance=table.provenance, sealed=table.sealed[np.ix_(iu, jd)])
 
 
 def adaptive_axes(table_on: Callable[[tuple[int, ...], tuple[int, ...]], Any], n_u: int, n_dp: int,

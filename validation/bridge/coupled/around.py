@@ -10,11 +10,16 @@ a state reached by another dp ramp is the same state for frictionless contact). 
 
 1. the seed: the goal's paths (its forces, the start and the largest holdable force) on the
    tensor sub-grid of every `u_every`-th u and `dp_every`-th dp: cheap, and within a few
-   lattice cells of the full table's paths;
+   lattice cells of the full table's paths; or, where the goal gives a hint (points near which
+   the paths are expected, e.g. another route's trajectories), the cells around those points
+   (a row and four dp columns either side);
 2. on the lattice, the states the interpolation of those paths reads, widened by `margin` cells;
 3. the goal's lifetimes and largest holdable force on that table; where they read a hole, the
    missing states (widened by `margin`) are added and they are computed again, until they run
-   through. What they read then is built, and nothing else is asked of the table.
+   through. A missing state in a raised row (u <= 0) brings with it the `reach` rows below it,
+   in its column and two more either side: there the paths run down in u at nearly constant dp
+   (the plate rising as the gas leaks in), and a round that adds one row at a time would need one
+   round per row. What they read then is built, and nothing else is asked of the table.
 
 The cost and the lifetimes against the full grid: benchmarks/bench_coupled.py --around.
 """
@@ -41,6 +46,7 @@ class AroundSpec:
     dp_every: int = 5
     margin: int = 0
     max_rounds: int = 100
+    reach: int = 4
 
     def __post_init__(self) -> None:
         if not all(isinstance(k, int) and k >= 1 for k in (self.u_every, self.dp_every, self.max_rounds)):
@@ -48,6 +54,8 @@ class AroundSpec:
                              f"{self.u_every}, {self.dp_every}, {self.max_rounds}")
         if not (isinstance(self.margin, int) and self.margin >= 0):
             raise ValueError(f"margin: need an integer >= 0, got {self.margin}")
+        if not (isinstance(self.reach, int) and self.reach >= 0):
+            raise ValueError(f"reach: need an integer >= 0, got {self.reach}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,7 +77,7 @@ def holed_subtable(table, built: np.ndarray):
     return SuctionTable(u_m=table.u_m, dp_Pa=table.dp_Pa, **cut, E_Pa=table.E_Pa,
                         profiles=tuple(tuple(p if built[i, j] else None for j, p in enumerate(row))
                                        for i, row in enumerate(table.profiles)),
-                        provenance=table.provenance)
+                        provenance=table.provenance, sealed=table.sealed | ~built)
 
 
 def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goal: SuctionGoal,
@@ -77,17 +85,24 @@ def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goa
     """The table with holes the goal's lifetimes read (module docstring). table_on(built) returns
     the `SuctionTable` on the lattice with the states `built` [n_u, n_dp] (solving what it lacks)."""
     asked = np.zeros((n_u, n_dp), dtype=bool)
-    U = sorted(set(range(0, n_u, spec.u_every)) | {n_u - 1})
-    D = sorted(set(range(0, n_dp, spec.dp_every)) | {n_dp - 1})
-    asked[np.ix_(U, D)] = True
-    lattice = table_on(asked)
-    reads = _Reads(lattice.u_m, goal.model.kappa * lattice.dp_Pa)
     memo: dict = {}                                   # node conductances, shared by the rounds
     built = np.zeros_like(asked)
-    for u, dp in _path_points(goal, _compressed(lattice, U, D), memo):
-        _widen(built, reads(u, dp), spec.margin)
+    if goal.hint:                                     # the paths' expected points: no seed grid
+        lattice = table_on(asked)
+        reads = _Reads(lattice.u_m, goal.model.kappa * lattice.dp_Pa)
+        for u, dp in goal.hint:
+            _widen(built, reads(u, dp), max(spec.margin, 1), cols=4)
+    else:
+        U = sorted(set(range(0, n_u, spec.u_every)) | {n_u - 1})
+        D = sorted(set(range(0, n_dp, spec.dp_every)) | {n_dp - 1})
+        asked[np.ix_(U, D)] = True
+        lattice = table_on(asked)
+        reads = _Reads(lattice.u_m, goal.model.kappa * lattice.dp_Pa)
+        for u, dp in _path_points(goal, _compressed(lattice, U, D), memo):
+            _widen(built, reads(u, dp), spec.margin)
     rounds = []
-    every = list(range(len(goal.forces_N) + 1))       # the lifetimes, then the largest force
+    # the lifetimes, then (unless the goal leaves it out) the largest force
+    every = list(range(len(goal.forces_N) + int(goal.largest)))
     pending = every
     for _ in range(spec.max_rounds):
         asked |= built
@@ -100,6 +115,7 @@ def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goa
         if not missing:
             return AroundBuild(table, asked, tuple(rounds))
         _widen(built, missing, spec.margin)
+        _reach_down(built, missing, lattice.u_m, spec.reach)
     raise RuntimeError(f"suction table around the paths: states still missing after {spec.max_rounds} rounds")
 
 
@@ -115,11 +131,21 @@ class _Reads:
         return self.holes.missing(u, dp)
 
 
-def _widen(built: np.ndarray, nodes, margin: int) -> None:
-    """Mark `nodes` and every node within `margin` cells of one as built."""
-    n_u, n_dp = built.shape
+def _reach_down(built: np.ndarray, nodes, u: np.ndarray, reach: int) -> None:
+    """Mark the `reach` rows below each missing node in a raised row (u <= 0: the paths run down
+    in u there at nearly constant dp) in its column and two more either side."""
     for i, j in nodes:
-        built[max(i - margin, 0):min(i + margin + 1, n_u), max(j - margin, 0):min(j + margin + 1, n_dp)] = True
+        if u[i] <= 0:
+            built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
+
+
+def _widen(built: np.ndarray, nodes, margin: int, cols: int | None = None) -> None:
+    """Mark `nodes` and every node within `margin` cells of one as built (`cols` along dp, if
+    given)."""
+    n_u, n_dp = built.shape
+    c = margin if cols is None else cols
+    for i, j in nodes:
+        built[max(i - margin, 0):min(i + margin + 1, n_u), max(j - c, 0):min(j + c + 1, n_dp)] = True
 
 
 def _compressed(table, U: list[int], D: list[int]):
@@ -134,23 +160,25 @@ def _cavity(goal: SuctionGoal, table, memo: dict):
     from reduced.lifetime.routes import ROUTES
 
     route = ROUTES["coupled"]
-    cavity, u_start, _ = route.cavity(replace(goal.model, suction=table), dict(route.options))
+    options = dict(route.options, **({} if goal.u_start_m is None else {"u_start_m": goal.u_start_m}))
+    cavity, u_start, _ = route.cavity(replace(goal.model, suction=table), options)
     return replace(cavity, conductances=memo), u_start
 
 
 def _path_points(goal: SuctionGoal, table, memo: dict) -> list[tuple[float, float]]:
     """Every (u, dp) the goal's paths visit on a complete table: the lifetimes' trajectories, the
-    start and the largest holdable force's end."""
+    start and the cup raised at its start content (the largest holdable force's path)."""
     cavity, u_start = _cavity(goal, table, memo)
-    points = [(u_start, cavity.start(u_start)[0])]
+    dp_start, N0 = cavity.start(u_start)
+    points = [(u_start, dp_start)]
     for F in goal.forces_N:
         try:
             r = cavity._lifetime(F, u_start)
         except ValueError:          # the coarse table fails where the lattice may not: no seed
             continue
         points += list(zip(r.u_m.tolist(), r.dp_Pa.tolist()))
-    largest = cavity._largest_force(u_start)
-    points.append((float(table.u_m[0]), cavity._dp_range(largest)[0]))
+    us, dps, _, _ = cavity._raised_at(N0, u_start)
+    points += list(zip(us.tolist(), dps.tolist()))
     return points
 
 

@@ -1,9 +1,12 @@
 """The FEM suction table of a design, built once and kept: the input of the coupled route.
 
-`SuctionGridSpec` names the (u, dp) grid: the default one (`DEFAULT_GRID`, 105 u values graded towards
-u = 0 up to 0.8 h1, dp = 0, 1, ..., 100 kPa; halving the u spacing moves cup A's lifetimes by
-<= 0.2 %, the dp spacing by <= 0.8 %, benchmarks/bench_coupled.py) and a coarse one for quick checks
-(`QUICK_GRID`).
+`SuctionGridSpec` names the (u, dp) grid: the default one (`DEFAULT_GRID`: 105 u values graded towards
+u = 0 up to 0.8 h1, and below them the raised rows, u = -0.6 h1 ... 0 every 0.005 h1, where the
+plate is above the free cup's touching height and the seal is held by the suction alone, down to
+where the FEM branch of cup A lets go at 40 N, -0.56 h1; dp = 0, 1, ..., 100 kPa. Halving the
+pressed rows' u spacing moves cup A's lifetimes by <= 0.2 %, the dp spacing by <= 0.8 %,
+benchmarks/bench_coupled.py; the raised rows': benchmarks/bench_coupled_raised.py) and a coarse one
+for quick checks (`QUICK_GRID`, pressed rows only: its branches end at the table's edge, u > 0).
 `suction_table_for` runs `fem.suction.suction_grid` on a design and converts it to the reduced
 model's `SuctionTable`; with a cache directory the table goes through `validation.bridge.cache`, keyed by the
 design, the law, the grid and a hash of the sources that make it (`fem`, `validation.bridge.coupled` and
@@ -31,7 +34,7 @@ from validation.bridge.coupled.around import AroundSpec, around_paths
 if TYPE_CHECKING:
     from fem.interface import ContactLaw
 
-__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "QUICK_GRID", "SuctionGoal", "AdaptiveSpec", "AroundSpec",
+__all__ = ["SuctionGridSpec", "DEFAULT_GRID", "PRESSED_GRID", "QUICK_GRID", "SuctionGoal", "AdaptiveSpec", "AroundSpec",
            "suction_table_for"]
 
 _U_COARSE = (0.001, 0.0025, 0.005, 0.0075, 0.01, 0.0175, 0.025, 0.0375, 0.05, 0.075, 0.1, 0.125,
@@ -61,7 +64,12 @@ def _halved(u: tuple[float, ...]) -> tuple[float, ...]:
     return tuple(sorted(set(u) | {0.5 * (a + b) for a, b in zip(u, u[1:])}))
 
 
-DEFAULT_GRID = SuctionGridSpec(_halved(_halved(_U_COARSE)), tuple(float(x) for x in range(0, 101)))
+#: the raised rows (u <= 0) as fractions of h1: -0.6 ... 0 every 0.005
+_U_RAISED = tuple(round(-0.005 * k, 4) + 0.0 for k in range(120, -1, -1))
+
+DEFAULT_GRID = SuctionGridSpec(_U_RAISED + _halved(_halved(_U_COARSE)), tuple(float(x) for x in range(0, 101)))
+#: the default grid's pressed rows only (u > 0): its branches end at the table's edge u > 0
+PRESSED_GRID = SuctionGridSpec(_halved(_halved(_U_COARSE)), DEFAULT_GRID.dp_kPa)
 QUICK_GRID = SuctionGridSpec(_U_COARSE, tuple(float(x) for x in range(0, 101, 5)))
 
 

@@ -18,14 +18,21 @@ def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -
     """The hand-off table of an FEM grid: F1, V, r_k, r_cut and the lumped nodal contact
     pressures (provenance: the grid's law and mu, material, h1, solver, then `provenance`),
     converted as the stiffness sidecar's are (`profiles_from_lists`: a node shared by
-    two facets merged, fewer than two points or no pressure is None)."""
+    two facets merged, fewer than two points or no pressure is None). A state without a seal
+    (`fem.suction`: no node of the cavity chain on the plane) is null in every grid and profile
+    and False in `sealed`: its numbers are not those of a cup under suction; so is a state whose
+    plane carries no pressure (the rim touching at zero force)."""
     prov = _provenance(grid.contact_law, grid.material, grid.h1_m, grid.stats, provenance)
-    return SuctionTable(u_m=grid.u_m, dp_Pa=grid.dp_Pa, F1_N=grid.F1_N, V_m3=grid.V_m3,
-                        seal_r_m=grid.seal_r_m, cut_r_m=grid.cut_r_m,
-                        profiles=tuple(profiles_from_lists([1e3 * p.r_m for p in row],
-                                                           [1e-3 * p.p_Pa for p in row])
-                                       for row in grid.profiles),
-                        E_Pa=grid.material.E_Pa, provenance=prov)
+    converted = [profiles_from_lists([1e3 * p.r_m for p in row], [1e-3 * p.p_Pa for p in row])
+                 for row in grid.profiles]
+    # a state whose plane carries no pressure (the rim touching at zero force, u = 0 and dp = 0)
+    # holds no seal either
+    sealed = np.asarray(grid.sealed, dtype=bool) & np.array(
+        [[p is not None for p in row] for row in converted]).reshape(np.shape(grid.sealed))
+    cut = {name: np.where(sealed, getattr(grid, name), np.nan) for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
+    profiles = tuple(tuple(p if ok else None for p, ok in zip(row, sealed[i])) for i, row in enumerate(converted))
+    return SuctionTable(u_m=grid.u_m, dp_Pa=grid.dp_Pa, **cut, profiles=profiles,
+                        E_Pa=grid.material.E_Pa, provenance=prov, sealed=None if sealed.all() else sealed)
 
 
 def fem_beta(table: SuctionTable) -> np.ndarray:
@@ -46,21 +53,28 @@ def fem_beta(table: SuctionTable) -> np.ndarray:
 def holed_suction_table(states: SuctionStates, u_m: np.ndarray, dp_Pa: np.ndarray, built: np.ndarray,
                         contact: ContactLaw, provenance: dict[str, Any] | None = None) -> SuctionTable:
     """The hand-off table (as `suction_table`) on the grid u_m x dp_Pa with only the states
-    `built` [len(u), len(dp)] (solved by `states`, whose contact law is `contact`, in increasing
-    u and dp where it lacks them), nan and None at the others: a table with holes
-    (`reduced.suction_table`)."""
+    `built` [len(u), len(dp)] (solved by `states`, whose contact law is `contact`, pressed rows in
+    increasing u and dp, raised rows (u <= 0) in decreasing u, where it lacks them), nan and None
+    at the others: a table with holes (`reduced.suction_table`); a state without a seal as in
+    `suction_table`."""
     shape = (len(u_m), len(dp_Pa))
     grids = {name: np.full(shape, np.nan) for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
     profiles = [[None] * shape[1] for _ in range(shape[0])]
-    for i, j in zip(*np.nonzero(built)):
-        F1, _, V, r_k, r_cut, _, _, p = states.state(float(u_m[i]), float(dp_Pa[j]))
+    sealed = np.ones(shape, dtype=bool)
+    nodes = sorted(zip(*np.nonzero(built)), key=lambda n: (u_m[n[0]] <= 0, abs(u_m[n[0]]), n[1]))
+    for i, j in nodes:
+        F1, _, V, r_k, r_cut, _, _, p, closed = states.state(float(u_m[i]), float(dp_Pa[j]))
+        profile = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0]
+        if not closed or profile is None:
+            sealed[i, j] = False
+            continue
         for name, x in zip(grids, (F1, V, r_k, r_cut)):
             grids[name][i, j] = x
-        profiles[i][j] = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0]
+        profiles[i][j] = profile
     prov = _provenance(contact, states.material, states.h1_m, states.stats, provenance)
     return SuctionTable(u_m=np.asarray(u_m, float), dp_Pa=np.asarray(dp_Pa, float), **grids,
                         profiles=tuple(tuple(row) for row in profiles), E_Pa=states.material.E_Pa,
-                        provenance=prov)
+                        provenance=prov, sealed=None if sealed.all() else sealed)
 
 
 def _provenance(law: ContactLaw, material, h1_m: float, stats, extra: dict[str, Any] | None) -> dict[str, Any]:
