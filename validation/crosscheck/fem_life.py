@@ -9,7 +9,8 @@ the coarse mesh (72 lives; the route's default is medium: frictionless, coarse i
 medium within 0.9 %, benchmarks/fem_route_mesh_study.md), E = 4 MPa, nu = 0.49, reference conventions (no
 relaxation, air at 293.15 K, p_a = 100 kPa). Beside them: the paper route with the paper's own
 inputs (Table 1's cup, Appendix A's F0, eqs 3-7 with beta) and the table-coupled route (the
-frictionless FEM's suction table of the design on its default (u, dp) grid, coarse mesh). No
+frictionless FEM's suction table of the design on its default (u, dp) grid, built around the
+paths, coarse mesh). No
 parameter is fitted to a measured number.
 
 A cell gives the lifetime [s] and why it ended: fold (the branch's largest N at F1), reached_r1
@@ -294,10 +295,18 @@ def suction_table(ctx: Context, cup: str):
 
 
 def _table_in(cup: str, root):
+    """Built around the section's paths (`validation.bridge.coupled.around`: only the states the
+    lifetimes and the largest holdable force read, each the full default grid's own)."""
     from validation.bridge.coupled.build import DEFAULT_GRID, suction_table_for
 
     cache = None if root is None else root / "suction"
-    return suction_table_for(cup, fidelity=CROSSCHECK_FIDELITY, grid=DEFAULT_GRID, cache_dir=cache)
+    return suction_table_for(cup, fidelity=CROSSCHECK_FIDELITY, grid=DEFAULT_GRID, cache_dir=cache,
+                             goal=_table_goal(cup))
+
+
+def _table_goal(cup: str):
+    from validation.bridge.coupled.adaptive import SuctionGoal
+    return SuctionGoal(model_for(cup), FORCES_N[cup])
 
 
 def suction_table_cached(ctx: Context, cup: str) -> bool:
@@ -311,7 +320,7 @@ def suction_table_cached(ctx: Context, cup: str) -> bool:
 
     if ctx.memo.cache_dir is None:
         return False
-    memo = Memory(str(ctx.memo.cache_dir / "suction"), verbose=0).cache(build._build, ignore=["progress"])
-    code = source_hash("fem", "validation/bridge/coupled", *build._TABLE_TYPES)
+    memo = Memory(str(ctx.memo.cache_dir / "suction"), verbose=0).cache(build._build_around, ignore=["progress"])
+    code = source_hash("fem", "validation/bridge/coupled", "reduced")
     return memo.check_call_in_cache(cup_geometry(cup), CROSSCHECK_FIDELITY, ContactLaw(), 4e6, 0.49,
-                                    build.DEFAULT_GRID, code)
+                                    build.DEFAULT_GRID, _table_goal(cup), build.AroundSpec(), code)
