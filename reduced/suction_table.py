@@ -40,30 +40,32 @@ _GRIDS = {"F1_N": ("F1_N", 1.0), "V_mm3": ("V_m3", 1e-9), "seal_r_mm": ("seal_r_
           "cut_r_mm": ("cut_r_m", 1e-3)}
 
 
-class MissingStates(LookupError):
-    """A value read at a hole of a `SuctionTable`: `nodes` are the (i, j) indices of the missing
-    states on the table's axes (what a builder must add), `u_m`, `dp_Pa` their coordinates."""
+class _AtStates(LookupError):
+    """A value read at states of a `SuctionTable` it cannot give: `nodes` are their (i, j) indices on
+    the table's axes, `u_m`, `dp_Pa` their coordinates; `what` says why (the subclass's)."""
+
+    what = ""
 
     def __init__(self, nodes, u_axis: np.ndarray, dp_axis: np.ndarray, where: str = ""):
         self.nodes = tuple(sorted({(int(i), int(j)) for i, j in nodes}))
         self.u_m = tuple(float(u_axis[i]) for i, _ in self.nodes)
         self.dp_Pa = tuple(float(dp_axis[j]) for _, j in self.nodes)
         first = ", ".join(f"({1e3 * u:.4g} mm, {d / 1e3:.4g} kPa)" for u, d in zip(self.u_m[:3], self.dp_Pa[:3]))
-        super().__init__(f"suction table: {len(self.nodes)} state(s) not built {where}: (u, dp) = {first}"
+        super().__init__(f"suction table: {self.what.format(n=len(self.nodes))} {where}: (u, dp) = {first}"
                          + (", ..." if len(self.nodes) > 3 else ""))
 
 
-class SealOpen(LookupError):
+class MissingStates(_AtStates):
+    """A value read at a hole of a `SuctionTable`: the states a builder must add."""
+
+    what = "{n} state(s) not built"
+
+
+class SealOpen(_AtStates):
     """A value read at a state without a seal (`SuctionTable.sealed` False): the cup there holds
-    no suction, so a path reaching it has let go. `nodes`, `u_m`, `dp_Pa` as `MissingStates`."""
+    no suction, so a path reaching it has let go."""
 
-    def __init__(self, nodes, u_axis: np.ndarray, dp_axis: np.ndarray, where: str = ""):
-        self.nodes = tuple(sorted({(int(i), int(j)) for i, j in nodes}))
-        self.u_m = tuple(float(u_axis[i]) for i, _ in self.nodes)
-        self.dp_Pa = tuple(float(dp_axis[j]) for _, j in self.nodes)
-        first = ", ".join(f"({1e3 * u:.4g} mm, {d / 1e3:.4g} kPa)" for u, d in zip(self.u_m[:3], self.dp_Pa[:3]))
-        super().__init__(f"suction table: the seal is open {where}: (u, dp) = {first}"
-                         + (", ..." if len(self.nodes) > 3 else ""))
+    what = "the seal is open"
 
 
 @dataclass(frozen=True, eq=False)

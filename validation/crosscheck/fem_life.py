@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from validation.crosscheck.context import CROSSCHECK_FIDELITY, SURFACE, Context, pmma_uc_table
+from validation.crosscheck.context import CROSSCHECK_FIDELITY, Context, pmma_uc_table
 from validation.crosscheck.runs import FemRun
 
 NAME = "fem_life"

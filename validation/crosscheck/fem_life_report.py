@@ -8,8 +8,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from validation.crosscheck.context import SURFACE, Context
 from validation.crosscheck.report import new_figure
 

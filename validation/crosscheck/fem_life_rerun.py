@@ -116,7 +116,7 @@ def main(argv=None) -> int:
 
         root = Path(user_cache_dir("validate") if a.cache_dir is None else a.cache_dir)
         cups = None if a.cup is None else set(a.cup)
-        tables = () if a.quick or laws not in (None,) or cups else tuple(fem_life.FORCES_N)
+        tables = () if a.quick or laws is not None or cups else tuple(fem_life.FORCES_N)
         fem_life.fill(fem_life.groups(a.quick, cups, laws), root, a.jobs, tables)
         cached_only = True
     print("wrote " + ", ".join(merge_into(into, a.quick, a.cache_dir, cached_only)))
