@@ -17,6 +17,7 @@ itself, as a note or in the output's provenance.
 from __future__ import annotations
 
 import argparse
+import atexit
 import errno
 import importlib
 import os
@@ -112,14 +113,34 @@ def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentPars
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one subcommand; return its exit status (argparse errors and --help raise SystemExit)."""
+    """Run one subcommand; return its exit status (argparse errors and --help raise SystemExit).
+    From the command line (argv None) a Ctrl-C that arrives after the command has returned leaves
+    the command's status: its outputs are complete, so the interpreter's exit is not a run to report
+    as interrupted. Until the last exit handler it ends the process at once; after it (registered
+    first, it runs last) it is ignored, because the interpreter's finalization resets a Python
+    handler to the default, death by SIGINT, but keeps an ignored signal ignored."""
+    if argv is None:
+        atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
     try:
         os.environ.setdefault("PYTHONWARNINGS", "ignore")   # the workers' library warnings: not for the terminal
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")              # nor this process's
-            return _main(argv)
+            status = _main(argv)
     except KeyboardInterrupt:                # during start-up or while a command was reporting
-        return _interrupted("cupcheck")
+        status = _interrupted("cupcheck")
+    if argv is None and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+        signal.signal(signal.SIGINT, lambda *_: _exit_now(status))
+    return status
+
+
+def _exit_now(status: int) -> None:
+    """Leave with `status`, skipping the interpreter's finalization (the run is over)."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(status)
 
 
 def _interrupted(who: str) -> int:
