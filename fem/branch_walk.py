@@ -260,10 +260,12 @@ class Walk:
         """Each load step's first Newton iterate on the line from `start` to (u_m, N): the linear
         response of `predict_from` (a state whose slopes are known, e.g. the last trial of an F1
         root) to the change of plate and N, from that state for the first step and from the last
-        converged one after it; None (Newton from the last converged state) without one."""
+        converged one after it; None (Newton from the last converged state) without one, and for
+        a law with a history (sticking, Coulomb): there the iterate picks among the stick/slide
+        sets, and a predicted start moved a lifetime by more than the step error, and cost more."""
         base = self.predict_from
         response = self.responses.get(base) if base is not None else None
-        if response is None:
+        if response is None or self.cup.cup.plane.law.anchored:
             return None
         x_N, x_u = response
         u0, N0 = start.u_m, start.N
