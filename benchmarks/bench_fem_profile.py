@@ -198,7 +198,8 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     own = _median_time(lambda: solver.factor(K, free))
     row = next((line.split() for line in out.getvalue().splitlines()
                 if line.split()[:1] == [f"{force_N:g}"]), ["", "?", "?"])
-    return {"level": level, "force": force_N, "contact": contact, "cpu": cpu, "lifetime": row[1], "reason": row[2],
+    return {"level": level, "force": force_N, "contact": contact, "cpu": cpu, "lifetime": row[1],
+            "reason": row[2],
             "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own}
 
 

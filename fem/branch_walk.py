@@ -5,7 +5,9 @@ and the jump of the pull where that bracket closes without a root; the plate rai
 the fold and the seal's opening located between two states; the branch measured.
 
 The sensitivities dF1/dN and dF1/du are the linear response of a converged state at the held
-plate (`held_plate_system`, shared with the water cavity's walk, `fem.water_branch`).
+plate (`held_plate_system`, shared with the water cavity's walk, `fem.water_branch`). With the
+frictionless law, that response (du/dN, du/du_plate, `linear_response`) also gives each trial's
+first Newton iterate (`Walk._predictor`).
 """
 
 from __future__ import annotations
@@ -22,8 +24,8 @@ from .cup import _joined
 from .free_block import solve_free_block
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
-__all__ = ["Branch", "Walk", "Trial", "Jump", "STICKING_STEPS", "held_plate_system", "sensitivities", "linear_response",
-           "seal_open", "u_leads"]
+__all__ = ["Branch", "Walk", "Trial", "Jump", "STICKING_STEPS", "held_plate_system", "sensitivities",
+           "linear_response", "seal_open", "u_leads"]
 
 STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
 
@@ -79,7 +81,8 @@ def sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, 
     return linear_response(cup, N, state)[:2]
 
 
-def linear_response(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, float, np.ndarray, np.ndarray]:
+def linear_response(cup: CupWithGas, N: float,
+                    state: StepResult) -> tuple[float, float, np.ndarray, np.ndarray]:
     """(dF1/dN, dF1/du, du/dN, du/du_plate) of the converged state `state` holding N molecules:
     the pull's sensitivities and the displacement's linear response to N at the held plate and
     to the plate at fixed N (held contact dofs fixed, `held_plate_system`), the first-order
@@ -172,6 +175,8 @@ class Walk:
         # state whose response predicts the next solve's Newton start (`solve`)
         self.responses: dict[Trial, tuple[np.ndarray, np.ndarray]] = {}
         self.predict_from: Trial | None = None
+        # only a law without a history (frictionless) starts its trials predicted (`_predictor`)
+        self.predicts = bool(cup.cup.plane.law.conservative)
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
         self.tolerance = cup.options.rtol * cup.p_a_Pa * math.pi * rim**2
@@ -251,8 +256,7 @@ class Walk:
         carries no history (frictionless: the state does not depend on the path, and the Newton
         then starts from the predicting state's contact set as from its displacement)."""
         base = self.predict_from
-        if base is None or base is start or base not in self.responses or \
-                self.cup.cup.plane.law.anchored or not self.cup.cup.plane.law.conservative:
+        if not self.predicts or base is None or base is start or base not in self.responses:
             return start.step
         return replace(start.step, contact=base.step.contact)
 
@@ -265,7 +269,7 @@ class Walk:
         sets, and a predicted start moved a lifetime by more than the step error, and cost more."""
         base = self.predict_from
         response = self.responses.get(base) if base is not None else None
-        if response is None or self.cup.cup.plane.law.anchored:
+        if response is None or not self.predicts:
             return None
         x_N, x_u = response
         u0, N0 = start.u_m, start.N

@@ -338,8 +338,9 @@ def follow_gas_path(mech: GasMechanics, dirichlet: Callable[[float], tuple[np.nd
                     name: str = "t",
                     predict: Callable[[float, np.ndarray, float], np.ndarray] | None = None) -> SolverStats:
     """`fem.solver.follow_path` for a `GasMechanics`, with the exact rank-one tangent (module
-    docstring); predict: each step's first Newton iterate (`fem.solver.follow_path`). Raises what follow_path raises, and RuntimeError if the solver did not build its
-    linear solver through the wrapped factory."""
+    docstring); predict: each step's first Newton iterate (`fem.solver.follow_path`). Raises what
+    follow_path raises, and RuntimeError if the solver did not build its linear solver through
+    the wrapped factory."""
     if not isinstance(mech, GasMechanics):
         raise TypeError(f"mech: a GasMechanics is required, got {type(mech).__name__}")
     return follow_path(mech, dirichlet, t_max, plane=plane, start=start, options=options,
