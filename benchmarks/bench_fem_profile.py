@@ -190,14 +190,17 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     law_args = ["--contact", law[0]] + (["--friction", law[1]] if len(law) > 1 else [])
     CLOCK.reset()
     t = time.process_time()
-    with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()):
-        cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level]
-            + law_args)
+    with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()) as err:
+        code = cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level]
+                   + law_args)
     cpu = time.process_time() - t
     solver, K, free = CLOCK.last_factor
     own = _median_time(lambda: solver.factor(K, free))
     row = next((line.split() for line in out.getvalue().splitlines()
-                if line.split()[:1] == [f"{force_N:g}"]), ["", "?", "?"])
+                if line.split()[:1] == [f"{force_N:g}"]), None)
+    if row is None:              # no lifetime printed: the command's exit status and last message
+        last = (err.getvalue().strip().splitlines() or ["?"])[-1]
+        row = ["", "?", f"exit {code}: {last}"]
     return {"level": level, "force": force_N, "contact": contact, "cpu": cpu, "lifetime": row[1],
             "reason": row[2],
             "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own}
