@@ -2,7 +2,8 @@
 and, with --route-forces, where one lifetime of the route "fem" goes.
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_fem_profile.py [--levels coarse medium]
-        [--contact frictionless] [--repeat 3] [--whole] [--route-forces 10 [--route-only]]
+        [--contact frictionless] [--repeat 3] [--whole] [--route-forces 10 [--route-only]
+        [--route-contact frictionless sticking "coulomb 0.5"]]
 
 Runs `fem.cup.compress_cup` in-process (no start-up, no CSV) and prints per curve: load steps,
 Newton iterations, dofs, factorizations, the in-process wall time (first call and the median of
@@ -26,13 +27,14 @@ factorization by the solver itself and by scipy's sparse LU (`scipy.sparse.linal
 ordering): the scale of the linear algebra alone against the time per Newton iteration, and
 their ratio (a Newton iteration in units of one factorization of each kind).
 With --route-forces F ..., also `cupcheck lifetime --route fem --cup A --force F --fidelity LEVEL`
+(per contact law of --route-contact)
 in-process (the command's own work: pressing, sealing, the largest holdable force, the branch,
 the leak), its CPU time per part as above plus
 
   cavity     the cavity volume, its gradient and Hessian (`fem.cavity.CavitySurface`);
-  sens       the branch's sensitivities dF1/dN, dF1/du (`fem.branch_walk.sensitivities`: one
-             factorization of the held plate's free block, `fem.free_block`, outside the
-             solver's factorizations);
+  sens       the branch's sensitivities dF1/dN, dF1/du and the linear response that predicts
+             each trial's Newton start (`fem.branch_walk.linear_response`: one factorization of
+             the held plate's free block, `fem.free_block`, outside the solver's factorizations);
   setup      building a linear solver (`fem.condensation.make_solver`'s orderings and maps);
 
 and the calls of each, and the CPU time per solver factorization (each Newton iteration factors
@@ -134,6 +136,8 @@ def _instrument() -> None:
     fem.cup.check_state = w("post", fem.cup.check_state)
     fem.cavity.CavitySurface._terms = w("cavity", fem.cavity.CavitySurface._terms)
     fem.branch_walk.sensitivities = w("sens", fem.branch_walk.sensitivities)
+    if hasattr(fem.branch_walk, "linear_response"):   # (the sensitivities with the predictor's response)
+        fem.branch_walk.linear_response = w("sens", fem.branch_walk.linear_response)
     if hasattr(fem.condensation, "_new_solver"):     # (a solver per path, uncounted, before it)
         fem.condensation._new_solver = w("setup", fem.condensation._new_solver)
 
@@ -178,25 +182,33 @@ def profile_curve(level: str, contact: str, repeat: int) -> dict:
             "free": int(free.sum())}
 
 
-def profile_route(level: str, force_N: float) -> dict:
-    """One `cupcheck lifetime --route fem` in-process: its CPU time and parts (module docstring)."""
+def profile_route(level: str, force_N: float, contact: str = "frictionless") -> dict:
+    """One `cupcheck lifetime --route fem` in-process: its CPU time and parts (module docstring);
+    contact: a law's name, or "coulomb MU"."""
     from validation.cli import main as cli
+    law = contact.split()
+    law_args = ["--contact", law[0]] + (["--friction", law[1]] if len(law) > 1 else [])
     CLOCK.reset()
     t = time.process_time()
-    with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()):
-        cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level])
+    with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()) as err:
+        code = cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level]
+                   + law_args)
     cpu = time.process_time() - t
     solver, K, free = CLOCK.last_factor
     own = _median_time(lambda: solver.factor(K, free))
     row = next((line.split() for line in out.getvalue().splitlines()
-                if line.split()[:1] == [f"{force_N:g}"]), ["", "?", "?"])
-    return {"level": level, "force": force_N, "cpu": cpu, "lifetime": row[1], "reason": row[2],
+                if line.split()[:1] == [f"{force_N:g}"]), None)
+    if row is None:              # no lifetime printed: the command's exit status and last message
+        last = (err.getvalue().strip().splitlines() or ["?"])[-1]
+        row = ["", "?", f"exit {code}: {last}"]
+    return {"level": level, "force": force_N, "contact": contact, "cpu": cpu, "lifetime": row[1],
+            "reason": row[2],
             "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own}
 
 
 def report_route(r: dict) -> None:
     total = r["cpu"]
-    print(f"\nfem route, cup A {r['level']}, F1 = {r['force']:g} N: lifetime {r['lifetime']} s "
+    print(f"\nfem route, cup A {r['level']}, {r['contact']}, F1 = {r['force']:g} N: lifetime {r['lifetime']} s "
           f"({r['reason']}); in-process CPU time {total:.2f} s")
     per = total / r["calls"]["factor"]
     print(f"  per solver factorization (~ per Newton iteration) {1e3 * per:.2f} ms; one factorization of the "
@@ -259,6 +271,8 @@ def main() -> None:
     ap.add_argument("--route-forces", nargs="*", type=float, default=[],
                     help="also profile one fem route lifetime per force [N] and level")
     ap.add_argument("--route-only", action="store_true", help="skip the stiffness curves")
+    ap.add_argument("--route-contact", nargs="+", default=["frictionless"],
+                    help='the route\'s contact laws: frictionless, sticking, "coulomb MU"')
     args = ap.parse_args()
     _instrument()
     for level in args.levels:
@@ -268,7 +282,8 @@ def main() -> None:
                 r["whole_cpu"], r["whole_wall"] = whole_process(level, args.contact, args.repeat)
             report(r)
         for force in args.route_forces:
-            report_route(profile_route(level, force))
+            for contact in args.route_contact:
+                report_route(profile_route(level, force, contact))
 
 
 if __name__ == "__main__":

@@ -5,7 +5,9 @@ and the jump of the pull where that bracket closes without a root; the plate rai
 the fold and the seal's opening located between two states; the branch measured.
 
 The sensitivities dF1/dN and dF1/du are the linear response of a converged state at the held
-plate (`held_plate_system`, shared with the water cavity's walk, `fem.water_branch`).
+plate (`held_plate_system`, shared with the water cavity's walk, `fem.water_branch`). With the
+frictionless law, that response (du/dN, du/du_plate, `linear_response`) also gives each trial's
+first Newton iterate (`Walk._predictor`).
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from .free_block import solve_free_block
 from .trapped_gas import K_B, GasMechanics, follow_gas_path
 
 __all__ = ["Branch", "Walk", "Trial", "Jump", "STICKING_STEPS", "held_plate_system", "sensitivities",
-           "seal_open", "u_leads"]
+           "linear_response", "seal_open", "u_leads"]
 
 STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
 
@@ -76,6 +78,15 @@ def held_plate_system(cup, state: StepResult) -> tuple[np.ndarray, np.ndarray, s
 def sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, float]:
     """(dF1/dN, dF1/du) of the converged state `state` holding N molecules
     (`fem.gas_branch.pull_sensitivities`)."""
+    return linear_response(cup, N, state)[:2]
+
+
+def linear_response(cup: CupWithGas, N: float,
+                    state: StepResult) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """(dF1/dN, dF1/du, du/dN, du/du_plate) of the converged state `state` holding N molecules:
+    the pull's sensitivities and the displacement's linear response to N at the held plate and
+    to the plate at fixed N (held contact dofs fixed, `held_plate_system`), the first-order
+    predictor of a nearby state (`Walk.solve`)."""
     mech = GasMechanics(cup.cup.mech, cup.cavity, cup._gas(N))
     u = state.u
     _, r, K = mech.evaluate(u)
@@ -90,7 +101,7 @@ def sensitivities(cup: CupWithGas, N: float, state: StepResult) -> tuple[float, 
     y[:, :2] -= np.outer(y[:, 2], c * (gf @ y[:, :2]) / (1.0 + c * gf @ y[:, 2]))
     x_N, x_u = np.zeros(u.size), down.copy()
     x_N[free], x_u[free] = y[:, 0], y[:, 1]
-    return float(np.sum((K @ x_N + b)[plate_z])), float(np.sum((K @ x_u)[plate_z]))
+    return float(np.sum((K @ x_N + b)[plate_z])), float(np.sum((K @ x_u)[plate_z])), x_N, x_u
 
 
 def u_leads(tangent) -> bool:
@@ -160,13 +171,20 @@ class Walk:
         self.stop_at_crossing = False
         self.staircase = cup.cup.plane.law.name == "sticking"
         self.slopes: dict[Trial, tuple[float, float]] = {}     # by identity
+        # the linear response (du/dN, du/du_plate) of the states whose slopes are known, and the
+        # state whose response predicts the next solve's Newton start (`solve`)
+        self.responses: dict[Trial, tuple[np.ndarray, np.ndarray]] = {}
+        self.predict_from: Trial | None = None
+        # only a law without a history (frictionless) starts its trials predicted (`_predictor`)
+        self.predicts = bool(cup.cup.plane.law.conservative)
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
         self.tolerance = cup.options.rtol * cup.p_a_Pa * math.pi * rim**2
 
     def derivatives(self, s: Trial) -> tuple[float, float]:
         if s not in self.slopes:
-            self.slopes[s] = sensitivities(self.cup, s.N, s.step)
+            dF1_dN, dF1_du, x_N, x_u = linear_response(self.cup, s.N, s.step)
+            self.slopes[s], self.responses[s] = (dF1_dN, dF1_du), (x_N, x_u)
         return self.slopes[s]
 
     def slope(self, s: Trial) -> float:
@@ -204,8 +222,9 @@ class Walk:
             if stop_at_crossing and self.relaxes and step.unstable:
                 raise _Crossed("the path crossed an instability")
         try:
-            stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=start.step,
-                                    options=options or self.options, on_step=on_step)
+            stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=self._start(start),
+                                    options=options or self.options, on_step=on_step,
+                                    predict=self._predictor(start, u_m, N))
         except _Crossed as stop:
             stats = stop.stats
         except ConvergenceError as err:         # the cost of a failed trial counts too
@@ -223,6 +242,44 @@ class Walk:
         if crossed is not None:
             return replace(end, crossed=end if crossed is last[-1] else trial(crossed, crossed.t))
         return end
+
+    def _solve_from(self, base: Trial, start: Trial, u_m: float, N: float, options=None) -> Trial:
+        """`solve` with its Newton starts predicted by `base`'s linear response (`_predictor`)."""
+        self.predict_from = base
+        try:
+            return self.solve(start, u_m, N, options)
+        finally:
+            self.predict_from = None
+
+    def _start(self, start: Trial) -> StepResult:
+        """The path's start state: `start`'s, with the contact set of `predict_from` where the law
+        carries no history (frictionless: the state does not depend on the path, and the Newton
+        then starts from the predicting state's contact set as from its displacement)."""
+        base = self.predict_from
+        if not self.predicts or base is None or base is start or base not in self.responses:
+            return start.step
+        return replace(start.step, contact=base.step.contact)
+
+    def _predictor(self, start: Trial, u_m: float, N: float):
+        """Each load step's first Newton iterate on the line from `start` to (u_m, N): the linear
+        response of `predict_from` (a state whose slopes are known, e.g. the last trial of an F1
+        root) to the change of plate and N, from that state for the first step and from the last
+        converged one after it; None (Newton from the last converged state) without one, and for
+        a law with a history (sticking, Coulomb): there the iterate picks among the stick/slide
+        sets, and a predicted start moved a lifetime by more than the step error, and cost more."""
+        base = self.predict_from
+        response = self.responses.get(base) if base is not None else None
+        if response is None or not self.predicts:
+            return None
+        x_N, x_u = response
+        u0, N0 = start.u_m, start.N
+
+        def predict(t0: float, u_t0: np.ndarray, t1: float) -> np.ndarray:
+            u1, N1 = u0 + t1 * (u_m - u0), N0 + t1 * (N - N0)
+            if t0 == 0.0:
+                return base.step.u + (u1 - base.u_m) * x_u + (N1 - base.N) * x_N
+            return u_t0 + ((t1 - t0) * (u_m - u0)) * x_u + ((t1 - t0) * (N - N0)) * x_N
+        return predict
 
     def _count(self, stats: SolverStats | None) -> None:
         if stats is not None:
@@ -244,13 +301,13 @@ class Walk:
         mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`)."""
         name = "N" if k == 0 else "the plate position"
 
-        def at(x):
-            self.stop_at_crossing = True
+        def at(x, base=prev):
+            self.stop_at_crossing, self.predict_from = True, base
             try:
                 s = self.solve(prev, u_m, x, self.trial_options) if k == 0 else \
                     self.solve(prev, x, N, self.trial_options)
             finally:
-                self.stop_at_crossing = False
+                self.stop_at_crossing, self.predict_from = False, None
             if s.crossed is not None:       # the cup meets an instability on the way: it jumps
                 raise Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
                             f"crossed on the way to {name} {x:.6g}", instability=True)
@@ -269,7 +326,7 @@ class Walk:
                     x_new = xb - fb * (xb - xa) / (fb - fa)
             if k == 0 and not x_new > 0.0:
                 break
-            s = at(x_new)
+            s = at(x_new, s)
             tried.append((x_new, s.F1_N - self.F1, s))
         return self._bracket(at, tried, x0 - x_prev, name)
 
@@ -325,7 +382,7 @@ class Walk:
             u_new = a.u_m + float(np.clip(step, -du_m, -1e-6 * du_m))
             if u_new < u_min:
                 return None
-            s = self.solve(a, u_new, a.N)
+            s = self._solve_from(a, a, u_new, a.N)
             if seal_open(self.cup, s):          # the seal opened before the pull reached F1
                 return None
             if s.F1_N - self.F1 > self.tolerance:
@@ -335,7 +392,7 @@ class Walk:
         fa, fb, side = a.F1_N - self.F1, b.F1_N - self.F1, 0
         for _ in range(60):
             u = b.u_m + (a.u_m - b.u_m) * fb / (fb - fa)
-            s = self.solve(a, u, a.N)
+            s = self._solve_from(a, a, u, a.N)
             f = s.F1_N - self.F1
             if abs(f) <= self.tolerance:
                 return s

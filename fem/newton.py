@@ -34,26 +34,30 @@ _STALLED = 12           # Newton iterations in a row whose linearized frictional
 
 
 def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy,
-                stall: int = _STALLED):
+                stall: int = _STALLED, guess: np.ndarray | None = None):
     """Newton iterations of one step with a contact step per iteration (module docstring), to the
     tolerances of `opts` (a `fem.solver.SolverOptions`); returns (u, r_int, contact state,
-    iterations, whether the tangent was indefinite on the way)."""
+    iterations, whether the tangent was indefinite on the way). guess: the first iterate (a
+    predictor, projected onto the admissible set) instead of u_start, which stays the step's
+    start for the contact history (where a node landing in the step touched down)."""
     flags = {"indefinite": False}
     try:
         return _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags,
-                        stall)
+                        stall, guess)
     except StepFailure as fail:
         fail.indefinite = flags["indefinite"]
         raise
 
 
-def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags, stall):
+def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, flags, stall,
+             guess=None):
     n = mech.kin.ndofs
     fixed_dofs, fixed_vals = dirichlet(t)
     fext0 = fext = f_ext(t)
     history: list[float] = []
     try:
-        u = plane.project(u_start, u_start, state, state.active) if plane is not None else u_start
+        u = u_start if guess is None else guess
+        u = plane.project(u, u_start, state, state.active) if plane is not None else u
         Pi, r, K = total_potential(mech, u, fext)
     except FloatingPointError as err:
         raise StepFailure(f"{err} at the predictor; likely cause: the step is too large for "

@@ -126,7 +126,8 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
                 options: SolverOptions = SolverOptions(),
                 on_step: Callable[[StepResult], None] | None = None,
                 progress: Callable[[float, str], None] | None = None,
-                name: str = "t", start: StepResult | None = None) -> SolverStats:
+                name: str = "t", start: StepResult | None = None,
+                predict: Callable[[float, np.ndarray, float], np.ndarray] | None = None) -> SolverStats:
     """Follow the equilibrium path from t = 0 to t_max; call `on_step` for every converged step
     (including t = 0). `name` names t in messages (e.g. "u [m]"). Raises `ConvergenceError` if
     a step cannot be converged.
@@ -137,7 +138,10 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
     the step to t1 minimizes ``mech.at(t1)``'s energy, and its energy balance counts the work of
     the parameter, int dPi_t/dt dt at fixed u, by the trapezoid. A `mech` with a method
     ``make_solver(pattern, coordinates, mesh)`` builds its own linear solver (a tangent that is
-    not a plain sparse matrix, such as the trapped gas's rank-one term, `fem.trapped_gas`)."""
+    not a plain sparse matrix, such as the trapped gas's rank-one term, `fem.trapped_gas`).
+    predict(t0, u0, t1): the first Newton iterate of the step from the converged state (t0, u0)
+    to t1 (default: u0, the prescribed increment then imposed through the tangent), e.g. the
+    state's linear response to the load (`fem.branch_walk`)."""
     begin = time.perf_counter()
     n = mech.kin.ndofs
     f_ext = f_ext or (lambda t: np.zeros(n))
@@ -167,8 +171,9 @@ def follow_path(mech: Mechanics, dirichlet: Callable[[float], tuple[np.ndarray, 
         m1 = at(t1)
         fail = None
         try:
+            guess = predict(t, u0, t1) if predict is not None else None
             u1, r1, state1, its, indefinite = newton_step(m1, dirichlet, f_ext, plane, state, u0,
-                                                           t1, options, solver, policy)
+                                                           t1, options, solver, policy, guess=guess)
             if relaxes and indefinite and (t1 - t > short or largest_slip(plane, state1, u1, u0) > short):
                 raise StepFailure("the step crossed an instability", [math.nan] * its, indefinite=True)
         except StepFailure as err:

@@ -335,11 +335,13 @@ def follow_gas_path(mech: GasMechanics, dirichlet: Callable[[float], tuple[np.nd
                     t_max: float, *, plane: RigidPlane | None, start: StepResult | None,
                     options: SolverOptions = SolverOptions(),
                     on_step: Callable[[StepResult], None] | None = None,
-                    name: str = "t") -> SolverStats:
+                    name: str = "t",
+                    predict: Callable[[float, np.ndarray, float], np.ndarray] | None = None) -> SolverStats:
     """`fem.solver.follow_path` for a `GasMechanics`, with the exact rank-one tangent (module
-    docstring). Raises what follow_path raises, and RuntimeError if the solver did not build its
-    linear solver through the wrapped factory."""
+    docstring); predict: each step's first Newton iterate (`fem.solver.follow_path`). Raises what
+    follow_path raises, and RuntimeError if the solver did not build its linear solver through
+    the wrapped factory."""
     if not isinstance(mech, GasMechanics):
         raise TypeError(f"mech: a GasMechanics is required, got {type(mech).__name__}")
     return follow_path(mech, dirichlet, t_max, plane=plane, start=start, options=options,
-                       on_step=on_step, name=name)
+                       on_step=on_step, name=name, predict=predict)
