@@ -7,7 +7,8 @@ r_start = 12 mm, sealed, held at F1 along its FEM branch, per mesh level and con
         --forces 5 10 20 40 --du-factors 1 0.5 0.25 --jsonl study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --summarize study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --why 5 20
-    OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --seal 20 --levels coarse medium fine
+    OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --seal 5 10 20 40 --levels coarse medium fine \
+        --laws "coulomb 0.5" --jsonl benchmarks/fem_route_mesh_study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --mesh-study --levels coarse medium fine \
         --laws frictionless "coulomb 0.5" --forces 5 10 20 40 --jsonl benchmarks/fem_route_mesh_study.jsonl
 
@@ -26,9 +27,10 @@ fidelity name or an intermediate mesh "N_ALONGxN_THROUGH" with the levels' gradi
 the mesh study: per law and force each level's lifetime, the converged estimate (Richardson from
 the three finest levels where they converge monotonically, else the finest level) and each
 level's error against it, and the coarsest level within 1 % wherever every level has a lifetime.
---seal F1 splits each level's lifetime at F1 at N = 8 N0 (before the seal narrows to one node),
-read from the lumped profile and as the route reads it (validation.bridge.fem_leak), on the same
-states.
+--seal F1 [F1 ...] splits each level's lifetime at each F1 at N = 8 N0 (before the seal narrows to
+a few nodes), read from the lumped profile, with lone nodes by their reactions only, and as the
+route reads it (bands scaled to their reactions as well, validation.bridge.fem_leak), on the same
+states; with --jsonl it appends the route's lifetimes (and their CPU) for --mesh-study.
 """
 
 from __future__ import annotations
