@@ -28,9 +28,8 @@ the mesh study: per law and force each level's lifetime, the converged estimate 
 the three finest levels where they converge monotonically, else the finest level) and each
 level's error against it, and the coarsest level within 1 % wherever every level has a lifetime.
 --seal F1 [F1 ...] splits each level's lifetime at each F1 at N = 8 N0 (before the seal narrows to
-a few nodes), read from the lumped profile, with lone nodes by their reactions only, and as the
-route reads it (bands scaled to their reactions as well, validation.bridge.fem_leak), on the same
-states; with --jsonl it appends the route's lifetimes (and their CPU) for --mesh-study.
+a few nodes), read from the lumped profile and as the route reads it (validation.bridge.fem_leak),
+on the same states; with --jsonl it appends the route's lifetimes (and their CPU) for --mesh-study.
 """
 
 from __future__ import annotations
@@ -100,8 +99,8 @@ def main() -> None:
                     help="run the lifetimes missing from --jsonl, then print the mesh study (module docstring)")
     ap.add_argument("--seal", nargs="+", type=float, default=None, metavar="F1",
                     help="the seal diagnosis at each F1 per level (seal_diagnosis): the lifetime until "
-                         "N = 8 N0 and after, in the three readings of the seal; with --jsonl the route's "
-                         "lifetimes are appended")
+                         "N = 8 N0 and after, read from the lumped profile and as the route reads it; "
+                         "with --jsonl the route's lifetimes are appended")
     ap.add_argument("--why", nargs=2, type=float, default=None, metavar=("F_LOW", "F_HIGH"),
                     help="the leak of the two forces' frictionless branch states at equal N / N0, each "
                          "also at the other's p_b (the profile's share against the pressure's)")
@@ -220,16 +219,15 @@ def why(model, low: float, high: float, level: str = "coarse") -> None:
               f"{swapped[0]:.3g} / {swapped[1]:.3g} |", flush=True)
 
 
-READINGS = {"lumped profile": {"lone_by_reaction": False, "bands_by_reaction": False},
-            "lone node by its reaction": {"bands_by_reaction": False},
-            "route (bands and lone nodes by their reactions)": {}}
+READINGS = {"lumped profile": {"lone_by_reaction": False},
+            "route (lone node by its reaction)": {}}
 
 
 def seal_diagnosis(model, forces: list[float], levels: list[str], law: str = "frictionless", split: float = 8.0,
                    du_m: float = DEFAULT_DU_M, jsonl: str | None = None) -> None:
     """Where the mesh moves the lifetime at each force under `law`: per level, the time until
     N = split N0 (before any level's seal has narrowed to a few nodes) and after it, read in the
-    three ways of READINGS (`validation.bridge.fem_leak`) on the same branch states (refined as
+    two ways of READINGS (`validation.bridge.fem_leak`) on the same branch states (refined as
     the route refines them, with its reading: the route's lifetime); and at the first state whose
     contact is one node (the rim corner alone) its N, the corner's reaction and the lumped
     profile's force over its neighbours' radii. With jsonl, the route's lifetime per (level,

@@ -1,12 +1,12 @@
 """The fem route's default mesh level against the next finer level (benchmarks/bench_fem_route.py
---mesh-study): cup A pressed to r_start, pmma-1.89, the route's default plate step, frictionless
-and with Coulomb friction mu = 0.5. Independent check: the same cup and path on the nested mesh
-with twice the elements each way.
+--mesh-study): cup A pressed to r_start, frictionless, pmma-1.89, the route's default plate step.
+Independent check: the same cup and path on the nested mesh with twice the elements each way.
 
 The largest holdable force is mesh-converged (coarse, medium, fine within 0.03 %). The lifetime
-is within 1 % of the next finer level at the default (medium) since the leak reads the seal by
-the plane's reactions (a lone node as a ring of its reaction, a band of nodes scaled to theirs:
-validation.bridge.fem_leak); the numbers are in benchmarks/fem_route_mesh_study.md."""
+is within 1 % of the next finer level at the default (medium) since a node touching the plane
+alone enters the leak by its reaction (validation.bridge.fem_leak): medium against fine 0.15,
+0.38, 0.44 % at 5, 10, 20 N (benchmarks/fem_route_mesh_study.md); the coarse level is not
+(1.2-4.6 %)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,6 @@ import pytest
 
 import reduced
 from fem.mesh import FIDELITIES
-from fem.interface import ContactLaw
 from validation.bridge.fem_route import FemCup
 from validation.bridge.pipeline import surface_uc_table
 
@@ -44,18 +43,6 @@ def test_default_mesh_lifetime_within_one_percent_of_the_next_finer_level(model)
     default = FemCup("A").fidelity
     F = 10.0
     lives = [reduced.solve_lifetime(model, F, route="fem", cup=FemCup("A", level))
-             for level in (default, next_finer(default))]
-    assert lives[0].reason == lives[1].reason == "reached_r1"
-    assert lives[0].lifetime_s == pytest.approx(lives[1].lifetime_s, rel=0.01)
-
-
-@pytest.mark.slow
-def test_default_mesh_coulomb_lifetime_within_one_percent_of_the_next_finer_level(model):
-    """With friction the seal narrows to the rim corner through bands of two and three nodes, at
-    a different N on each level: read by their reactions the lifetime converges as without."""
-    default = FemCup("A").fidelity
-    F, law = 20.0, ContactLaw("coulomb", 0.5)
-    lives = [reduced.solve_lifetime(model, F, route="fem", cup=FemCup("A", level, contact=law))
              for level in (default, next_finer(default))]
     assert lives[0].reason == lives[1].reason == "reached_r1"
     assert lives[0].lifetime_s == pytest.approx(lives[1].lifetime_s, rel=0.01)

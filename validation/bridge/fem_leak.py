@@ -13,12 +13,6 @@ its neighbours' radii is not lambda_a and follows the elements (benchmarks/fem_r
 Such a node enters as a ring load of its own reaction lambda_a at its radius (`SealLoad`):
 patch-averaged, a box F / (2 pi r L), the element size gone. The reaction is the FEM's converged
 quantity: alone on the plane, the corner's is the plate's force (global equilibrium).
-A band of neighbouring loaded nodes keeps the shape of its lumped profile, scaled so that its
-force is the sum of its nodes' reactions: the profile's trapezoid, which falls to 0 at the lifted
-nodes beside the band, carries over a band of two or three nodes (a frictional seal narrowing to
-the rim) only 0.8 of their reactions, and the leak jumped by a factor 3-4 where the band became
-two lone nodes, at a different N on each mesh. Read by force, the band, its last two nodes and
-the lone corner are one reading; on a wide band the scale is 1 to the profile's discretisation.
 """
 
 from __future__ import annotations
@@ -40,8 +34,8 @@ __all__ = ["SealLoad", "seal_load", "contact_reactions", "state_leak_rate"]
 @dataclass(frozen=True)
 class SealLoad:
     """The contact traction of one FEM state as the leak reads it (module docstring): the lumped
-    pressures p_Pa [Pa] at the contact nodes' radii r_m [m] (0 at a lone node; each band scaled to
-    its reactions), and the lone nodes' reactions rings_F_N [N] at rings_r_m [m]."""
+    pressures p_Pa [Pa] at the contact nodes' radii r_m [m] (0 at a lone node), and the lone nodes'
+    reactions rings_F_N [N] at rings_r_m [m]."""
 
     r_m: np.ndarray
     p_Pa: np.ndarray
@@ -60,53 +54,33 @@ def contact_reactions(plane: RigidPlane, step) -> tuple[np.ndarray, np.ndarray]:
     return r[order], lam[order]
 
 
-def seal_load(state: GasState, plane: RigidPlane, bands_by_reaction: bool = True) -> SealLoad:
+def seal_load(state: GasState, plane: RigidPlane) -> SealLoad:
     """The state's `SealLoad`: its profile (radii merged where nodes coincide, the largest
     pressure kept), each loaded sample whose neighbours in r are both unloaded taken out of it
-    and given as a ring load of the reactions of the nodes at its radius, and each band of
-    neighbouring loaded samples scaled so that its trapezoid force (out to the unloaded samples
-    beside it) is the sum of its nodes' reactions (bands_by_reaction=False: as lumped)."""
+    and given as a ring load of the reactions of the nodes at its radius."""
     radii, p = _merged_profile(state)
     loaded = p > 0
     neighbour = np.zeros_like(loaded)
     neighbour[1:] |= loaded[:-1]
     neighbour[:-1] |= loaded[1:]
     lone = loaded & ~neighbour
-    p = np.where(lone, 0.0, p)
-    bands = _runs(loaded & ~lone) if bands_by_reaction else []
-    if not (np.any(lone) or bands):
-        return SealLoad(radii, p, np.zeros(0), np.zeros(0))
-    r, lam = contact_reactions(plane, state.state)
     rings = radii[lone]
-    forces = _reaction_between(r, lam, rings, rings)
-    for i, j in bands:                             # samples i..j loaded, i - 1 and j + 1 not
-        lo, hi = max(i - 1, 0), min(j + 1, radii.size - 1)
-        f = p[lo:hi + 1] * radii[lo:hi + 1]
-        force = 2.0 * math.pi * float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(radii[lo:hi + 1])))
-        p[i:j + 1] *= _reaction_between(r, lam, radii[[i]], radii[[j]])[0] / force
-    return SealLoad(radii, p, rings, forces)
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """(first, last) index of each run of True in `mask`."""
-    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
-    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1))
-
-
-def _reaction_between(r: np.ndarray, lam: np.ndarray, lo_m: np.ndarray, hi_m: np.ndarray) -> np.ndarray:
-    """The plane's reactions [N] summed over the held nodes at radii in [lo_m, hi_m] (r sorted;
-    the radii are the profile's own, matched to 1e-12)."""
-    lo = np.searchsorted(r, lo_m - 1e-12 * lo_m, "left")
-    hi = np.searchsorted(r, hi_m + 1e-12 * hi_m, "right")
-    if np.any(hi <= lo):
-        raise RuntimeError("seal_load: a loaded node of the profile is not among the plane's held "
-                           "nodes (the profile and the state disagree)")
-    sums = np.concatenate([[0.0], np.cumsum(lam)])
-    return np.maximum(sums[hi] - sums[lo], 0.0)
+    if rings.size:
+        r, lam = contact_reactions(plane, state.state)
+        tol = 1e-12 * rings
+        lo, hi = np.searchsorted(r, rings - tol, "left"), np.searchsorted(r, rings + tol, "right")
+        if np.any(hi <= lo):
+            raise RuntimeError("seal_load: a loaded node of the profile is not among the plane's held "
+                               "nodes (the profile and the state disagree)")
+        sums = np.concatenate([[0.0], np.cumsum(lam)])
+        forces = np.maximum(sums[hi] - sums[lo], 0.0)
+    else:
+        forces = np.zeros(0)
+    return SealLoad(radii, np.where(lone, 0.0, p), rings, forces)
 
 
 def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: str = "annulus", *,
-                    plane: RigidPlane, lone_by_reaction: bool = True, bands_by_reaction: bool = True) -> float:
+                    plane: RigidPlane, lone_by_reaction: bool = True) -> float:
     """Molecules per second leaking into the cavity at one sealed FEM state, or for water the
     volume inflow [m^3/s] of eq (24): the gas in the contact zone [r_k, r_cut] rises from p_b to
     p_a (the model's `interface`, as `reduced.table_surface.solid_profile`), which the FEM's
@@ -115,14 +89,13 @@ def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: s
     docstring) where u_c has a patch length (the rise acts on the resolved contact: a lone
     node's zone has no width), its rings' gaps u_c(p / E_Pa) in series at the state's p_b; inf
     where no solid contact is left (the fluid holds the seal open).
-    lone_by_reaction=False reads the lumped profile as it is, lone nodes included;
-    bands_by_reaction=False keeps the bands' lumped profile (the readings before, for the mesh
-    study's diagnosis)."""
+    lone_by_reaction=False reads the lumped profile as it is, lone nodes included (the reading
+    before, for the mesh study's diagnosis)."""
     from reduced.profile_leak import ContactProfile, patch_average, profile_leak_rate, profile_liquid_rate, ring_gaps
 
     patch = getattr(model.u_c, "patch_length_m", None)
     if patch and lone_by_reaction:
-        load = seal_load(state, plane, bands_by_reaction)
+        load = seal_load(state, plane)
     else:                   # no nominal pressure: the lumped profile as it is, lone nodes included
         load = SealLoad(*_merged_profile(state), np.zeros(0), np.zeros(0))
     if load.r_m.size < 2 or not (np.any(load.p_Pa > 0) or np.any(load.rings_F_N > 0)):
