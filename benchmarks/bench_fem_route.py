@@ -7,7 +7,8 @@ r_start = 12 mm, sealed, held at F1 along its FEM branch, per mesh level and con
         --forces 5 10 20 40 --du-factors 1 0.5 0.25 --jsonl study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --summarize study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --why 5 20
-    OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --seal 20 --levels coarse medium fine
+    OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --seal 5 10 20 40 --levels coarse medium fine \
+        --laws "coulomb 0.5" --jsonl benchmarks/fem_route_mesh_study.jsonl
     OMP_NUM_THREADS=1 python benchmarks/bench_fem_route.py --mesh-study --levels coarse medium fine \
         --laws frictionless "coulomb 0.5" --forces 5 10 20 40 --jsonl benchmarks/fem_route_mesh_study.jsonl
 
@@ -26,9 +27,9 @@ fidelity name or an intermediate mesh "N_ALONGxN_THROUGH" with the levels' gradi
 the mesh study: per law and force each level's lifetime, the converged estimate (Richardson from
 the three finest levels where they converge monotonically, else the finest level) and each
 level's error against it, and the coarsest level within 1 % wherever every level has a lifetime.
---seal F1 splits each level's lifetime at F1 at N = 8 N0 (before the seal narrows to one node),
-read from the lumped profile and as the route reads it (validation.bridge.fem_leak), on the same
-states.
+--seal F1 [F1 ...] splits each level's lifetime at each F1 at N = 8 N0 (before the seal narrows to
+a few nodes), read from the lumped profile and as the route reads it (validation.bridge.fem_leak),
+on the same states; with --jsonl it appends the route's lifetimes (and their CPU) for --mesh-study.
 """
 
 from __future__ import annotations
@@ -47,7 +48,8 @@ from fem.mesh import FIDELITIES, mesh_spec
 from validation.bridge.fem_route import DEFAULT_DU_M, FemCup, FemRouteError, Press, lifetime_integral, register
 from validation.bridge.pipeline import surface_uc_table
 
-LAWS = {"frictionless": ContactLaw(), "coulomb 0.5": ContactLaw("coulomb", 0.5),
+LAWS = {"frictionless": ContactLaw(), "coulomb 0.3": ContactLaw("coulomb", 0.3),
+        "coulomb 0.5": ContactLaw("coulomb", 0.5),
         "coulomb 1": ContactLaw("coulomb", 1.0), "coulomb 2": ContactLaw("coulomb", 2.0),
         "sticking": ContactLaw("sticking")}
 
@@ -95,9 +97,10 @@ def main() -> None:
     ap.add_argument("--summarize", default=None, help="print the convergence table of a --jsonl file")
     ap.add_argument("--mesh-study", action="store_true",
                     help="run the lifetimes missing from --jsonl, then print the mesh study (module docstring)")
-    ap.add_argument("--seal", type=float, default=None, metavar="F1",
-                    help="the seal diagnosis at F1 per level (seal_diagnosis): the lifetime until the seal "
-                         "is one node and after, read from the lumped profile and as the route reads it")
+    ap.add_argument("--seal", nargs="+", type=float, default=None, metavar="F1",
+                    help="the seal diagnosis at each F1 per level (seal_diagnosis): the lifetime until "
+                         "N = 8 N0 and after, read from the lumped profile and as the route reads it; "
+                         "with --jsonl the route's lifetimes are appended")
     ap.add_argument("--why", nargs=2, type=float, default=None, metavar=("F_LOW", "F_HIGH"),
                     help="the leak of the two forces' frictionless branch states at equal N / N0, each "
                          "also at the other's p_b (the profile's share against the pressure's)")
@@ -116,10 +119,12 @@ def main() -> None:
     if a.why:
         why(model, *a.why, level=a.levels[0])
         return
-    if a.seal is not None:
-        seal_diagnosis(model, a.seal, a.levels, a.laws[0])
-        return
     du0 = DEFAULT_DU_M if a.du_mm is None else 1e-3 * a.du_mm
+    if a.seal is not None:
+        for law in a.laws:
+            for f in a.du_factors:
+                seal_diagnosis(model, a.seal, a.levels, law, du_m=f * du0, jsonl=a.jsonl)
+        return
     press = None if a.press_u_mm is None else Press("u_m", 1e-3 * a.press_u_mm)
     done = _done(a.jsonl) if a.mesh_study else set()
     print("| level | law | du [mm] | F1 [N] | lifetime [s] | reason | states | Newton it. | seal r start/end [mm] "
@@ -214,43 +219,62 @@ def why(model, low: float, high: float, level: str = "coarse") -> None:
               f"{swapped[0]:.3g} / {swapped[1]:.3g} |", flush=True)
 
 
-def seal_diagnosis(model, F: float, levels: list[str], law: str = "frictionless", split: float = 8.0) -> None:
-    """Where the mesh moves the lifetime at F under `law`: per level, the time until N = split N0
-    (before any level's seal has narrowed to one node) and after it, read from the lumped profile
-    as it is and as the route reads it (`validation.bridge.fem_leak`: a lone node by its
-    reaction), on the same branch states; and at the first state whose contact is one node (the
-    rim corner alone) its N, the corner's reaction and the lumped profile's force over its
-    neighbours' radii."""
+READINGS = {"lumped profile": {"lone_by_reaction": False},
+            "route (lone node by its reaction)": {}}
+
+
+def seal_diagnosis(model, forces: list[float], levels: list[str], law: str = "frictionless", split: float = 8.0,
+                   du_m: float = DEFAULT_DU_M, jsonl: str | None = None) -> None:
+    """Where the mesh moves the lifetime at each force under `law`: per level, the time until
+    N = split N0 (before any level's seal has narrowed to a few nodes) and after it, read in the
+    two ways of READINGS (`validation.bridge.fem_leak`) on the same branch states (refined as
+    the route refines them, with its reading: the route's lifetime); and at the first state whose
+    contact is one node (the rim corner alone) its N, the corner's reaction and the lumped
+    profile's force over its neighbours' radii. With jsonl, the route's lifetime per (level,
+    force) is appended as --jsonl rows (no trajectory fields), with its CPU time."""
+    from fem.branch_end import up_to_most_gas
     from fem.gas_branch import equilibrium_branch, state_between
     from reduced.profile_leak import ContactProfile
     from validation.bridge.fem_leak import contact_reactions, seal_load, state_leak_rate
     from validation.bridge.fem_route import refine_branch
 
-    print(f"| level | reading | lifetime [s] | until {split:g} N0 [s] | after [s] | one node from N/N0 "
-          f"| corner reaction [N] | lumped profile's force [N] |  (F1 = {F:g} N, {law})")
-    print("|---|---|---|---|---|---|---|---|")
+    print(f"| level | F1 [N] | reading | lifetime [s] | until {split:g} N0 [s] | after [s] | one node from N/N0 "
+          f"| corner reaction [N] | lumped profile's force [N] | CPU [s] |  ({law}, du = {1e3 * du_m:g} mm)")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for level in levels:
         route = register()
         sealed = route.seal(model, {**route.options, "cup": fem_cup(level, law)})
         plane = sealed.cup.cup.plane
-        leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, plane=plane)  # noqa: E731
-        branch = equilibrium_branch(sealed.cup, sealed.state, F, du_m=DEFAULT_DU_M)
-        states, q, _ = refine_branch(sealed.cup, list(branch.states), [leak(s) for s in branch.states], F,
-                                     leak, state_between)
-        lumped = np.array([state_leak_rate(s, model, sealed.E_Pa, plane=plane, lone_by_reaction=False)
-                           for s in states])
-        N = np.array([s.N for s in states])
-        loads = [seal_load(s, plane) for s in states]
-        lone = [k for k, ld in enumerate(loads) if ld.rings_r_m.size == 1 and not np.any(ld.p_Pa)]
-        k = lone[0] if lone else len(states) - 1
-        s = states[k]
-        corner = float(np.sum(contact_reactions(plane, s.state)[1]))
-        profile_force = ContactProfile(s.profile.r_m, s.profile.p_Pa).force_N if s.profile.r_m.size > 1 else 0.0
-        for name, rate in (("lumped profile", lumped), ("route (lone node by its reaction)", q)):
-            t = lifetime_integral(N, rate)
-            until = float(np.interp(split * N[0], N, t))
-            print(f"| {level} | {name} | {t[-1]:.4g} | {until:.4g} | {t[-1] - until:.4g} | {N[k] / N[0]:.3f} "
-                  f"| {corner:.3f} | {profile_force:.3f} |", flush=True)
+        for F in forces:
+            c0 = time.process_time()
+            leak = lambda s: state_leak_rate(s, model, sealed.E_Pa, plane=plane)  # noqa: E731
+            branch = equilibrium_branch(sealed.cup, sealed.state, F, du_m=du_m)
+            kept = up_to_most_gas(branch.states) if branch.reason == "fold" else list(branch.states)
+            states, q, _ = refine_branch(sealed.cup, kept, [leak(s) for s in kept], F, leak, state_between)
+            cpu = time.process_time() - c0
+            N = np.array([s.N for s in states])
+            loads = [seal_load(s, plane) for s in states]
+            lone = [k for k, ld in enumerate(loads) if ld.rings_r_m.size == 1 and not np.any(ld.p_Pa)]
+            k = lone[0] if lone else len(states) - 1
+            s = states[k]
+            corner = float(np.sum(contact_reactions(plane, s.state)[1])) if lone else math.nan
+            profile_force = ContactProfile(s.profile.r_m, s.profile.p_Pa).force_N if s.profile.r_m.size > 1 else 0.0
+            for name, how in READINGS.items():
+                rate = q if not how else np.array([state_leak_rate(x, model, sealed.E_Pa, plane=plane, **how)
+                                                   for x in states])
+                t = lifetime_integral(N, rate)
+                until = float(np.interp(split * N[0], N, t))
+                print(f"| {level} | {F:g} | {name} | {t[-1]:.4g} | {until:.4g} | {t[-1] - until:.4g} "
+                      f"| {N[k] / N[0]:.3f} | {corner:.3f} | {profile_force:.3f} | {cpu:.1f} |", flush=True)
+            if jsonl:
+                t = lifetime_integral(N, q)
+                reason = "fold" if branch.reason == "fold" else "reached_r1"
+                row = {"level": level, "law": law, "du_mm": 1e3 * du_m, "F1_N": F, "largest_N": math.nan,
+                       "largest_lower_bound": False, "press_u_mm": None, "lifetime_s": float(t[-1]),
+                       "reason": reason, "states": len(states), "N0": float(N[0]),
+                       "N_max_over_N0": float(N[-1] / N[0]), "cpu_s": cpu, "from": "--seal"}
+                with open(jsonl, "a") as f:
+                    f.write(json.dumps(row) + "\n")
 
 
 def summarize(path: str) -> None:
