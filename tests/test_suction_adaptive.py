@@ -190,7 +190,7 @@ def test_raised_states_are_the_sealed_gas_cups_and_open_without_suction(coarse_c
     dp = gas.p_a_Pa - raised.p_b_Pa
     assert dp > 0 and raised.F1_N == pytest.approx(10.0, rel=0.01)
     states = SuctionStates(mesh, NeoHookean())
-    F1, N, V, r_k, *_, closed = states.state(raised.u_m, dp)
+    F1, N, V, r_k, *_, closed, _ = states.state(raised.u_m, dp)
     assert closed and N > 0
     assert F1 == pytest.approx(raised.F1_N, rel=1e-5, abs=1e-5 * abs(raised.F1_N) + 1e-6)
     assert V == pytest.approx(raised.V_m3, rel=1e-6) and r_k == pytest.approx(raised.seal_r_m, rel=1e-6)
@@ -208,3 +208,42 @@ def test_raised_states_are_the_sealed_gas_cups_and_open_without_suction(coarse_c
     with pytest.raises(SealOpen, match="seal is open"):
         cavity.F1(u[0], 0.5 * dp)
     assert cavity.F1(u[0], dp) == pytest.approx(F1, rel=1e-12)
+
+
+def test_the_table_reads_a_lone_rim_corner_as_the_fem_route_does(tmp_path):
+    """A cup pressed until its rim corner alone touches: the table records the corner as a ring
+    load of its reaction, the plate's force (global equilibrium), and keeps it through its JSON;
+    the leak through the table's state is the fem route's through the same cup pressed by its own
+    path (`validation.bridge.fem_leak`), to the solver's tolerance, and not the lumped profile's."""
+    from reduced.profile_leak import profile_leak_rate, ring_gaps
+    from reduced.suction_table import SuctionTable
+    from reduced.table_surface import solid_profile
+    from validation.bridge.coupled.table import suction_table
+    from validation.bridge.fem_leak import state_leak_rate
+    from validation.bridge.fem_route import FemCup
+    from validation.bridge.pipeline import surface_uc_table
+
+    model = replace(reference_model(cup_by_name("A"), surface_uc_table()), interface="p_b")
+    cup = FemCup("A", "coarse").build(model.gas.T_K, model.p_a_Pa)
+    gas_state = cup.press(0.2e-3)[-1]
+    grid = suction_grid(cup.mesh, NeoHookean(E_Pa=4e6, nu=0.49), [0.1e-3, 0.2e-3], [0.0, 1e3])
+    table = SuctionTable.from_json(suction_table(grid).to_json(tmp_path / "table.json"))
+    r, F = table.seal_rings[1][0]
+    assert r.size == 1 and F[0] == pytest.approx(-table.F1_N[1, 0], rel=1e-9)   # the plate's force
+    assert F[0] == pytest.approx(-gas_state.F1_N, rel=1e-5)
+
+    p_b = 0.7 * model.p_a_Pa
+    patch = model.u_c.patch_length_m
+
+    def table_leak(t):
+        solid = solid_profile(t, 1, 0, 1.0, 0.0, "p_b", patch)
+        return profile_leak_rate(model.gas, model.p_a_Pa, p_b, solid.r_m, ring_gaps(solid, model.u_c, 4e6))
+    fem = state_leak_rate(replace(gas_state, p_b_Pa=p_b, dp_Pa=model.p_a_Pa - p_b), model, 4e6,
+                          plane=cup.cup.plane)
+    assert table_leak(table) == pytest.approx(fem, rel=1e-4)
+    lumped = replace(table, seal_rings=None)          # the reading before: the lumped profile
+    assert table_leak(lumped) != pytest.approx(fem, rel=0.05)
+    ring_off_profile = tuple(tuple(None if p is None else (np.array([0.5 * p.r_m[0]]), np.array([1.0])) for p in row)
+                             for row in table.profiles)
+    with pytest.raises(ValueError, match="seal_rings"):
+        replace(table, seal_rings=ring_off_profile)

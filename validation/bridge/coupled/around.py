@@ -77,7 +77,10 @@ def holed_subtable(table, built: np.ndarray):
     return SuctionTable(u_m=table.u_m, dp_Pa=table.dp_Pa, **cut, E_Pa=table.E_Pa,
                         profiles=tuple(tuple(p if built[i, j] else None for j, p in enumerate(row))
                                        for i, row in enumerate(table.profiles)),
-                        provenance=table.provenance, sealed=table.sealed | ~built)
+                        provenance=table.provenance, sealed=table.sealed | ~built,
+                        seal_rings=None if table.seal_rings is None else
+                        tuple(tuple(x if built[i, j] else None for j, x in enumerate(row))
+                              for i, row in enumerate(table.seal_rings)))
 
 
 def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goal: SuctionGoal,

@@ -105,7 +105,7 @@ def suction_table_for(geometry, *, fidelity: str = "coarse", contact: ContactLaw
 
 #: the `reduced` modules a table is made of (part of its key; the rest of `reduced`, the leak
 #: included, only reads tables; an entry that no longer loads is recomputed by joblib)
-_TABLE_TYPES = ("reduced/suction_table.py", "reduced/stiffness_curve.py")
+_TABLE_TYPES = ("reduced/suction_table.py", "reduced/stiffness_curve.py", "reduced/coupled_seal.py")
 
 
 def _build_adaptive(geometry, fidelity, contact, E_Pa, nu, grid, goal, adaptive, code, progress=None):
