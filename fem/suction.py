@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 from skfem import Mesh
 
+from .branch_end import plate_floor_m
 from .cavity import CavitySurface, PressurizedMechanics
 from .contact import PressureProfile
 from .cup import CupSetup, _joined, _measure, cup_height
@@ -44,7 +45,7 @@ from .interface import ContactLaw
 from .material import NeoHookean
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["SuctionGrid", "SuctionStates", "held_reactions", "suction_grid"]
+__all__ = ["SuctionGrid", "SuctionStates", "held_reactions", "plate_floor_of", "suction_grid"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,9 +82,10 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
                  friction: float = 0.0, wetting_m: float = 0.0,
                  progress: Callable[[float, str], None] | None = None, anchor_m: float | None = None,
                  **solver_opts: Any) -> SuctionGrid:
-    """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in (0, h1];
-    dp_Pa: increasing, starting at 0. u_m: increasing, in (-h1, h1] (u <= 0: raised, module docstring). contact: a `fem.interface.ContactLaw`, or the law's name
-    with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input,
+    """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in
+    [u_floor, h1] (u <= 0: raised, module docstring; u_floor = h1 - 2 L, the plate's floor of the
+    held cup's walk, `fem.branch_end.plate_floor_m`); dp_Pa: increasing, starting at 0. contact:
+    a `fem.interface.ContactLaw`, or the law's name with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input,
     `fem.solver.ConvergenceError` naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
     converged state violates contact between the nodes or folds onto itself."""
     states = SuctionStates(mesh, material, contact, friction, wetting_m, anchor_m, **solver_opts)
@@ -114,9 +116,16 @@ class SuctionStates:
         # a dp interval is one load step unless it needs cutting: the grid itself is the sampling
         self._ramp_options = replace(self._options, initial_step=1.0, max_step=1.0)
         self._cavity = CavitySurface.of(mesh, wetting_m)
+        # the lowest plate position of a raised row: the held cup's floor (fem.branch_end)
+        self.floor_m = plate_floor_m(self)
         self._pressed: dict[float, StepResult] = {}
         self._rows: dict[float, dict[float, tuple[StepResult, tuple]]] = {}
         self.stats: SolverStats | None = None     # the cost of every state solved so far
+
+    @property
+    def cavity(self) -> CavitySurface:
+        """The cavity's surface (its chain of nodes from the plate's edge to the rim)."""
+        return self._cavity
 
     @property
     def solved(self) -> int:
@@ -131,7 +140,7 @@ class SuctionStates:
         """The states on u_m x dp_Pa (as `suction_grid`), solving only those not kept."""
         u = np.asarray(u_m, float)
         dp = np.asarray(dp_Pa, float)
-        _check_axes(u, dp, self.h1_m, self.material)
+        _check_axes(u, dp, self.h1_m, self.floor_m, self.material)
         todo = sum(not self.has(float(a), float(b)) for a in u for b in dp[1:])
         done = 0
         outputs = np.empty((u.size, dp.size), dtype=object)
@@ -223,6 +232,20 @@ class SuctionStates:
         return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0)
 
 
+def plate_floor_of(mesh: Mesh, wetting_m: float = 0.0) -> float:
+    """The plate's floor u_floor = h1 - 2 L [m] of the cup of `mesh` (`fem.branch_end.plate_floor_m`),
+    the lowest u of a raised row."""
+    return plate_floor_m(_MeshCavity(mesh, CavitySurface.of(mesh, wetting_m)))
+
+
+@dataclass(frozen=True)
+class _MeshCavity:
+    """A mesh and its cavity surface (what `fem.branch_end.plate_floor_m` reads of a cup)."""
+
+    mesh: Mesh
+    cavity: CavitySurface
+
+
 def _raising(cup: CupSetup, u_from: float) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
     """The plate raised from u_from: u_z = -(u_from - t) (`fem.solver.follow_path`'s dirichlet(t))."""
     dofs = np.concatenate([2 * cup.top, 2 * cup.top + 1])
@@ -265,11 +288,11 @@ def held_reactions(plane, step: StepResult) -> tuple[np.ndarray, np.ndarray]:
     return r[order], lam[order]
 
 
-def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, material: NeoHookean) -> None:
+def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, floor: float, material: NeoHookean) -> None:
     if u.ndim != 1 or u.size == 0 or not np.all(np.isfinite(u)) or np.any(np.diff(u) <= 0) \
-            or u[0] <= -h1 or u[-1] > h1:
-        raise ValueError(f"u_m: plate displacements must increase within (-h1, h1] = ("
-                         f"{-h1 * 1e3:.4g}, {h1 * 1e3:.4g} mm], got {np.round(u * 1e3, 4).tolist()} mm")
+            or u[0] < floor * (1 + 1e-12) or u[-1] > h1:
+        raise ValueError(f"u_m: plate displacements must increase within [h1 - 2 L, h1] = ["
+                         f"{floor * 1e3:.4g}, {h1 * 1e3:.4g} mm], got {np.round(u * 1e3, 4).tolist()} mm")
     if dp.ndim != 1 or dp.size == 0 or not np.all(np.isfinite(dp)) or dp[0] != 0.0 \
             or np.any(np.diff(dp) <= 0) or dp[-1] > 10.0 * material.E_Pa:
         raise ValueError(f"dp_Pa: cavity pressures must start at 0 and increase, at most 10 E = "
