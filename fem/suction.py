@@ -43,7 +43,7 @@ from .cup import CupSetup, _joined, _measure, cup_height
 from .integrity import check_state
 from .interface import ContactLaw
 from .material import NeoHookean
-from .solver import SolverOptions, SolverStats, StepResult, follow_path
+from .solver import ConvergenceError, SolverOptions, SolverStats, StepResult, follow_path
 
 __all__ = ["SuctionGrid", "SuctionStates", "held_reactions", "plate_floor_of", "suction_grid"]
 
@@ -85,9 +85,11 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
     """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in
     [u_floor, h1] (u <= 0: raised, module docstring; u_floor = h1 - 2 L, the plate's floor of the
     held cup's walk, `fem.branch_end.plate_floor_m`); dp_Pa: increasing, starting at 0. contact:
-    a `fem.interface.ContactLaw`, or the law's name with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input,
-    `fem.solver.ConvergenceError` naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
-    converged state violates contact between the nodes or folds onto itself."""
+    a `fem.interface.ContactLaw`, or the law's name with Coulomb's mu as `friction` (as
+    `fem.cup.compress_cup`). Raises ValueError for bad input, `fem.solver.ConvergenceError` naming
+    u and dp where a pressed state cannot be reached, and `fem.integrity.StateRejected` (one) where
+    a converged pressed state violates contact between the nodes or folds onto itself; a raised
+    state no raise reaches holds no seal (`SuctionStates._raised`)."""
     states = SuctionStates(mesh, material, contact, friction, wetting_m, anchor_m, **solver_opts)
     return states.grid(u_m, dp_Pa, progress=progress)
 
@@ -120,6 +122,9 @@ class SuctionStates:
         self.floor_m = plate_floor_m(self)
         self._pressed: dict[float, StepResult] = {}
         self._rows: dict[float, dict[float, tuple[StepResult, tuple]]] = {}
+        #: raised states no raise reaches (`_raised`): (u, dp) -> the cause
+        self.unreached: dict[tuple[float, float], str] = {}
+        self._unreached_below: dict[float, float] = {}
         self.stats: SolverStats | None = None     # the cost of every state solved so far
 
     @property
@@ -187,8 +192,13 @@ class SuctionStates:
 
     def _raised(self, u: float, dp: float) -> tuple:
         """The state at u <= 0: the plate raised at fixed dp from the kept state at dp with the
-        next larger u (the anchor row's if none is kept; module docstring)."""
+        next larger u (the anchor row's if none is kept; module docstring). Where that raise
+        cannot reach u (the wall folds onto itself, `fem.integrity`, or Newton fails) no cup state
+        is there: the state is returned as holding no seal, with nan numbers and no profile, and
+        kept in `unreached` with its cause, as is every state at that dp above which it lies."""
         row = self._rows.setdefault(u, {})
+        if dp not in row and u <= self._unreached_below.get(dp, -np.inf):
+            return _UNREACHED
         if dp not in row:
             above = [a for a, r in self._rows.items() if a > u and dp in r and a <= self.anchor_m]
             if not above:
@@ -198,9 +208,14 @@ class SuctionStates:
             start = self._rows[a][dp][0]
             mech = (PressurizedMechanics(self._cup.mech, self._cavity, dp, schedule=lambda t, dp=dp: dp)
                     if dp > 0.0 else self._cup.mech)
-            state = self._segment(mech, _raising(self._cup, a), a - u, start, u,
-                                  f"plate raised from u = {a * 1e3:.4g} to {u * 1e3:.4g} mm at dp = {dp / 1e3:.4g} kPa",
-                                  options=self._options)
+            try:
+                state = self._segment(mech, _raising(self._cup, a), a - u, start, u,
+                                      f"plate raised from u = {a * 1e3:.4g} to {u * 1e3:.4g} mm at dp = "
+                                      f"{dp / 1e3:.4g} kPa", options=self._options)
+            except ConvergenceError as err:             # StateRejected included
+                self.unreached[(u, dp)] = str(err)
+                self._unreached_below[dp] = max(u, self._unreached_below.get(dp, -np.inf))
+                return _UNREACHED
             row[dp] = (state, _measured(state, mech.at(1.0) if dp > 0.0 else mech, self._cup, self._cavity))
         return row[dp][1]
 
@@ -244,6 +259,10 @@ class _MeshCavity:
 
     mesh: Mesh
     cavity: CavitySurface
+
+
+#: the outputs of a raised state no raise reaches (`SuctionStates._raised`): no seal, no numbers
+_UNREACHED = (*(np.nan,) * 7, None, False, (np.zeros(0), np.zeros(0)))
 
 
 def _raising(cup: CupSetup, u_from: float) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:

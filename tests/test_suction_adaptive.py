@@ -247,3 +247,31 @@ def test_the_table_reads_a_lone_rim_corner_as_the_fem_route_does(tmp_path):
                              for row in table.profiles)
     with pytest.raises(ValueError, match="seal_rings"):
         replace(table, seal_rings=ring_off_profile)
+
+
+def test_a_raised_state_no_raise_reaches_holds_no_seal(coarse_cup, monkeypatch):
+    """Where the raise at fixed dp cannot reach u (here: rejected below u = -0.2 h1, as a wall
+    folding onto itself is) the state is one without a seal, and so is every deeper state at that
+    dp, without another solve; the table says how many and why (SealOpen where a path reads it)."""
+    from fem.integrity import StateRejected
+    from fem.interface import ContactLaw
+    from validation.bridge.coupled.table import holed_suction_table
+
+    mesh, h1 = coarse_cup
+    states = SuctionStates(mesh, NeoHookean())
+    real, calls = states._segment, []
+
+    def segment(mech, dirichlet, t_max, start, u_plate, where, options=None):
+        calls.append(u_plate)
+        if u_plate < -0.2 * h1:
+            raise StateRejected(f"{where}: the wall folds onto itself", step=0, t_from=0.0, t_to=1.0, cause="folds")
+        return real(mech, dirichlet, t_max, start, u_plate, where, options)
+    monkeypatch.setattr(states, "_segment", segment)
+    u, dp = np.array([-0.4 * h1, -0.3 * h1, -0.1 * h1, 0.05 * h1]), np.array([0.0, 3e4])
+    built = np.zeros((4, 2), dtype=bool)
+    built[:, 1] = True
+    table = holed_suction_table(states, u, dp, built, ContactLaw())
+    assert table.sealed[:, 1].tolist() == [False, False, True, True]
+    assert np.isnan(table.F1_N[:2, 1]).all() and table.profiles[0][1] is None
+    assert sum(c < -0.2 * h1 for c in calls) == 1                 # the deeper one not tried again
+    assert table.provenance["unreached"]["states"] == 1 and "folds" in table.provenance["unreached"]["cause"]

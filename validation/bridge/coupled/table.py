@@ -24,7 +24,7 @@ def suction_table(grid: SuctionGrid, provenance: dict[str, Any] | None = None) -
     and False in `sealed`: its numbers are not those of a cup under suction; so is a state whose
     plane carries no pressure (the rim touching at zero force)."""
     prov = _provenance(grid.contact_law, grid.material, grid.h1_m, grid.stats, provenance)
-    converted = [profiles_from_lists([1e3 * p.r_m for p in row], [1e-3 * p.p_Pa for p in row])
+    converted = [[None if p is None else profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0] for p in row]
                  for row in grid.profiles]
     # a state whose plane carries no pressure (the rim touching at zero force, u = 0 and dp = 0)
     # holds no seal either
@@ -60,7 +60,9 @@ def holed_suction_table(states: SuctionStates, u_m: np.ndarray, dp_Pa: np.ndarra
     `built` [len(u), len(dp)] (solved by `states`, whose contact law is `contact`, pressed rows in
     increasing u and dp, raised rows (u <= 0) in decreasing u, where it lacks them), nan and None
     at the others: a table with holes (`reduced.suction_table`); a state without a seal as in
-    `suction_table`."""
+    `suction_table`, and so is a raised state no raise reaches (the wall folds onto itself, or
+    Newton fails: no cup state is there, a path reaching it has let go; the provenance's
+    `unreached` says how many and why)."""
     shape = (len(u_m), len(dp_Pa))
     grids = {name: np.full(shape, np.nan) for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
     profiles = [[None] * shape[1] for _ in range(shape[0])]
@@ -69,8 +71,8 @@ def holed_suction_table(states: SuctionStates, u_m: np.ndarray, dp_Pa: np.ndarra
     nodes = sorted(zip(*np.nonzero(built)), key=lambda n: (u_m[n[0]] <= 0, abs(u_m[n[0]]), n[1]))
     for i, j in nodes:
         F1, _, V, r_k, r_cut, _, _, p, closed, reactions = states.state(float(u_m[i]), float(dp_Pa[j]))
-        profile = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0]
-        if not closed or profile is None:
+        profile = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0] if closed else None
+        if profile is None:
             sealed[i, j] = False
             continue
         for name, x in zip(grids, (F1, V, r_k, r_cut)):
@@ -78,10 +80,19 @@ def holed_suction_table(states: SuctionStates, u_m: np.ndarray, dp_Pa: np.ndarra
         profiles[i][j] = profile
         rings[i][j] = _rings(profile, reactions)
     prov = _provenance(contact, states.material, states.h1_m, states.stats, provenance)
+    if states.unreached:
+        prov["unreached"] = _unreached(states.unreached)
     return SuctionTable(u_m=np.asarray(u_m, float), dp_Pa=np.asarray(dp_Pa, float), **grids,
                         profiles=tuple(tuple(row) for row in profiles), E_Pa=states.material.E_Pa,
                         provenance=prov, sealed=None if sealed.all() else sealed,
                         seal_rings=tuple(tuple(row) for row in rings))
+
+
+def _unreached(unreached: dict) -> dict:
+    """The provenance of the raised states no raise reached (`fem.suction.SuctionStates._raised`):
+    how many, the highest u among them and the first one's cause."""
+    (u, dp), cause = max(unreached.items(), key=lambda item: item[0])
+    return {"states": len(unreached), "highest_u_mm": 1e3 * u, "cause": f"at dp = {dp / 1e3:.4g} kPa: {cause}"}
 
 
 def _rings(profile, reactions: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
