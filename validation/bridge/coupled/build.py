@@ -188,6 +188,19 @@ def around_table(states, u_m: np.ndarray, dp_Pa: np.ndarray, goal: SuctionGoal, 
                                 "rounds": [list(r) for r in done.rounds], "forces_N": list(goal.forces_N)})
 
 
+def _build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=None):
+    from fem.material import NeoHookean
+    from fem.mesh import cup_mesh
+    from fem.suction import suction_grid
+    from validation.bridge.coupled.table import suction_table
+
+    mesh = cup_mesh(geometry, fidelity)
+    result = suction_grid(mesh, NeoHookean(E_Pa=E_Pa, nu=nu), full_rows(grid, mesh), grid.dp_Pa,
+                          contact=contact, progress=progress)
+    return suction_table(result, {"geometry": geometry.describe(), "fidelity": fidelity,
+                                  "grid": grid.describe()})
+
+
 #: a full table (no goal) holds the raised rows down to u = -FULL_DEPTH_H1 h1 only: below, the
 #: raised cup at large dp is pulled far past any path's use and each row costs all its dp; a build
 #: around the paths reaches the floor where they go
