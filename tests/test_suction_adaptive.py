@@ -275,3 +275,28 @@ def test_a_raised_state_no_raise_reaches_holds_no_seal(coarse_cup, monkeypatch):
     assert np.isnan(table.F1_N[:2, 1]).all() and table.profiles[0][1] is None
     assert sum(c < -0.2 * h1 for c in calls) == 1                 # the deeper one not tried again
     assert table.provenance["unreached"]["states"] == 1 and "folds" in table.provenance["unreached"]["cause"]
+
+
+def test_the_default_grids_raised_rows_reach_the_plate_floor(coarse_cup):
+    """540 raised rows evenly from u = 0 down to the plate's floor h1 - 2 L (below it the states
+    are refused before any solve); a full table keeps those down to -0.6 h1."""
+    from fem.suction import plate_floor_of
+    from validation.bridge.coupled.build import DEFAULT_GRID, FULL_DEPTH_H1, SuctionGridSpec, full_rows
+
+    mesh, h1 = coarse_cup
+    floor = plate_floor_of(mesh)
+    assert floor < -h1                                         # cup A: -24.3 mm, h1 = 9.09 mm
+    u = DEFAULT_GRID.u_m(h1, floor)
+    raised = u[u <= 0]
+    assert raised.size == DEFAULT_GRID.raised_rows + 1 and raised[0] == pytest.approx(floor, rel=1e-12)
+    np.testing.assert_allclose(np.diff(raised), -floor / DEFAULT_GRID.raised_rows, rtol=1e-9)
+    pressed = np.minimum(np.array(DEFAULT_GRID.u_fractions[1:]) * h1, h1)
+    assert pressed.size == 105 and np.array_equal(u[u > 0], pressed)
+    full = full_rows(DEFAULT_GRID, mesh)
+    assert full[0] >= -FULL_DEPTH_H1 * h1 * (1 + 1e-12) and full[0] - (-FULL_DEPTH_H1 * h1) < -floor / 540
+    with pytest.raises(ValueError, match="floor_m"):
+        DEFAULT_GRID.u_m(h1)
+    with pytest.raises(ValueError, match="raised_rows"):
+        SuctionGridSpec((0.1,), (0.0, 1.0), raised_rows=-1)
+    with pytest.raises(ValueError, match=r"u_m: .*h1 - 2 L"):
+        SuctionStates(mesh, NeoHookean()).grid([1.01 * floor, 0.1 * h1], [0.0, 1e3])
