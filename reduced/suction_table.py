@@ -266,6 +266,11 @@ def _ring(value: Any, key: str) -> tuple[np.ndarray, np.ndarray] | None:
     return _numbers(value["r_mm"], f"{key}.r_mm") * 1e-3, _numbers(value["F_N"], f"{key}.F_N")
 
 
+_NO_RINGS = (np.zeros(0), np.zeros(0))
+for _a in _NO_RINGS:
+    _a.flags.writeable = False
+
+
 def _checked_rings(rings, profiles) -> tuple:
     """`rings` as read-only arrays, checked against the profiles: one entry per state, None where
     the profile is, forces finite and >= 0, each radius one of its profile's."""
@@ -273,11 +278,16 @@ def _checked_rings(rings, profiles) -> tuple:
         raise ValueError(f"seal_rings: expected {len(profiles)} rows of {len(profiles[0]) if profiles else 0} entries")
     out = []
     for i, (row, prow) in enumerate(zip(rings, profiles)):
+        if row.count(None) == len(row) == prow.count(None):      # an unbuilt row: nothing to check
+            out.append(tuple(row))
+            continue
         cells = []
         for j, (x, prof) in enumerate(zip(row, prow)):
             if (x is None) != (prof is None):
                 raise ValueError(f"seal_rings[{i}][{j}]: expected null exactly where the profile is null")
-            if x is not None:
+            if x is not None and len(x[0]) == len(x[1]) == 0:        # no lone node (most states)
+                x = _NO_RINGS
+            elif x is not None:
                 r, F = (np.array(a, dtype=float).reshape(-1) for a in x)
                 if r.size != F.size or not (np.all(np.isfinite(F)) and np.all(F >= 0)) \
                         or int(np.isin(r, prof.r_m).sum()) != r.size:
