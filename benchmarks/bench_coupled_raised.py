@@ -1,9 +1,9 @@
-"""The table-coupled route past the touching height: cup A (coarse, frictionless, pmma-1.89) from
-the fem route's sealed content, the table route on the default grid's table built around its
-paths (raised rows u = -0.6 ... 0 h1 every 0.005 h1), beside the fem route, and the same with the
-raised rows' spacing halved (the grid's interpolation error).
+"""The table-coupled route past the touching height: cup A or B (coarse, frictionless, pmma-1.89)
+from the fem route's sealed content, the table route on the default grid's table built around its
+paths (raised rows evenly down to the plate's floor h1 - 2 L, `DEFAULT_GRID`), beside the fem
+route, and the same with the raised rows' spacing halved (the grid's interpolation error).
 
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled_raised.py [--half] [--forces 5 10 20]
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled_raised.py [--half] [--cup B] [--forces 10 20 40]
 
 Prints the fem route's lifetimes, the table's build (states solved, CPU seconds) and per force
 the table route's lifetime, how it ended, its last u, and its difference from the fem route's.
@@ -20,7 +20,7 @@ from scipy.optimize import brentq
 
 import reduced
 from validation.bridge.coupled.adaptive import SuctionGoal
-from validation.bridge.coupled.build import DEFAULT_GRID, SuctionGridSpec, suction_table_for
+from validation.bridge.coupled.build import DEFAULT_GRID, suction_table_for
 from validation.bridge.fem_route import FemCup, register
 from validation.bridge.pipeline import surface_uc_table
 
@@ -28,11 +28,12 @@ from validation.bridge.pipeline import surface_uc_table
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--half", action="store_true", help="halve the raised rows' u spacing")
+    parser.add_argument("--cup", choices=("A", "B"), default="A")
     parser.add_argument("--forces", type=float, nargs="+", default=[5.0, 10.0, 20.0])
     parser.add_argument("--out", default=None, help="also write the table (JSON) here")
     args = parser.parse_args()
-    model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
-    route, cup = register(), FemCup("A", "coarse")
+    model = reduced.reference_model(reduced.CUP_A if args.cup == "A" else reduced.CUP_B, surface_uc_table())
+    route, cup = register(), FemCup(args.cup, "coarse")
     sealed = route.seal(model, {**route.options, "cup": cup})
     u_start = brentq(lambda u: sealed.cup.move_plate(sealed.state, u)[-1].F1_N,
                      0.3 * sealed.state.u_m, (1 - 1e-6) * sealed.state.u_m, xtol=1e-10)
@@ -43,16 +44,11 @@ def main() -> None:
         hint += list(zip(u, dp)) + [(u_start + s * (u[0] - u_start), s * dp[0]) for s in np.linspace(0, 1, 40)]
         print(f"fem route   F1 = {F:g} N: {fem[F].lifetime_s:.4g} s, {fem[F].reason}, u_end = "
               f"{fem[F].trajectory['u_mm'][-1]:.3f} mm", flush=True)
-    grid = DEFAULT_GRID
-    if args.half:
-        u = np.array(grid.u_fractions)
-        raised = u[u <= 0]
-        grid = SuctionGridSpec(tuple(np.sort(np.concatenate([raised, 0.5 * (raised[1:] + raised[:-1])])))
-                               + tuple(u[u > 0]), grid.dp_kPa)
+    grid = DEFAULT_GRID.halved_raised() if args.half else DEFAULT_GRID
     goal = SuctionGoal(dataclasses.replace(model, suction=None, stiffness=None), tuple(args.forces),
                        u_start_m=u_start, hint=tuple(hint), largest=False)
     t = time.process_time()
-    table = suction_table_for("A", fidelity="coarse", goal=goal, grid=grid)
+    table = suction_table_for(args.cup, fidelity="coarse", goal=goal, grid=grid)
     print(f"table {table.provenance['grid']}: {table.provenance['states_solved']} states solved, "
           f"{int((~table.sealed).sum())} without a seal, {time.process_time() - t:.1f} s CPU", flush=True)
     if args.out:

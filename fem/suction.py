@@ -36,15 +36,16 @@ from typing import Any
 import numpy as np
 from skfem import Mesh
 
+from .branch_end import plate_floor_m
 from .cavity import CavitySurface, PressurizedMechanics
 from .contact import PressureProfile
 from .cup import CupSetup, _joined, _measure, cup_height
 from .integrity import check_state
 from .interface import ContactLaw
 from .material import NeoHookean
-from .solver import SolverOptions, SolverStats, StepResult, follow_path
+from .solver import ConvergenceError, SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["SuctionGrid", "SuctionStates", "suction_grid"]
+__all__ = ["SuctionGrid", "SuctionStates", "held_reactions", "plate_floor_of", "suction_grid"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,6 +68,8 @@ class SuctionGrid:
     sealed: np.ndarray          # bool: a node of the cavity chain on the plane (module docstring)
     profiles: tuple[tuple[PressureProfile, ...], ...] = field(repr=False)
     stats: SolverStats = field(repr=False)
+    # the plane's reactions (r [m], lambda [N]) at the held nodes of each state (`held_reactions`)
+    reactions: tuple[tuple[tuple[np.ndarray, np.ndarray], ...], ...] = field(repr=False, default=())
 
     @property
     def contact_law(self) -> ContactLaw:
@@ -79,11 +82,14 @@ def suction_grid(mesh: Mesh, material: NeoHookean, u_m: Sequence[float], dp_Pa: 
                  friction: float = 0.0, wetting_m: float = 0.0,
                  progress: Callable[[float, str], None] | None = None, anchor_m: float | None = None,
                  **solver_opts: Any) -> SuctionGrid:
-    """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in (0, h1];
-    dp_Pa: increasing, starting at 0. u_m: increasing, in (-h1, h1] (u <= 0: raised, module docstring). contact: a `fem.interface.ContactLaw`, or the law's name
-    with Coulomb's mu as `friction` (as `fem.cup.compress_cup`). Raises ValueError for bad input,
-    `fem.solver.ConvergenceError` naming u and dp where a state cannot be reached, and `fem.integrity.StateRejected` (one) where a
-    converged state violates contact between the nodes or folds onto itself."""
+    """The cup's response at every (u_i, dp_j) (module docstring). u_m: increasing, in
+    [u_floor, h1] (u <= 0: raised, module docstring; u_floor = h1 - 2 L, the plate's floor of the
+    held cup's walk, `fem.branch_end.plate_floor_m`); dp_Pa: increasing, starting at 0. contact:
+    a `fem.interface.ContactLaw`, or the law's name with Coulomb's mu as `friction` (as
+    `fem.cup.compress_cup`). Raises ValueError for bad input, `fem.solver.ConvergenceError` naming
+    u and dp where a pressed state cannot be reached, and `fem.integrity.StateRejected` (one) where
+    a converged pressed state violates contact between the nodes or folds onto itself; a raised
+    state no raise reaches holds no seal (`SuctionStates._raised`)."""
     states = SuctionStates(mesh, material, contact, friction, wetting_m, anchor_m, **solver_opts)
     return states.grid(u_m, dp_Pa, progress=progress)
 
@@ -112,9 +118,19 @@ class SuctionStates:
         # a dp interval is one load step unless it needs cutting: the grid itself is the sampling
         self._ramp_options = replace(self._options, initial_step=1.0, max_step=1.0)
         self._cavity = CavitySurface.of(mesh, wetting_m)
+        # the lowest plate position of a raised row: the held cup's floor (fem.branch_end)
+        self.floor_m = plate_floor_m(self)
         self._pressed: dict[float, StepResult] = {}
         self._rows: dict[float, dict[float, tuple[StepResult, tuple]]] = {}
+        #: raised states no raise reaches (`_raised`): (u, dp) -> the cause
+        self.unreached: dict[tuple[float, float], str] = {}
+        self._unreached_below: dict[float, float] = {}
         self.stats: SolverStats | None = None     # the cost of every state solved so far
+
+    @property
+    def cavity(self) -> CavitySurface:
+        """The cavity's surface (its chain of nodes from the plate's edge to the rim)."""
+        return self._cavity
 
     @property
     def solved(self) -> int:
@@ -129,7 +145,7 @@ class SuctionStates:
         """The states on u_m x dp_Pa (as `suction_grid`), solving only those not kept."""
         u = np.asarray(u_m, float)
         dp = np.asarray(dp_Pa, float)
-        _check_axes(u, dp, self.h1_m, self.material)
+        _check_axes(u, dp, self.h1_m, self.floor_m, self.material)
         todo = sum(not self.has(float(a), float(b)) for a in u for b in dp[1:])
         done = 0
         outputs = np.empty((u.size, dp.size), dtype=object)
@@ -150,10 +166,12 @@ class SuctionStates:
             u_m=u, dp_Pa=dp, F1_N=take(outputs, 0), contact_force_N=take(outputs, 1), V_m3=take(outputs, 2),
             seal_r_m=take(outputs, 3), cut_r_m=take(outputs, 4), r_c_m=take(outputs, 5),
             potential_J=take(outputs, 6), sealed=take(outputs, 8).astype(bool),
-            profiles=tuple(tuple(o[7] for o in row) for row in outputs), stats=self.stats)
+            profiles=tuple(tuple(o[7] for o in row) for row in outputs), stats=self.stats,
+            reactions=tuple(tuple(o[9] for o in row) for row in outputs))
 
     def state(self, u: float, dp: float) -> tuple:
-        """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile, sealed) at (u, dp), solved if not kept."""
+        """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile, sealed, reactions) at (u, dp), solved if
+        not kept (reactions: `held_reactions`)."""
         if u <= 0.0:
             return self._raised(u, dp)
         row = self._rows.setdefault(u, {})
@@ -174,8 +192,13 @@ class SuctionStates:
 
     def _raised(self, u: float, dp: float) -> tuple:
         """The state at u <= 0: the plate raised at fixed dp from the kept state at dp with the
-        next larger u (the anchor row's if none is kept; module docstring)."""
+        next larger u (the anchor row's if none is kept; module docstring). Where that raise
+        cannot reach u (the wall folds onto itself, `fem.integrity`, or Newton fails) no cup state
+        is there: the state is returned as holding no seal, with nan numbers and no profile, and
+        kept in `unreached` with its cause, as is every state at that dp above which it lies."""
         row = self._rows.setdefault(u, {})
+        if dp not in row and u <= self._unreached_below.get(dp, -np.inf):
+            return _UNREACHED
         if dp not in row:
             above = [a for a, r in self._rows.items() if a > u and dp in r and a <= self.anchor_m]
             if not above:
@@ -185,9 +208,14 @@ class SuctionStates:
             start = self._rows[a][dp][0]
             mech = (PressurizedMechanics(self._cup.mech, self._cavity, dp, schedule=lambda t, dp=dp: dp)
                     if dp > 0.0 else self._cup.mech)
-            state = self._segment(mech, _raising(self._cup, a), a - u, start, u,
-                                  f"plate raised from u = {a * 1e3:.4g} to {u * 1e3:.4g} mm at dp = {dp / 1e3:.4g} kPa",
-                                  options=self._options)
+            try:
+                state = self._segment(mech, _raising(self._cup, a), a - u, start, u,
+                                      f"plate raised from u = {a * 1e3:.4g} to {u * 1e3:.4g} mm at dp = "
+                                      f"{dp / 1e3:.4g} kPa", options=self._options)
+            except ConvergenceError as err:             # StateRejected included
+                self.unreached[(u, dp)] = str(err)
+                self._unreached_below[dp] = max(u, self._unreached_below.get(dp, -np.inf))
+                return _UNREACHED
             row[dp] = (state, _measured(state, mech.at(1.0) if dp > 0.0 else mech, self._cup, self._cavity))
         return row[dp][1]
 
@@ -219,6 +247,24 @@ class SuctionStates:
         return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0)
 
 
+def plate_floor_of(mesh: Mesh, wetting_m: float = 0.0) -> float:
+    """The plate's floor u_floor = h1 - 2 L [m] of the cup of `mesh` (`fem.branch_end.plate_floor_m`),
+    the lowest u of a raised row."""
+    return plate_floor_m(_MeshCavity(mesh, CavitySurface.of(mesh, wetting_m)))
+
+
+@dataclass(frozen=True)
+class _MeshCavity:
+    """A mesh and its cavity surface (what `fem.branch_end.plate_floor_m` reads of a cup)."""
+
+    mesh: Mesh
+    cavity: CavitySurface
+
+
+#: the outputs of a raised state no raise reaches (`SuctionStates._raised`): no seal, no numbers
+_UNREACHED = (*(np.nan,) * 7, None, False, (np.zeros(0), np.zeros(0)))
+
+
 def _raising(cup: CupSetup, u_from: float) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
     """The plate raised from u_from: u_z = -(u_from - t) (`fem.solver.follow_path`'s dirichlet(t))."""
     dofs = np.concatenate([2 * cup.top, 2 * cup.top + 1])
@@ -242,17 +288,30 @@ def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> t
 
 
 def _measured(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:
-    """`_outputs` and whether the state is sealed (module docstring: a node of the cavity chain
-    on the plane)."""
+    """`_outputs`, whether the state is sealed (module docstring: a node of the cavity chain on
+    the plane) and the plane's reactions at its held nodes (`held_reactions`)."""
     x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])
-    return (*_outputs(state, mech, cup, cavity), bool(np.any(x[1, cavity.nodes] <= cavity.tolerance_m)))
+    return (*_outputs(state, mech, cup, cavity), bool(np.any(x[1, cavity.nodes] <= cavity.tolerance_m)),
+            held_reactions(cup.plane, state))
 
 
-def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, material: NeoHookean) -> None:
+def held_reactions(plane, step: StepResult) -> tuple[np.ndarray, np.ndarray]:
+    """The deformed radii [m] of the nodes the plane holds in the converged state `step` and the
+    plane's reactions lambda_a [N] on them, both sorted by radius: the contact traction as the
+    FEM resolves it (the lumped pressures divide it by each node's share of the facets)."""
+    held = step.contact.active
+    nodes = plane.nodes[held]
+    r = plane.kin.node_coordinates()[0, nodes] + step.u[2 * nodes]
+    lam = plane.reactions(step.r_int)[held]
+    order = np.argsort(r, kind="stable")
+    return r[order], lam[order]
+
+
+def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, floor: float, material: NeoHookean) -> None:
     if u.ndim != 1 or u.size == 0 or not np.all(np.isfinite(u)) or np.any(np.diff(u) <= 0) \
-            or u[0] <= -h1 or u[-1] > h1:
-        raise ValueError(f"u_m: plate displacements must increase within (-h1, h1] = ("
-                         f"{-h1 * 1e3:.4g}, {h1 * 1e3:.4g} mm], got {np.round(u * 1e3, 4).tolist()} mm")
+            or u[0] < floor * (1 + 1e-12) or u[-1] > h1:
+        raise ValueError(f"u_m: plate displacements must increase within [h1 - 2 L, h1] = ["
+                         f"{floor * 1e3:.4g}, {h1 * 1e3:.4g} mm], got {np.round(u * 1e3, 4).tolist()} mm")
     if dp.ndim != 1 or dp.size == 0 or not np.all(np.isfinite(dp)) or dp[0] != 0.0 \
             or np.any(np.diff(dp) <= 0) or dp[-1] > 10.0 * material.E_Pa:
         raise ValueError(f"dp_Pa: cavity pressures must start at 0 and increase, at most 10 E = "

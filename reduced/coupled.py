@@ -29,8 +29,10 @@ the seal to the zone's outer edge (``interface="linear"``; "p_b" keeps the table
 whole dp off: the two bounds). When the u_c table carries a patch length (`UcTable.patch_length_m`,
 from the roughness spectrum) that solid pressure is averaged over patches of that width before
 u_c is read, as on the profile route (`reduced.profile_leak.patch_average`): the nominal pressure
-of rough-contact theory, which makes the leak independent of the mesh where the rim corner alone
-touches.
+of rough-contact theory. A node that touches alone (a seal narrowed to its last ring) enters by
+the plane's reaction on it where the table records it (`SuctionTable.seal_rings`), a ring load
+spread over the patch: the fem route's reading of the same state (`reduced.coupled_seal`), which
+makes the leak independent of the mesh there.
 
 A table with holes (`SuctionTable.built`: states only where the paths go) is read only where
 every state the interpolation reads is built (`reduced.coupled_holes`); the root finders bracket

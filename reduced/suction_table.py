@@ -17,7 +17,13 @@ JSON (one file; units in the key names)::
     {"u_mm": [...], "dp_kPa": [...], "F1_N": [[...]], "V_mm3": [[...]], "seal_r_mm": [[...]],
      "cut_r_mm": [[...]], "E_Pa": 4e6, "profiles": [[{"r_mm": [...], "p_kPa": [...]}, ...]],
      "sealed": [[true, false, ...]],          (optional: absent means every state is sealed)
+     "seal_rings": [[{"r_mm": [...], "F_N": [...]}, ...]],   (optional, below)
      "provenance": {...}}
+
+`seal_rings` (optional; null at a hole): per state the nodes that touch the plane alone (a seal
+narrowed to its last ring) as the leak reads them, each ring's radius and the plane's reaction on
+it, at a radius of the state's profile (`reduced.coupled_seal`: the same reading as the fem
+route's). Absent: the table records no reactions and its lumped profiles are read as they are.
 """
 
 from __future__ import annotations
@@ -84,6 +90,8 @@ class SuctionTable:
     E_Pa: float
     provenance: dict[str, Any] = field(default_factory=dict)
     sealed: np.ndarray | None = None
+    #: per state (r_m, F_N) of the lone nodes' ring loads (module docstring), None at a hole; None: not recorded
+    seal_rings: tuple[tuple[tuple[np.ndarray, np.ndarray] | None, ...], ...] | None = None
 
     def __post_init__(self) -> None:
         u, dp = (np.array(a, dtype=float) for a in (self.u_m, self.dp_Pa))
@@ -116,6 +124,8 @@ class SuctionTable:
             raise ValueError(f"profiles: expected {u.size} rows of {dp.size} profiles")
         if any(self.profiles[i][j] is not None for i, j in zip(*np.nonzero(hole))):
             raise ValueError("profiles: expected null at every hole of the grids")
+        if self.seal_rings is not None:
+            object.__setattr__(self, "seal_rings", _checked_rings(self.seal_rings, self.profiles))
         if not (np.isfinite(self.E_Pa) and self.E_Pa > 0):
             raise ValueError(f"E_Pa: the modulus of the table must be > 0 Pa, got {self.E_Pa}")
         u.flags.writeable = dp.flags.writeable = False
@@ -144,7 +154,9 @@ class SuctionTable:
         k = np.asarray(keep, dtype=bool)
         return SuctionTable(u_m=self.u_m[k], dp_Pa=self.dp_Pa, **{name: getattr(self, name)[k] for name, _ in _GRIDS.values()},
                             profiles=tuple(row for row, ok in zip(self.profiles, k) if ok), E_Pa=self.E_Pa,
-                            provenance=self.provenance, sealed=None if self.sealed[k].all() else self.sealed[k])
+                            provenance=self.provenance, sealed=None if self.sealed[k].all() else self.sealed[k],
+                            seal_rings=None if self.seal_rings is None else
+                            tuple(row for row, ok in zip(self.seal_rings, k) if ok))
 
     @property
     def h1_m(self) -> float:
@@ -162,6 +174,9 @@ class SuctionTable:
                                                       "p_kPa": (p.p_Pa / 1e3).tolist()} for p in row]
                              for row in self.profiles],
                 **({} if self.all_sealed else {"sealed": self.sealed.tolist()}),
+                **({} if self.seal_rings is None else {"seal_rings": [
+                    [None if x is None else {"r_mm": (x[0] * 1e3).tolist(), "F_N": x[1].tolist()} for x in row]
+                    for row in self.seal_rings]}),
                 "provenance": self.provenance}
         tmp = path.with_name(path.name + ".tmp")
         tmp.write_text(json.dumps(data))
@@ -195,10 +210,17 @@ class SuctionTable:
             if sealed is not None and not (isinstance(sealed, list) and all(
                     isinstance(row, list) and all(isinstance(x, bool) for x in row) for row in sealed)):
                 raise ValueError("sealed: expected rows (lists) of true/false")
+            rings = data.get("seal_rings")
+            if rings is not None:
+                if not (isinstance(rings, list) and all(isinstance(row, list) for row in rings)):
+                    raise ValueError("seal_rings: expected rows (lists), one per u")
+                rings = tuple(tuple(_ring(x, f"seal_rings[{i}][{j}]") for j, x in enumerate(row))
+                              for i, row in enumerate(rings))
             return cls(u_m=_numbers(data["u_mm"], "u_mm") * 1e-3, dp_Pa=_numbers(data["dp_kPa"], "dp_kPa") * 1e3,
                        **grids, profiles=profiles, E_Pa=float(_numbers(data["E_Pa"], "E_Pa", scalar=True)),
                        provenance=provenance,
-                       sealed=None if sealed is None else np.array(sealed, dtype=bool).reshape(len(sealed), -1))
+                       sealed=None if sealed is None else np.array(sealed, dtype=bool).reshape(len(sealed), -1),
+                       seal_rings=rings)
         except ValueError as err:
             field_, _, rest = str(err).partition(": ")
             spelled = {name: key for key, (name, _) in _GRIDS.items()}.get(field_, field_)   # as the file spells it
@@ -233,3 +255,46 @@ def _profile(value: Any, key: str) -> ContactProfile | None:
         return ContactProfile(r_m, p_Pa)
     except ValueError as err:
         raise ValueError(f"{key}: {err}") from None
+
+
+def _ring(value: Any, key: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """One state's ring loads of the JSON form ({"r_mm": [...], "F_N": [...]} or null)."""
+    if value is None:
+        return None
+    if not isinstance(value, dict) or set(value) != {"r_mm", "F_N"}:
+        raise ValueError(f"{key}: expected null or an object with exactly the keys r_mm, F_N")
+    return _numbers(value["r_mm"], f"{key}.r_mm") * 1e-3, _numbers(value["F_N"], f"{key}.F_N")
+
+
+_NO_RINGS = (np.zeros(0), np.zeros(0))
+for _a in _NO_RINGS:
+    _a.flags.writeable = False
+
+
+def _checked_rings(rings, profiles) -> tuple:
+    """`rings` as read-only arrays, checked against the profiles: one entry per state, None where
+    the profile is, forces finite and >= 0, each radius one of its profile's."""
+    if len(rings) != len(profiles) or any(len(a) != len(b) for a, b in zip(rings, profiles)):
+        raise ValueError(f"seal_rings: expected {len(profiles)} rows of {len(profiles[0]) if profiles else 0} entries")
+    out = []
+    for i, (row, prow) in enumerate(zip(rings, profiles)):
+        if row.count(None) == len(row) == prow.count(None):      # an unbuilt row: nothing to check
+            out.append(tuple(row))
+            continue
+        cells = []
+        for j, (x, prof) in enumerate(zip(row, prow)):
+            if (x is None) != (prof is None):
+                raise ValueError(f"seal_rings[{i}][{j}]: expected null exactly where the profile is null")
+            if x is not None and len(x[0]) == len(x[1]) == 0:        # no lone node (most states)
+                x = _NO_RINGS
+            elif x is not None:
+                r, F = (np.array(a, dtype=float).reshape(-1) for a in x)
+                if r.size != F.size or not (np.all(np.isfinite(F)) and np.all(F >= 0)) \
+                        or int(np.isin(r, prof.r_m).sum()) != r.size:
+                    raise ValueError(f"seal_rings[{i}][{j}]: expected one force >= 0 per ring, each ring at "
+                                     f"a radius of the state's profile")
+                r.flags.writeable = F.flags.writeable = False
+                x = (r, F)
+            cells.append(x)
+        out.append(tuple(cells))
+    return tuple(out)

@@ -15,7 +15,8 @@ from functools import cached_property
 
 import numpy as np
 
-from reduced.profile_leak import ContactProfile, patch_average
+from reduced.coupled_seal import solid_seal_profile
+from reduced.profile_leak import ContactProfile
 from reduced.suction_table import SuctionTable
 
 __all__ = ["INTERFACES", "TableSurface", "cell", "solid_profile"]
@@ -73,18 +74,13 @@ def solid_profile(table: SuctionTable, i: int, j: int, scale: float, dp: float,
     """The solid contact pressure at node (i, j): scale p_tab less the interface gas's rise over
     p_b across the zone [r_k, r_cut] at the pressure difference dp (`reduced.coupled`), averaged
     over patches of `patch_length_m` when given (the nominal pressure of rough-contact theory,
-    `reduced.profile_leak.patch_average`; the suction's share is in the FEM's pressures already).
-    ValueError where the table has no profile (the cavity is open there)."""
+    `reduced.profile_leak.patch_average`; the suction's share is in the FEM's pressures already),
+    a lone node by its ring load where the table records it (`reduced.coupled_seal`, the fem
+    route's reading). ValueError where the table has no profile (the cavity is open there)."""
     prof = table.profiles[i][j]
     if prof is None:
         raise ValueError(f"suction table: no contact profile at u = {1e3 * table.u_m[i]:.4g} mm, "
                          f"dp = {table.dp_Pa[j] / 1e3:.4g} kPa (the cavity is open)")
-    r, p = prof.r_m, scale * prof.p_Pa
-    rk, rcut = table.seal_r_m[i, j], table.cut_r_m[i, j]
-    tol = 1e-9 * rcut                       # the zone's end nodes are profile nodes too
-    zone = (r >= rk - tol) & (r <= rcut + tol)
-    rise = {"p_b": 0.0, "p_a": 1.0}.get(interface)
-    if rise is None:
-        rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
-    solid = ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
-    return patch_average(solid, patch_length_m) if patch_length_m else solid
+    rings = None if table.seal_rings is None else table.seal_rings[i][j]
+    return solid_seal_profile(prof, *(rings or (None, None)), dp, table.seal_r_m[i, j], table.cut_r_m[i, j],
+                              interface, patch_length_m, scale)

@@ -171,7 +171,7 @@ def test_suction_grid_without_suction_is_the_cup_curve(grid):
 
 def test_suction_grid_refuses_bad_axes():
     mesh = cup_mesh(cup_geometry("A"), "coarse")
-    for u_m in ([1e-3, 0.0], [-1.0, 1e-3], [1e-3, 1.0]):        # not increasing; outside (-h1, h1]
+    for u_m in ([1e-3, 0.0], [-1.0, 1e-3], [1e-3, 1.0]):        # not increasing; outside [h1 - 2 L, h1]
         with pytest.raises(ValueError, match="u_m"):
             suction_grid(mesh, NeoHookean(), u_m=u_m, dp_Pa=[0.0, 1e4])
     with pytest.raises(ValueError, match="dp_Pa"):

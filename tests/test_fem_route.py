@@ -124,14 +124,13 @@ def table(model, sealed_start, fem_lives):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("force_N", [5.0, 10.0, pytest.param(20.0, marks=pytest.mark.xfail(strict=True, reason=(
-    "the fem route reads a seal reduced to one node by its reaction (validation.bridge.fem_leak), the "
-    "table route its stored lumped profile: 471.0 against 476.8 s (-1.2 %)")))])
+@pytest.mark.parametrize("force_N", [5.0, 10.0, 20.0])
 def test_mu0_equals_the_table_coupled_route(model, table, sealed_start, fem_lives, force_N):
     """Two paths to one answer: the FEM branch at N as unknown against the (u, dp) table's branch,
     started from the same sealed content, both ending where the seal opens (the table's states
-    above the touching height, u < 0, say where no node of the cavity is on the plane): whole
-    lifetimes within 1 %."""
+    above the touching height, u < 0, say where no node of the cavity is on the plane), both
+    reading a seal narrowed to one node by its reaction (`reduced.coupled_seal`): whole lifetimes
+    within 1 %."""
     from reduced.lifetime.routes import ROUTES
 
     route = ROUTES["coupled"]          # its cavity, as the route builds it from the model

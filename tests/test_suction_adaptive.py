@@ -190,7 +190,7 @@ def test_raised_states_are_the_sealed_gas_cups_and_open_without_suction(coarse_c
     dp = gas.p_a_Pa - raised.p_b_Pa
     assert dp > 0 and raised.F1_N == pytest.approx(10.0, rel=0.01)
     states = SuctionStates(mesh, NeoHookean())
-    F1, N, V, r_k, *_, closed = states.state(raised.u_m, dp)
+    F1, N, V, r_k, *_, closed, _ = states.state(raised.u_m, dp)
     assert closed and N > 0
     assert F1 == pytest.approx(raised.F1_N, rel=1e-5, abs=1e-5 * abs(raised.F1_N) + 1e-6)
     assert V == pytest.approx(raised.V_m3, rel=1e-6) and r_k == pytest.approx(raised.seal_r_m, rel=1e-6)
@@ -208,3 +208,95 @@ def test_raised_states_are_the_sealed_gas_cups_and_open_without_suction(coarse_c
     with pytest.raises(SealOpen, match="seal is open"):
         cavity.F1(u[0], 0.5 * dp)
     assert cavity.F1(u[0], dp) == pytest.approx(F1, rel=1e-12)
+
+
+def test_the_table_reads_a_lone_rim_corner_as_the_fem_route_does(tmp_path):
+    """A cup pressed until its rim corner alone touches: the table records the corner as a ring
+    load of its reaction, the plate's force (global equilibrium), and keeps it through its JSON;
+    the leak through the table's state is the fem route's through the same cup pressed by its own
+    path (`validation.bridge.fem_leak`), to the solver's tolerance, and not the lumped profile's."""
+    from reduced.profile_leak import profile_leak_rate, ring_gaps
+    from reduced.suction_table import SuctionTable
+    from reduced.table_surface import solid_profile
+    from validation.bridge.coupled.table import suction_table
+    from validation.bridge.fem_leak import state_leak_rate
+    from validation.bridge.fem_route import FemCup
+    from validation.bridge.pipeline import surface_uc_table
+
+    model = replace(reference_model(cup_by_name("A"), surface_uc_table()), interface="p_b")
+    cup = FemCup("A", "coarse").build(model.gas.T_K, model.p_a_Pa)
+    gas_state = cup.press(0.2e-3)[-1]
+    grid = suction_grid(cup.mesh, NeoHookean(E_Pa=4e6, nu=0.49), [0.1e-3, 0.2e-3], [0.0, 1e3])
+    table = SuctionTable.from_json(suction_table(grid).to_json(tmp_path / "table.json"))
+    r, F = table.seal_rings[1][0]
+    assert r.size == 1 and F[0] == pytest.approx(-table.F1_N[1, 0], rel=1e-9)   # the plate's force
+    assert F[0] == pytest.approx(-gas_state.F1_N, rel=1e-5)
+
+    p_b = 0.7 * model.p_a_Pa
+    patch = model.u_c.patch_length_m
+
+    def table_leak(t):
+        solid = solid_profile(t, 1, 0, 1.0, 0.0, "p_b", patch)
+        return profile_leak_rate(model.gas, model.p_a_Pa, p_b, solid.r_m, ring_gaps(solid, model.u_c, 4e6))
+    fem = state_leak_rate(replace(gas_state, p_b_Pa=p_b, dp_Pa=model.p_a_Pa - p_b), model, 4e6,
+                          plane=cup.cup.plane)
+    assert table_leak(table) == pytest.approx(fem, rel=1e-4)
+    lumped = replace(table, seal_rings=None)          # the reading before: the lumped profile
+    assert table_leak(lumped) != pytest.approx(fem, rel=0.05)
+    ring_off_profile = tuple(tuple(None if p is None else (np.array([0.5 * p.r_m[0]]), np.array([1.0])) for p in row)
+                             for row in table.profiles)
+    with pytest.raises(ValueError, match="seal_rings"):
+        replace(table, seal_rings=ring_off_profile)
+
+
+def test_a_raised_state_no_raise_reaches_holds_no_seal(coarse_cup, monkeypatch):
+    """Where the raise at fixed dp cannot reach u (here: rejected below u = -0.2 h1, as a wall
+    folding onto itself is) the state is one without a seal, and so is every deeper state at that
+    dp, without another solve; the table says how many and why (SealOpen where a path reads it)."""
+    from fem.integrity import StateRejected
+    from fem.interface import ContactLaw
+    from validation.bridge.coupled.table import holed_suction_table
+
+    mesh, h1 = coarse_cup
+    states = SuctionStates(mesh, NeoHookean())
+    real, calls = states._segment, []
+
+    def segment(mech, dirichlet, t_max, start, u_plate, where, options=None):
+        calls.append(u_plate)
+        if u_plate < -0.2 * h1:
+            raise StateRejected(f"{where}: the wall folds onto itself", step=0, t_from=0.0, t_to=1.0, cause="folds")
+        return real(mech, dirichlet, t_max, start, u_plate, where, options)
+    monkeypatch.setattr(states, "_segment", segment)
+    u, dp = np.array([-0.4 * h1, -0.3 * h1, -0.1 * h1, 0.05 * h1]), np.array([0.0, 3e4])
+    built = np.zeros((4, 2), dtype=bool)
+    built[:, 1] = True
+    table = holed_suction_table(states, u, dp, built, ContactLaw())
+    assert table.sealed[:, 1].tolist() == [False, False, True, True]
+    assert np.isnan(table.F1_N[:2, 1]).all() and table.profiles[0][1] is None
+    assert sum(c < -0.2 * h1 for c in calls) == 1                 # the deeper one not tried again
+    assert table.provenance["unreached"]["states"] == 1 and "folds" in table.provenance["unreached"]["cause"]
+
+
+def test_the_default_grids_raised_rows_reach_the_plate_floor(coarse_cup):
+    """540 raised rows evenly from u = 0 down to the plate's floor h1 - 2 L (below it the states
+    are refused before any solve); a full table keeps those down to -0.6 h1."""
+    from fem.suction import plate_floor_of
+    from validation.bridge.coupled.build import DEFAULT_GRID, FULL_DEPTH_H1, SuctionGridSpec, full_rows
+
+    mesh, h1 = coarse_cup
+    floor = plate_floor_of(mesh)
+    assert floor < -h1                                         # cup A: -24.3 mm, h1 = 9.09 mm
+    u = DEFAULT_GRID.u_m(h1, floor)
+    raised = u[u <= 0]
+    assert raised.size == DEFAULT_GRID.raised_rows + 1 and raised[0] == pytest.approx(floor, rel=1e-12)
+    np.testing.assert_allclose(np.diff(raised), -floor / DEFAULT_GRID.raised_rows, rtol=1e-9)
+    pressed = np.minimum(np.array(DEFAULT_GRID.u_fractions[1:]) * h1, h1)
+    assert pressed.size == 105 and np.array_equal(u[u > 0], pressed)
+    full = full_rows(DEFAULT_GRID, mesh)
+    assert full[0] >= -FULL_DEPTH_H1 * h1 * (1 + 1e-12) and full[0] - (-FULL_DEPTH_H1 * h1) < -floor / 540
+    with pytest.raises(ValueError, match="floor_m"):
+        DEFAULT_GRID.u_m(h1)
+    with pytest.raises(ValueError, match="raised_rows"):
+        SuctionGridSpec((0.1,), (0.0, 1.0), raised_rows=-1)
+    with pytest.raises(ValueError, match=r"u_m: .*h1 - 2 L"):
+        SuctionStates(mesh, NeoHookean()).grid([1.01 * floor, 0.1 * h1], [0.0, 1e3])

@@ -18,10 +18,12 @@ quantity: alone on the plane, the corner's is the plate's force (global equilibr
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from reduced.coupled_seal import SealLoad, lone_samples, solid_seal_profile
+from reduced.coupled_seal import seal_load as _seal_load
 
 if TYPE_CHECKING:
     from fem.contact import RigidPlane
@@ -31,52 +33,22 @@ if TYPE_CHECKING:
 __all__ = ["SealLoad", "seal_load", "contact_reactions", "state_leak_rate"]
 
 
-@dataclass(frozen=True)
-class SealLoad:
-    """The contact traction of one FEM state as the leak reads it (module docstring): the lumped
-    pressures p_Pa [Pa] at the contact nodes' radii r_m [m] (0 at a lone node), and the lone nodes'
-    reactions rings_F_N [N] at rings_r_m [m]."""
-
-    r_m: np.ndarray
-    p_Pa: np.ndarray
-    rings_r_m: np.ndarray
-    rings_F_N: np.ndarray
-
-
 def contact_reactions(plane: RigidPlane, step) -> tuple[np.ndarray, np.ndarray]:
     """The plane's reactions lambda_a [N] at the nodes it holds and their deformed radii [m], both
     sorted by radius, of a converged state `step` (a `fem.solver.StepResult`)."""
-    held = step.contact.active
-    nodes = plane.nodes[held]
-    r = plane.kin.node_coordinates()[0, nodes] + step.u[2 * nodes]
-    lam = plane.reactions(step.r_int)[held]
-    order = np.argsort(r, kind="stable")
-    return r[order], lam[order]
+    from fem.suction import held_reactions
+
+    return held_reactions(plane, step)
 
 
 def seal_load(state: GasState, plane: RigidPlane) -> SealLoad:
-    """The state's `SealLoad`: its profile (radii merged where nodes coincide, the largest
-    pressure kept), each loaded sample whose neighbours in r are both unloaded taken out of it
-    and given as a ring load of the reactions of the nodes at its radius."""
+    """The state's `SealLoad` (`reduced.coupled_seal.seal_load`): its profile (radii merged where
+    nodes coincide, the largest pressure kept), each loaded sample whose neighbours in r are both
+    unloaded taken out of it and given as a ring load of the reactions of the nodes at its radius."""
     radii, p = _merged_profile(state)
-    loaded = p > 0
-    neighbour = np.zeros_like(loaded)
-    neighbour[1:] |= loaded[:-1]
-    neighbour[:-1] |= loaded[1:]
-    lone = loaded & ~neighbour
-    rings = radii[lone]
-    if rings.size:
-        r, lam = contact_reactions(plane, state.state)
-        tol = 1e-12 * rings
-        lo, hi = np.searchsorted(r, rings - tol, "left"), np.searchsorted(r, rings + tol, "right")
-        if np.any(hi <= lo):
-            raise RuntimeError("seal_load: a loaded node of the profile is not among the plane's held "
-                               "nodes (the profile and the state disagree)")
-        sums = np.concatenate([[0.0], np.cumsum(lam)])
-        forces = np.maximum(sums[hi] - sums[lo], 0.0)
-    else:
-        forces = np.zeros(0)
-    return SealLoad(radii, np.where(lone, 0.0, p), rings, forces)
+    if not lone_samples(p).any():              # no reactions needed
+        return SealLoad(radii, p, np.zeros(0), np.zeros(0))
+    return _seal_load(radii, p, *contact_reactions(plane, state.state))
 
 
 def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: str = "annulus", *,
@@ -91,7 +63,7 @@ def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: s
     where no solid contact is left (the fluid holds the seal open).
     lone_by_reaction=False reads the lumped profile as it is, lone nodes included (the reading
     before, for the mesh study's diagnosis)."""
-    from reduced.profile_leak import ContactProfile, patch_average, profile_leak_rate, profile_liquid_rate, ring_gaps
+    from reduced.profile_leak import ContactProfile, profile_leak_rate, profile_liquid_rate, ring_gaps
 
     patch = getattr(model.u_c, "patch_length_m", None)
     if patch and lone_by_reaction:
@@ -100,17 +72,9 @@ def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: s
         load = SealLoad(*_merged_profile(state), np.zeros(0), np.zeros(0))
     if load.r_m.size < 2 or not (np.any(load.p_Pa > 0) or np.any(load.rings_F_N > 0)):
         return math.inf
-    r, p = load.r_m, load.p_Pa
-    dp = max(state.dp_Pa, 0.0)
-    rk, rcut = state.seal_r_m, state.cut_r_m
-    tol = 1e-9 * rcut
-    zone = (r >= rk - tol) & (r <= rcut + tol)
-    rise = {"p_b": 0.0, "p_a": 1.0}.get(model.interface)
-    if rise is None:
-        rise = np.clip((r - rk) / (rcut - rk), 0.0, 1.0) if rcut > rk else 1.0
-    solid = ContactProfile(r, np.where(zone, np.maximum(p - dp * rise, 0.0), p))
-    if patch:
-        solid = patch_average(solid, patch, load.rings_r_m, load.rings_F_N)
+    r, lumped = _merged_profile(state)
+    solid = solid_seal_profile(ContactProfile(r, lumped), load.rings_r_m, load.rings_F_N, max(state.dp_Pa, 0.0),
+                               state.seal_r_m, state.cut_r_m, model.interface, patch)
     gaps = ring_gaps(solid, model.u_c, E_Pa)
     if np.all(np.isinf(gaps)):
         return math.inf

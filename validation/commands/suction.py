@@ -8,11 +8,12 @@ on the handle F1, the cavity volume, the seal radius and the contact-pressure pr
 `cupcheck lifetime --route coupled --suction-table FILE` reads. Every input is checked before the
 solve (one line, exit 2); a solve that fails exits 1; no file is left behind either way.
 
---grid adaptive builds only the rows and columns of that grid which the lifetimes at --force on
---surface need (`validation.bridge.coupled.adaptive`: refined where the interpolation changes
-those lifetimes), among its pressed rows u > 0 (its lifetimes end at that edge); --grid full (the
-default) builds every state. Lifetimes past the touching height build their table around their
-paths (`validation.bridge.coupled.around`, as `lifetime --route coupled` does).
+--grid adaptive builds only the states of that grid which the lifetimes at --force on --surface
+and the largest holdable force read: the table with holes around their paths
+(`validation.bridge.coupled.around`), the same states `lifetime --route coupled` builds, its
+raised rows down to where the paths let go (at the latest the plate's floor h1 - 2 L,
+`fem.branch_end`). --grid full (the default) builds every state of the grid, its raised rows
+down to -0.6 h1 (`validation.bridge.coupled.build.FULL_DEPTH_H1`).
 
 The contact law is --contact (with --friction for coulomb), else the --geometry file's [contact]
 table, else frictionless; the table's provenance records it and where it came from.
@@ -51,10 +52,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     r.add_argument("--fidelity", choices=("coarse", "medium", "fine"), default="medium",
                    help="mesh level (default medium)")
     r.add_argument("--u-mm", type=float, nargs="+", default=None, dest="u_mm", metavar="U",
-                   help="plate displacements [mm], increasing, in (-h1, h1]; u <= 0 is the plate "
-                        "above the free cup's touching height, raised at fixed dp (default: 226 "
-                        "values, -0.6 ... 0 h1 every 0.005 h1 and 105 from 0.001 to 0.8 h1, graded "
-                        "towards 0)")
+                   help="plate displacements [mm], increasing, in [h1 - 2 L, h1] (L: the wall's "
+                        "length; h1 - 2 L the plate's floor); u <= 0 is the plate above the free "
+                        "cup's touching height, raised at fixed dp (default: 105 values from 0.001 "
+                        "to 0.8 h1, graded towards 0, u = 0 and 540 raised rows evenly down to the "
+                        "floor; --grid full builds those down to -0.6 h1)")
     r.add_argument("--dp-kPa", type=float, nargs="+", default=list(DEFAULT_GRID.dp_kPa), dest="dp_kPa",
                    metavar="DP",
                    help="pressure differences p_a - p_b [kPa], from 0, increasing, at most 1000 "
@@ -98,24 +100,22 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _adaptive(args: argparse.Namespace, job: dict, provenance: dict, progress):
-    """The adaptive table on the lattice u_m x dp_Pa for the goal (`validation.bridge.coupled.adaptive`)."""
+    """The table with holes around the goal's paths on the lattice u_m x dp_Pa
+    (`validation.bridge.coupled.around`, as the lifetimes' products build it)."""
     from fem.suction import SuctionStates
-    from validation.bridge.coupled.adaptive import adaptive_axes
-    from validation.bridge.coupled.table import suction_table
+    from validation.bridge.coupled.build import AroundSpec, around_table
 
-    states = SuctionStates(job["mesh"], job["material"], job["contact"].contact)
-    # the adaptive rows and columns follow the branches to the pressed rows' edge (u > 0): its
-    # refinement reads the branch's end at the table's smallest u, not the seal's opening
-    u, dp = job["u_m"][job["u_m"] > 0], job["dp_Pa"]
-
-    def table_on(iu, jd):
-        return suction_table(states.grid(u[list(iu)], dp[list(jd)], progress=progress), provenance)
-
-    axes = adaptive_axes(table_on, u.size, dp.size, job["goal"])
-    grid = states.grid(u[list(axes.u_index)], dp[list(axes.dp_index)])
-    table = suction_table(grid, {**provenance, "grid": axes.describe(), "lattice": f"{u.size} u x {dp.size} dp",
-                                 "states_solved": states.solved, "forces_N": list(job["goal"].forces_N)})
-    return table, f"{axes.describe()} of {u.size} x {dp.size}, {states.solved} states solved"
+    contact = job["contact"].contact
+    # pressed from the kept row below in one step, as the products' build (frictionless states do
+    # not depend on the path)
+    states = SuctionStates(job["mesh"], job["material"], contact, initial_step=1.0, max_step=1.0)
+    u, dp = job["u_m"], job["dp_Pa"]
+    table = around_table(states, u, dp, job["goal"], AroundSpec(), contact, provenance,
+                         f"{u.size} u x {dp.size} dp", progress)
+    raised = int(np.sum(table.built.any(axis=1) & (table.u_m <= 0)))
+    return table, (f"{int(table.built.sum())} states around the paths of {u.size} x {dp.size} ({raised} raised "
+                   f"rows, down to u = {1e3 * table.u_m[np.flatnonzero(table.built.any(axis=1))[0]]:.4g} mm), "
+                   f"{states.solved} states solved")
 
 
 def _prepare(args: argparse.Namespace) -> dict:
@@ -123,6 +123,8 @@ def _prepare(args: argparse.Namespace) -> dict:
     from fem.cup import cup_height
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
+    from fem.suction import plate_floor_of
+    from validation.bridge.coupled.build import full_rows
     from validation.commands._paths import check_writable
     from validation.bridge.pipeline import LOCKING_NU
     from validation.guards import check_design, check_modulus
@@ -142,10 +144,14 @@ def _prepare(args: argparse.Namespace) -> dict:
     geometry = geo.describe()
     check_design(geometry, args.allow_unusual_design, source=geo.name)
     mesh = cup_mesh(geo, args.fidelity)
-    h1 = cup_height(mesh)
-    u = DEFAULT_GRID.u_m(h1) if args.u_mm is None else 1e-3 * np.array(args.u_mm, float)
-    if not (np.all(np.isfinite(u)) and np.all(np.diff(u) > 0) and u[0] > -h1 and u[-1] <= h1 * (1 + 1e-9)):
-        raise ValueError(f"u_mm: plate displacements must increase within (-h1, h1] = ({-1e3 * h1:.6g}, "
+    h1, floor = cup_height(mesh), plate_floor_of(mesh)
+    if args.u_mm is not None:
+        u = 1e-3 * np.array(args.u_mm, float)
+    else:
+        u = DEFAULT_GRID.u_m(h1, floor) if args.grid == "adaptive" else full_rows(DEFAULT_GRID, mesh)
+    if not (np.all(np.isfinite(u)) and np.all(np.diff(u) > 0) and u[0] >= floor * (1 + 1e-9)
+            and u[-1] <= h1 * (1 + 1e-9)):
+        raise ValueError(f"u_mm: plate displacements must increase within [h1 - 2 L, h1] = [{1e3 * floor:.6g}, "
                          f"{1e3 * h1:.6g}] mm, got {args.u_mm}")
     dp = np.array(args.dp_kPa, float)
     if not (np.all(np.isfinite(dp)) and dp[0] == 0 and np.all(np.diff(dp) > 0) and dp[-1] <= 1000

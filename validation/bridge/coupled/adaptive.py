@@ -128,7 +128,9 @@ def lattice_subtable(table, u_index: Sequence[int], dp_index: Sequence[int]):
     cut = {name: getattr(table, name)[np.ix_(iu, jd)] for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
     return SuctionTable(u_m=table.u_m[iu], dp_Pa=table.dp_Pa[jd], **cut, E_Pa=table.E_Pa,
                         profiles=tuple(tuple(table.profiles[i][j] for j in jd) for i in iu),
-                        provenance=table.provenance, sealed=table.sealed[np.ix_(iu, jd)])
+                        provenance=table.provenance, sealed=table.sealed[np.ix_(iu, jd)],
+                        seal_rings=None if table.seal_rings is None else
+                        tuple(tuple(table.seal_rings[i][j] for j in jd) for i in iu))
 
 
 def adaptive_axes(table_on: Callable[[tuple[int, ...], tuple[int, ...]], Any], n_u: int, n_dp: int,

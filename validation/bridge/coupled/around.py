@@ -26,6 +26,7 @@ The cost and the lifetimes against the full grid: benchmarks/bench_coupled.py --
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
@@ -39,14 +40,17 @@ __all__ = ["AroundSpec", "AroundBuild", "around_paths", "holed_subtable"]
 
 @dataclass(frozen=True)
 class AroundSpec:
-    """The seed's sub-grid (every `u_every`-th u and `dp_every`-th dp of the lattice), the cells
-    added around each path point and each missing state, and a bound on the rounds."""
+    """The seed's sub-grid (every `u_every`-th u and `dp_every`-th dp of the lattice, its raised
+    rows only down to u = -seed_depth_h1 h1: the rows below, down to the plate's floor, are
+    reached by the rounds where the paths go), the cells added around each path point and each
+    missing state, and a bound on the rounds."""
 
     u_every: int = 24
     dp_every: int = 5
     margin: int = 0
     max_rounds: int = 100
     reach: int = 4
+    seed_depth_h1: float = 1.0
 
     def __post_init__(self) -> None:
         if not all(isinstance(k, int) and k >= 1 for k in (self.u_every, self.dp_every, self.max_rounds)):
@@ -56,6 +60,8 @@ class AroundSpec:
             raise ValueError(f"margin: need an integer >= 0, got {self.margin}")
         if not (isinstance(self.reach, int) and self.reach >= 0):
             raise ValueError(f"reach: need an integer >= 0, got {self.reach}")
+        if not self.seed_depth_h1 >= 0:
+            raise ValueError(f"seed_depth_h1: need a depth >= 0 (in h1), got {self.seed_depth_h1}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,7 +83,10 @@ def holed_subtable(table, built: np.ndarray):
     return SuctionTable(u_m=table.u_m, dp_Pa=table.dp_Pa, **cut, E_Pa=table.E_Pa,
                         profiles=tuple(tuple(p if built[i, j] else None for j, p in enumerate(row))
                                        for i, row in enumerate(table.profiles)),
-                        provenance=table.provenance, sealed=table.sealed | ~built)
+                        provenance=table.provenance, sealed=table.sealed | ~built,
+                        seal_rings=None if table.seal_rings is None else
+                        tuple(tuple(x if built[i, j] else None for j, x in enumerate(row))
+                              for i, row in enumerate(table.seal_rings)))
 
 
 def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goal: SuctionGoal,
@@ -93,7 +102,10 @@ def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goa
         for u, dp in goal.hint:
             _widen(built, reads(u, dp), max(spec.margin, 1), cols=4)
     else:
-        U = sorted(set(range(0, n_u, spec.u_every)) | {n_u - 1})
+        empty = table_on(asked)
+        # the seed's deepest raised row (all of them if the table does not record h1)
+        deep = 0 if math.isnan(empty.h1_m) else int(np.flatnonzero(empty.u_m >= -spec.seed_depth_h1 * empty.h1_m)[0])
+        U = sorted(set(range(deep, n_u, spec.u_every)) | {n_u - 1})
         D = sorted(set(range(0, n_dp, spec.dp_every)) | {n_dp - 1})
         asked[np.ix_(U, D)] = True
         lattice = table_on(asked)
