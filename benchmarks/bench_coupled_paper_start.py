@@ -1,0 +1,28 @@
+"""The table-coupled route from the paper's start as the study's products build it: cup A coarse,
+frictionless, pmma-1.89, the table around the paths of 5, 10, 20, 40 N and the largest holdable
+force (`goal_for`), in a fresh cache: its states and CPU, the lifetimes and the largest force.
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled_paper_start.py
+"""
+import dataclasses
+import tempfile
+import time
+
+import reduced
+from validation.bridge.coupled.adaptive import goal_for
+from validation.bridge.coupled.build import suction_table_for
+from validation.bridge.pipeline import surface_uc_table
+from reduced.lifetime.routes import ROUTES
+
+forces = (5.0, 10.0, 20.0, 40.0)
+model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
+t = time.process_time()
+table = suction_table_for("A", fidelity="coarse", goal=goal_for(model, forces), cache_dir=tempfile.mkdtemp())
+build = time.process_time() - t
+print(f"build: {table.provenance.get('states_solved')} states solved, {build:.1f} s CPU", flush=True)
+m = dataclasses.replace(model, suction=table)
+for F in forces:
+    r = reduced.solve_lifetime(m, F, route="coupled")
+    print(f"F1 = {F:g} N: {r.lifetime_s:.4g} s, {r.reason}", flush=True)
+route = ROUTES["coupled"]
+cavity, u_start, _ = route.cavity(m, dict(route.options))
+print(f"largest holdable force {cavity._largest_force(u_start):.4g} N; total {time.process_time() - t:.1f} s CPU")
