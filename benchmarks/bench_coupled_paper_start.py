@@ -16,7 +16,8 @@ from reduced.lifetime.routes import ROUTES
 forces = (5.0, 10.0, 20.0, 40.0)
 model = reduced.reference_model(reduced.CUP_A, surface_uc_table())
 t = time.process_time()
-table = suction_table_for("A", fidelity="coarse", goal=goal_for(model, forces), cache_dir=tempfile.mkdtemp())
+with tempfile.TemporaryDirectory() as cache:
+    table = suction_table_for("A", fidelity="coarse", goal=goal_for(model, forces), cache_dir=cache)
 build = time.process_time() - t
 print(f"build: {table.provenance.get('states_solved')} states solved, {build:.1f} s CPU", flush=True)
 m = dataclasses.replace(model, suction=table)
