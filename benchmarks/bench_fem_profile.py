@@ -33,7 +33,7 @@ the leak), its CPU time per part as above plus
 
   cavity     the cavity volume, its gradient and Hessian (`fem.cavity.CavitySurface`);
   sens       the branch's sensitivities dF1/dN, dF1/du and the linear response that predicts
-             each trial's Newton start (`fem.branch_walk.linear_response`: one factorization of
+             each trial's Newton start (`fem.branch_slopes.linear_response`: one factorization of
              the held plate's free block, `fem.free_block`, outside the solver's factorizations);
   setup      building a linear solver (`fem.condensation.make_solver`'s orderings and maps);
 

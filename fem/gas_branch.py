@@ -62,8 +62,8 @@ import numpy as np
 
 from .branch_end import plate_floor_m
 from .branch_jumps import LetGo, leak_to_hold, settle
-from .branch_walk import Branch, Jump, Trial as _Trial, Walk as _Walk, held_plate_system, seal_open, \
-    sensitivities, u_leads
+from .branch_slopes import held_plate_system, sensitivities
+from .branch_walk import Branch, Jump, Trial as _Trial, Walk as _Walk, seal_open, u_leads
 from .gas_path import CupWithGas, GasState
 
 __all__ = ["Branch", "equilibrium_branch", "held_plate_system", "pull_sensitivities", "state_between"]

@@ -41,7 +41,8 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from .gas_branch import Branch, _Trial, _Walk, equilibrium_branch, held_plate_system, state_between
+from .branch_slopes import held_plate_system
+from .gas_branch import Branch, _Trial, _Walk, equilibrium_branch, state_between
 from .solver import StepResult
 from .cup import _joined
 from .integrity import check_state
