@@ -168,9 +168,10 @@ def _routes_note(ctx, fl, outcomes, others, forces) -> None:
             f"{min(ratios):.3g}-{max(ratios):.3g}).")
     text += (" The two start from different sealed states: the table route releases the cup at the"
              " paper's h_start, the fem route presses it to r_start = 12 mm with the gas escaping. From"
-             " the same sealed content they agree within 1 % at 5 and 10 N and by 1.2 % at 20 N, where"
-             " the fem route reads the seal narrowed to one node by its reaction and the table its lumped"
-             " profile (tests/test_fem_route.py::test_mu0_equals_the_table_coupled_route, slow).")
+             " the same sealed content they agree within 1 % at 5, 10 and 20 N, both reading a seal"
+             " narrowed to one node by its reaction (`reduced.coupled_seal`; `python"
+             " benchmarks/bench_coupled_raised.py`, tests/test_fem_route.py::"
+             "test_mu0_equals_the_table_coupled_route, slow).")
     ctx.report.text(fl.name, text)
 
 
