@@ -235,7 +235,7 @@ def seal_diagnosis(model, forces: list[float], levels: list[str], law: str = "fr
     from fem.branch_end import up_to_most_gas
     from fem.gas_branch import equilibrium_branch, state_between
     from reduced.profile_leak import ContactProfile
-    from validation.bridge.fem_leak import contact_reactions, seal_load, state_leak_rate
+    from validation.bridge.fem_leak import seal_load, state_leak_rate
     from validation.bridge.fem_route import refine_branch
 
     print(f"| level | F1 [N] | reading | lifetime [s] | until {split:g} N0 [s] | after [s] | one node from N/N0 "
@@ -257,7 +257,7 @@ def seal_diagnosis(model, forces: list[float], levels: list[str], law: str = "fr
             lone = [k for k, ld in enumerate(loads) if ld.rings_r_m.size == 1 and not np.any(ld.p_Pa)]
             k = lone[0] if lone else len(states) - 1
             s = states[k]
-            corner = float(np.sum(contact_reactions(plane, s.state)[1])) if lone else math.nan
+            corner = float(np.sum(plane.held_reactions(s.state)[1])) if lone else math.nan
             profile_force = ContactProfile(s.profile.r_m, s.profile.p_Pa).force_N if s.profile.r_m.size > 1 else 0.0
             for name, how in READINGS.items():
                 rate = q if not how else np.array([state_leak_rate(x, model, sealed.E_Pa, plane=plane, **how)

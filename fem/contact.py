@@ -176,6 +176,18 @@ class RigidPlane:
         """Nodal normal reactions lambda_a [N] (> 0: the plane pushes up) = internal force at z-dofs."""
         return r_int[2 * self.nodes + 1]
 
+    def held_reactions(self, step) -> tuple[np.ndarray, np.ndarray]:
+        """The deformed radii [m] of the nodes the plane holds in the converged state `step` (a
+        `fem.solver.StepResult`) and its reactions lambda_a [N] on them, both sorted by radius: the
+        contact traction as the FEM resolves it (the lumped pressures divide it by each node's
+        share of the facets)."""
+        held = step.contact.active
+        nodes = self.nodes[held]
+        r = self.kin.node_coordinates()[0, nodes] + step.u[2 * nodes]
+        lam = self.reactions(step.r_int)[held]
+        order = np.argsort(r, kind="stable")
+        return r[order], lam[order]
+
     def project(self, u: np.ndarray, u_start: np.ndarray, state: ContactState,
                 on_plane: np.ndarray) -> np.ndarray:
         """The nearest admissible displacement: the `on_plane` nodes exactly on the plane (those

@@ -45,7 +45,7 @@ from .interface import ContactLaw
 from .material import NeoHookean
 from .solver import ConvergenceError, SolverOptions, SolverStats, StepResult, follow_path
 
-__all__ = ["SuctionGrid", "SuctionStates", "held_reactions", "plate_floor_of", "suction_grid"]
+__all__ = ["SuctionGrid", "SuctionStates", "plate_floor_of", "suction_grid"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,7 +68,7 @@ class SuctionGrid:
     sealed: np.ndarray          # bool: a node of the cavity chain on the plane (module docstring)
     profiles: tuple[tuple[PressureProfile, ...], ...] = field(repr=False)
     stats: SolverStats = field(repr=False)
-    # the plane's reactions (r [m], lambda [N]) at the held nodes of each state (`held_reactions`)
+    # the plane's reactions (r [m], lambda [N]) at the held nodes of each state (`RigidPlane.held_reactions`)
     reactions: tuple[tuple[tuple[np.ndarray, np.ndarray], ...], ...] = field(repr=False, default=())
 
     @property
@@ -171,7 +171,7 @@ class SuctionStates:
 
     def state(self, u: float, dp: float) -> tuple:
         """(F1, N, V, r_k, r_cut, r_c, W + dp V, profile, sealed, reactions) at (u, dp), solved if
-        not kept (reactions: `held_reactions`)."""
+        not kept (reactions: `RigidPlane.held_reactions`)."""
         if u <= 0.0:
             return self._raised(u, dp)
         row = self._rows.setdefault(u, {})
@@ -289,22 +289,10 @@ def _outputs(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> t
 
 def _measured(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> tuple:
     """`_outputs`, whether the state is sealed (module docstring: a node of the cavity chain on
-    the plane) and the plane's reactions at its held nodes (`held_reactions`)."""
+    the plane) and the plane's reactions at its held nodes (`fem.contact.RigidPlane.held_reactions`)."""
     x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])
     return (*_outputs(state, mech, cup, cavity), bool(np.any(x[1, cavity.nodes] <= cavity.tolerance_m)),
-            held_reactions(cup.plane, state))
-
-
-def held_reactions(plane, step: StepResult) -> tuple[np.ndarray, np.ndarray]:
-    """The deformed radii [m] of the nodes the plane holds in the converged state `step` and the
-    plane's reactions lambda_a [N] on them, both sorted by radius: the contact traction as the
-    FEM resolves it (the lumped pressures divide it by each node's share of the facets)."""
-    held = step.contact.active
-    nodes = plane.nodes[held]
-    r = plane.kin.node_coordinates()[0, nodes] + step.u[2 * nodes]
-    lam = plane.reactions(step.r_int)[held]
-    order = np.argsort(r, kind="stable")
-    return r[order], lam[order]
+            cup.plane.held_reactions(state))
 
 
 def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, floor: float, material: NeoHookean) -> None:

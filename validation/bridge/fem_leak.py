@@ -30,15 +30,7 @@ if TYPE_CHECKING:
     from fem.gas_path import GasState
     from reduced.lifetime import LeakageModel
 
-__all__ = ["SealLoad", "seal_load", "contact_reactions", "state_leak_rate"]
-
-
-def contact_reactions(plane: RigidPlane, step) -> tuple[np.ndarray, np.ndarray]:
-    """The plane's reactions lambda_a [N] at the nodes it holds and their deformed radii [m], both
-    sorted by radius, of a converged state `step` (a `fem.solver.StepResult`)."""
-    from fem.suction import held_reactions
-
-    return held_reactions(plane, step)
+__all__ = ["SealLoad", "seal_load", "state_leak_rate"]
 
 
 def seal_load(state: GasState, plane: RigidPlane) -> SealLoad:
@@ -48,7 +40,7 @@ def seal_load(state: GasState, plane: RigidPlane) -> SealLoad:
     radii, p = _merged_profile(state)
     if not lone_samples(p).any():              # no reactions needed
         return SealLoad(radii, p, np.zeros(0), np.zeros(0))
-    return _seal_load(radii, p, *contact_reactions(plane, state.state))
+    return _seal_load(radii, p, *plane.held_reactions(state.state))
 
 
 def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: str = "annulus", *,
@@ -72,9 +64,8 @@ def state_leak_rate(state: GasState, model: LeakageModel, E_Pa: float, radial: s
         load = SealLoad(*_merged_profile(state), np.zeros(0), np.zeros(0))
     if load.r_m.size < 2 or not (np.any(load.p_Pa > 0) or np.any(load.rings_F_N > 0)):
         return math.inf
-    r, lumped = _merged_profile(state)
-    solid = solid_seal_profile(ContactProfile(r, lumped), load.rings_r_m, load.rings_F_N, max(state.dp_Pa, 0.0),
-                               state.seal_r_m, state.cut_r_m, model.interface, patch)
+    solid = solid_seal_profile(ContactProfile(load.r_m, load.p_Pa), load.rings_r_m, load.rings_F_N,
+                               max(state.dp_Pa, 0.0), state.seal_r_m, state.cut_r_m, model.interface, patch)
     gaps = ring_gaps(solid, model.u_c, E_Pa)
     if np.all(np.isinf(gaps)):
         return math.inf
