@@ -152,7 +152,8 @@ def test_the_largest_pull_of_a_sticking_cup_is_searched_past_its_slips():
     largest pull exceeds every pull before the first slip; frictionless (no slips) is unchanged."""
     from fem.interface import ContactLaw
     from reduced.cup import CUPS
-    from validation.bridge.fem_route import FemCup, largest_pull_checked
+    from fem.gas_pull import largest_pull_checked
+    from validation.bridge.fem_route import FemCup
 
     seen = {}
     for law in ("sticking", "frictionless"):

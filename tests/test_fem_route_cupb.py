@@ -24,8 +24,8 @@ from fem.branch_end import FLOOR_STRETCH, plate_floor_m, up_to_most_gas, wall_le
 from fem.gas_branch import equilibrium_branch
 from fem.geometry import cup_geometry
 from fem.interface import ContactLaw
-from validation.bridge.fem_route import (DEFAULT_DU_M, FemCup, largest_pull_checked, lifetime_integral,
-                                         register)
+from fem.gas_pull import largest_pull_checked
+from validation.bridge.fem_route import DEFAULT_DU_M, FemCup, lifetime_integral, register
 from validation.bridge.pipeline import surface_uc_table
 
 

@@ -163,7 +163,7 @@ def test_water_holds_a_larger_pull_than_the_gas_sealed_alike(mesh, path):
     """Raised at a fixed content from the same pressed state, the gas expands (p_b >= 0: the pull
     is bounded by the ambient pressure on the seal) while the water goes into tension: the largest
     pull held in water exceeds the gas's, and exceeds p_a pi r_k^2 of the sealed state."""
-    from validation.bridge.fem_route import largest_pull_checked
+    from fem.gas_pull import largest_pull_checked
 
     cup, pressed, _, _ = path
     water, why = largest_pull(cup, pressed[-1])

@@ -24,7 +24,7 @@ states are added midway (`refine_branch`). The change when the plate step is hal
 quadrature and branch error (benchmarks/bench_fem_route.py, docs/lifetime.md).
 
 The largest holdable force is the largest pull along the plate raised at fixed N0 from the sealed
-state (the branch at a larger F1 does not start: the cup lets go at once).
+state (`fem.gas_pull`: the branch at a larger F1 does not start, the cup lets go at once).
 
 Water (model.fluid = "water"): the cavity is full of incompressible water (`fem.water_cavity`:
 V_cav = V_w, the cavity pressure its multiplier, which may fall below zero: a metastable liquid,
@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -177,13 +177,14 @@ class FemRoute:
         return self._sealed[key]
 
     def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
-        """The largest pull the sealed cup holds (`largest_pull`), once per sealed cup."""
+        """The largest pull the sealed cup holds (`fem.gas_pull`), once per sealed cup."""
         return self._largest_checked(model, options)[0]
 
     def _largest_checked(self, model: LeakageModel, options: Mapping[str, Any]) -> tuple[float, str | None]:
         sealed = self.seal(model, options)
         kept = self._largest.get(id(sealed))
         if kept is None or kept[0] is not sealed:
+            from fem.gas_pull import largest_pull_checked
             from fem.water_branch import largest_pull as largest_pull_water
 
             largest = largest_pull_water if model.fluid == "water" else largest_pull_checked
@@ -336,71 +337,6 @@ def _columns(states: list, q: np.ndarray, water: bool = False) -> dict[str, np.n
     return {"N": col("N"), "p_b_Pa": col("p_b_Pa"), "u_mm": col("u_m", 1e3), "F_plate_N": col("F1_N"),
             "V_mm3": col("V_m3", 1e9), "r_c_mm": col("r_c_m", 1e3), "seal_r_mm": col("seal_r_m", 1e3),
             "r_out_mm": col("cut_r_m", 1e3), "N_dot_per_s": q}
-
-
-class _Past(Exception):
-    """Stops the fixed-N0 pull once its pull has passed its maximum."""
-
-
-def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float:
-    """The largest pull F1 [N] along the plate raised at fixed N (the sealed state's) from
-    `sealed` (module docstring): the path is followed up to the plate's floor (`fem.branch_end`)
-    until F1 has fallen steadily by `drop` of its maximum since the last slip (a slip drops the
-    pull by more than that within one step, and the pull may rise again after it: the search goes
-    on past it), or the solver stops (the seal opening); the maximum over the path refined by the
-    parabola through the three states around it."""
-    return largest_pull_checked(cup, sealed, drop)[0]
-
-
-def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> tuple[float, str | None]:
-    """`largest_pull` and, where the solver stopped or the plate reached its floor while the pull
-    was still rising (the maximum not reached: a lower bound only), why; else None."""
-    from fem.branch_end import plate_floor_m
-    from fem.solver import ConvergenceError
-    from fem.trapped_gas import GasMechanics, TrappedGas, follow_gas_path
-
-    mech = GasMechanics(cup.cup.mech, cup.cavity, TrappedGas(sealed.N, cup.T_K, cup.p_a_Pa))
-    top = cup.cup.top
-    dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
-    u0, span = sealed.u_m, sealed.u_m - plate_floor_m(cup)
-    plate = lambda t: (dofs, np.concatenate([zeros, np.full(top.size, -(u0 - t))]))  # noqa: E731
-    seen: list[tuple[float, float]] = [(u0, sealed.F1_N)]
-
-    since_slip = [sealed.F1_N]                   # the pulls since the last slip
-
-    def on_step(step) -> None:
-        F1 = float(np.sum(step.r_int[2 * top + 1]))
-        best = max(since_slip)
-        if best > 0 and seen[-1][1] - F1 > drop * best:        # fell by more than drop in one step: a slip
-            since_slip[:] = [F1]
-        else:
-            since_slip.append(F1)
-        seen.append((u0 - step.t, F1))
-        if best > 0 and len(since_slip) > 1 and F1 < (1.0 - drop) * max(since_slip):
-            raise _Past
-    # the solver's steps are fractions of the whole range: scaled to give the same steps in u
-    # whatever the floor's depth, those of 1 % of the way from the sealed plate to -h1
-    o, f = cup.options, (u0 + cup.h1_m) / span
-    options = replace(o, initial_step=f * o.initial_step, max_step=f * min(o.max_step, 0.01),
-                      min_step=f * o.min_step, jump_min_step=f * o.jump_min_step)
-    stopped = None
-    try:
-        follow_gas_path(mech, plate, span, plane=cup.cup.plane, start=sealed.state, options=options,
-                        on_step=on_step)
-    except _Past:
-        pass
-    except ConvergenceError as err:
-        stopped = str(err)
-    u, F = np.array(seen).T
-    k = int(np.argmax(F))
-    partial = stopped if stopped is not None and k == F.size - 1 else None
-    if stopped is None and k == F.size - 1 > 0:            # still rising at the plate's floor
-        partial = f"the pull still rising at the plate's floor u = {1e3 * u[-1]:.4g} mm"
-    if 0 < k < F.size - 1:
-        a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
-        if a < 0:
-            return float(max(F[k], c - b * b / (4 * a))), partial
-    return float(F[k]), partial
 
 
 def register() -> FemRoute:
