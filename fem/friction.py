@@ -117,7 +117,12 @@ class FrictionStep:
 
     def reduces_residual(self, r_trial: np.ndarray, fext0: np.ndarray, alpha: float) -> bool:
         """The merit test of a step that need not descend in the energy: the free residual of
-        the new sets, friction included, falls by 1e-4 alpha of the iterate's."""
+        the new sets, friction included, falls by 1e-4 alpha of the iterate's; or the full step
+        presses a node onto the plane. That changes the sets and, at the rim, the cavity's chain
+        (the suction reaches the faces beyond the last contact): the residual jumps there, and
+        refused, the iterations crept to the plane by a tenth of the way each."""
+        if alpha >= 1.0 and self.pressed.any():
+            return True
         base = r_trial - fext0
         res = base - self.plane.law.friction_force(self.plane, self.state, base)
         free = self.free.copy()
