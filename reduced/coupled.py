@@ -290,13 +290,16 @@ class CoupledCavity:
         dp = brentq(lambda d: self.F1(u_start_m, d), 0.0, top, xtol=1e-9)
         return dp, (self.p_a_Pa - dp) * self.V(u_start_m, dp) / self.gas.kT_J
 
-    def dp_holding(self, u: float, value: Callable[[float], float], target: float, rising: bool) -> float | None:
+    def dp_holding(self, u: float, value: Callable[[float], float], target: float, rising: bool,
+                   near: float | None = None) -> float | None:
         """dp in [0, top] with value(dp) = target at the plate displacement u (value monotone in
         dp, rising or falling); None if the target lies beyond the table's dp range. SealOpen
-        (`reduced.suction_table`) where the crossing lies among states without a seal."""
+        (`reduced.suction_table`) where the crossing lies among states without a seal. On a table
+        with holes `near` (a path's previous dp) says which missing states to name first
+        (`Holes.root_cell`)."""
         top = self._dp_top
         if self._holes is not None:
-            found = self._holes.root_cell("dp", u, value, target, rising=rising, top=top)
+            found = self._holes.root_cell("dp", u, value, target, rising=rising, top=top, near=near)
             if not isinstance(found, tuple):
                 return None
             a, b = found
@@ -314,18 +317,18 @@ class CoupledCavity:
         """N [molecules] of the state (u, dp): the gas law (p_a - dp) V = N k_B T."""
         return (self.p_a_Pa - dp) * self.V(u, dp) / self.gas.kT_J
 
-    def _walk(self, u_from: float, u_to: float, dp_of: Callable[[float], float | None],
+    def _walk(self, u_from: float, u_to: float, dp_of: Callable[[float, float | None], float | None],
               samples: int, stop: Callable[[float, float], bool] | None = None
               ) -> tuple[np.ndarray, np.ndarray, str]:
-        """The states (u, dp(u)) from u_from down to u_to on `samples` points, as far as they
-        exist: (u, dp, end) with end "table_edge" (u_to reached, or dp(u) beyond the table's dp),
-        "reached_r1" (the next state reads one without a seal: the seal has opened), or "stop"
-        (stop(u, dp) true at the last state)."""
+        """The states (u, dp(u, dp of the previous state or None)) from u_from down to u_to on
+        `samples` points, as far as they exist: (u, dp, end) with end "table_edge" (u_to reached,
+        or dp(u) beyond the table's dp), "reached_r1" (the next state reads one without a seal:
+        the seal has opened), or "stop" (stop(u, dp) true at the last state)."""
         us, dps = [], []
         end = "table_edge"
         for u in np.linspace(u_from, u_to, samples):
             try:
-                dp = dp_of(float(u))
+                dp = dp_of(float(u), dps[-1] if dps else None)
             except SealOpen:
                 end = "reached_r1"
                 break
@@ -342,8 +345,8 @@ class CoupledCavity:
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
         """The cup sealed with N0 at u_start and raised at fixed N0 (the plate from u_start to
         the table's smallest u, or until it pulls F1): (u, dp, F1 along it, how it ends, as `_walk`)."""
-        def dp_of(u: float) -> float | None:
-            return self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False)
+        def dp_of(u: float, near: float | None) -> float | None:
+            return self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False, near=near)
         stop = None if F1 is None else (lambda u, d: self.F1(u, d) >= F1)
         us, dps, end = self._walk(u_start_m, float(self._u[0]), dp_of, self.samples, stop)
         return us, dps, np.array([self.F1(u, d) for u, d in zip(us, dps)]), end
@@ -404,8 +407,8 @@ class CoupledCavity:
                                    f"with its start content: it detaches at once", N0,
                                    *(np.zeros(0),) * 6, p_a_Pa=self.p_a_Pa)
 
-        def dp_of(u: float) -> float | None:
-            return dp0 if u == u0 else self.dp_holding(u, lambda d: self.F1(u, d), F1, rising=True)
+        def dp_of(u: float, near: float | None) -> float | None:
+            return dp0 if u == u0 else self.dp_holding(u, lambda d: self.F1(u, d), F1, rising=True, near=near)
         # a first walk finds where the branch ends, the second samples it up to there
         u_end = float(self._u[0])
         u, _, _ = self._walk(u0, u_end, dp_of, max(self.samples // 8, 11))

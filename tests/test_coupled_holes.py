@@ -92,6 +92,52 @@ def test_table_around_the_paths_gives_the_full_tables_lifetimes(lattice, around)
     assert len(rounds) >= 2 and all(np.all(later[earlier]) for earlier, later in zip(rounds, rounds[1:]))
 
 
+def test_a_line_names_first_the_states_next_to_the_paths_last_point(lattice):
+    """Along a line with nothing built near the crossing, the states named are those of the cells
+    within NEAR_CELLS of the path's last point (the whole line's without one), and once those
+    are built the gap's own rule names the rest; where the crossing is bracketed by built cells
+    `near` changes nothing."""
+    from reduced.coupled_holes import NEAR_CELLS, Holes
+
+    table, goal = lattice
+    u, dp = table.u_m, table.dp_Pa
+    built = np.zeros(table.built.shape, dtype=bool)
+    holes = Holes(built, u, dp, "pchip")
+    at = u[20]                                                 # on a node: the line reads row 20 only
+    value = lambda d: d                                        # noqa: E731  crosses 30.5 kPa in cell 30
+    with pytest.raises(MissingStates) as whole:
+        holes.root_cell("dp", at, value, dp[30] + 0.5 * (dp[31] - dp[30]), rising=True)
+    assert whole.value.nodes == tuple((20, j) for j in range(dp.size))
+    with pytest.raises(MissingStates) as near:
+        holes.root_cell("dp", at, value, dp[30] + 0.5 * (dp[31] - dp[30]), rising=True, near=dp[27])
+    assert near.value.nodes == tuple((20, j) for j in range(27 - NEAR_CELLS, 27 + NEAR_CELLS + 2))
+    built[20, 27 - NEAR_CELLS:27 + NEAR_CELLS + 2] = True      # built: the crossing lies above them
+    holes = Holes(built, u, dp, "pchip")
+    with pytest.raises(MissingStates) as gap:
+        holes.root_cell("dp", at, value, dp[30] + 0.5 * (dp[31] - dp[30]), rising=True, near=dp[27])
+    assert gap.value.nodes == tuple((20, j) for j in range(27 + NEAR_CELLS + 2, dp.size))
+    built[20, :] = True
+    holes = Holes(built, u, dp, "pchip")
+    target = dp[30] + 0.5 * (dp[31] - dp[30])
+    assert holes.root_cell("dp", at, value, target, rising=True, near=dp[3]) == \
+        holes.root_cell("dp", at, value, target, rising=True) == (dp[30], dp[31])
+
+
+def test_the_paths_last_point_saves_states_not_values(lattice, monkeypatch):
+    """Built with the missing states named next to each path's last point, the table gives the
+    same lifetimes and largest force as when whole gaps are named, from fewer states."""
+    import reduced.coupled_holes as coupled_holes
+
+    table, goal = lattice
+    near = around_paths(lambda built: holed_subtable(table, built), table.u_m.size, table.dp_Pa.size, goal,
+                        AroundSpec(u_every=8, dp_every=8))
+    monkeypatch.setattr(coupled_holes, "NEAR_CELLS", 10**6)     # every gap named whole
+    whole = around_paths(lambda built: holed_subtable(table, built), table.u_m.size, table.dp_Pa.size, goal,
+                         AroundSpec(u_every=8, dp_every=8))
+    np.testing.assert_allclose(_results(goal, near.table), _results(goal, whole.table), rtol=1e-9, atol=0)
+    assert near.asked.sum() < whole.asked.sum()
+
+
 def test_stiffer_cup_reads_its_own_paths(lattice):
     """kappa = 2: the cup answers dp as the table's does dp / 2, and its top dp (p_a) falls inside
     the table's last cell; built around its paths the table still gives the full one's results."""

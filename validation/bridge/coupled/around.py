@@ -144,11 +144,10 @@ class _Reads:
 
 
 def _reach_down(built: np.ndarray, nodes, u: np.ndarray, reach: int) -> None:
-    """Mark the `reach` rows below each missing node in a raised row (u <= 0: the paths run down
-    in u there at nearly constant dp) in its column and two more either side."""
+    """Mark the `reach` rows below each missing node (the paths run down in u as the gas leaks in)
+    in its column and two more either side."""
     for i, j in nodes:
-        if u[i] <= 0:
-            built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
+        built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
 
 
 def _widen(built: np.ndarray, nodes, margin: int, cols: int | None = None) -> None:
