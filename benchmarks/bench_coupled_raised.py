@@ -56,15 +56,20 @@ def main() -> None:
     for F in args.forces:
         c = table_lifetime(model, table, F, u_start)
         print(f"table route F1 = {F:g} N: {c.lifetime_s:.4g} s, {c.reason}, u_end = "
-              f"{c.trajectory['u_mm'][-1]:.3f} mm, {100 * (c.lifetime_s / fem[F].lifetime_s - 1):+.2f} % "
+              f"{1e3 * c.u_m[-1]:.3f} mm, {100 * (c.lifetime_s / fem[F].lifetime_s - 1):+.2f} % "
               f"from the fem route", flush=True)
 
 
 def table_lifetime(model, table, force_N: float, u_start_m: float):
-    """The coupled route's lifetime on `table` released at u_start_m (the table around the
-    lifetimes' paths does not hold the largest holdable force's path)."""
-    return reduced.solve_lifetime(dataclasses.replace(model, suction=table), force_N, route="coupled",
-                                  u_start_m=u_start_m)
+    """The coupled route's lifetime record on `table` released at u_start_m (its cavity's
+    `lifetime`: `reduced.solve_lifetime` also gives the largest holdable force, whose path the
+    table around the lifetimes' paths does not hold)."""
+    from reduced.lifetime.routes import ROUTES
+
+    route = ROUTES["coupled"]
+    cavity, u_start, _ = route.cavity(dataclasses.replace(model, suction=table),
+                                      {**route.options, "u_start_m": u_start_m})
+    return cavity.lifetime(force_N, u_start)
 
 
 if __name__ == "__main__":

@@ -40,7 +40,8 @@ inside built cells, and a value that would read a hole raises `MissingStates` na
 to add. Where they are built the values are the full table's; without relaxation only.
 
 The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a u
-grid of `samples` points from the start to the branch's end (found by a first walk of samples/8). A stiffness factor kappa makes the cup kappa times stiffer, as the
+grid of `samples` points from the start to the branch's end (found by a first walk of samples/8,
+which stops at its first sample past the fold: N has fallen). A stiffness factor kappa makes the cup kappa times stiffer, as the
 paper's kappa multiplies F0 (Fig. 1stiffnessFactor): a neo-Hookean body in frictionless contact
 with modulus kappa E answers dp exactly as the table's body answers dp / kappa, so F1(u, dp) =
 kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa) and the contact pressures scale
@@ -368,13 +369,13 @@ class CoupledCavity:
         u0 = brentq(excess, us[k], us[k - 1], xtol=1e-13, rtol=1e-12)
         return N0, self.dp_holding(u0, lambda d: self._gas(u0, d), N0, rising=False), u0
 
-    def _largest_force(self, u_start_m: float) -> float:
+    def largest_force(self, u_start_m: float) -> float:
         """The largest F1 [N] the cup released at u_start holds at t = 0: the largest pull of the
         cup raised at fixed N0 (`loaded`), refined between the samples around it. With
         relaxation: the cup at t = 0, kappa(phi = 0)."""
         if self.relaxation is not None:
             k0 = self._relaxed.kappa(0.0)[0]
-            return replace(self, kappa=k0, relaxation=None, phi0_s=None)._largest_force(u_start_m)
+            return replace(self, kappa=k0, relaxation=None, phi0_s=None).largest_force(u_start_m)
         _, N0 = self.start(u_start_m)
         us, _, pull, _ = self._raised_at(N0, u_start_m)
         if pull.size == 0:
@@ -389,7 +390,7 @@ class CoupledCavity:
                                options={"xatol": 1e-12})
         return max(float(-best.fun), float(pull[k]))
 
-    def _lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
+    def lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
                   rtol: float = 1e-6) -> _CoupledRecord:
         """Lifetime of the cup released at u_start and pulled by F1 = force_N (module docstring).
         With relaxation it is integrated in time (`reduced.coupled_relax`) up to t_max_s with the
@@ -409,11 +410,18 @@ class CoupledCavity:
 
         def dp_of(u: float, near: float | None) -> float | None:
             return dp0 if u == u0 else self.dp_holding(u, lambda d: self.F1(u, d), F1, rising=True, near=near)
-        # a first walk finds where the branch ends, the second samples it up to there
-        u_end = float(self._u[0])
-        u, _, _ = self._walk(u0, u_end, dp_of, max(self.samples // 8, 11))
-        if u.size < max(self.samples // 8, 11):
-            u_end = float(np.linspace(u0, u_end, max(self.samples // 8, 11))[u.size])
+        # a first walk finds where the branch ends (or has passed its fold: N fell), the second
+        # samples it up to there
+        u_end, coarse, contents = float(self._u[0]), max(self.samples // 8, 11), []
+
+        def past_fold(u: float, dp: float) -> bool:
+            contents.append(self._gas(u, dp))
+            return len(contents) > 1 and contents[-1] <= contents[-2]
+        u, _, end = self._walk(u0, u_end, dp_of, coarse, stop=past_fold)
+        if end == "stop":
+            u_end = float(u[-1])
+        elif u.size < coarse:
+            u_end = float(np.linspace(u0, u_end, coarse)[u.size])
         u, dps, reason = self._walk(u0, u_end, dp_of, self.samples)
         V = np.array([self.V(a, b) for a, b in zip(u, dps)])
         N = (self.p_a_Pa - dps) * V / self.gas.kT_J

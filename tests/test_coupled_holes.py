@@ -13,6 +13,7 @@ from reduced.coupled import CoupledCavity
 from reduced.critical_gap import illustrative_uc_table
 from reduced.cup import cup_by_name
 from reduced.lifetime import largest_holdable_force, reference_model, solve_lifetime
+from reduced.lifetime.routes import ROUTES
 from reduced.suction_table import MissingStates, SuctionTable
 from reduced.viscoelastic import default_relaxation
 from tests.test_reduced_coupled import paper_table
@@ -136,6 +137,27 @@ def test_the_paths_last_point_saves_states_not_values(lattice, monkeypatch):
                          AroundSpec(u_every=8, dp_every=8))
     np.testing.assert_allclose(_results(goal, near.table), _results(goal, whole.table), rtol=1e-9, atol=0)
     assert near.asked.sum() < whole.asked.sum()
+
+
+def test_a_branch_that_folds_reads_no_state_past_its_fold(lattice):
+    """A branch whose gas content folds (here: the paper's table with a cavity that shrinks
+    below u = h1 / 2) ends at the fold, and its walks stop there: with every state three rows
+    past the fold missing, its lifetime is the complete table's (to the root finders' tolerance:
+    they bracket inside built cells), not MissingStates."""
+    table, goal = lattice
+    h1 = goal.model.cup.h1_m
+    shrink = 1 - 0.8 * np.clip((0.5 * h1 - table.u_m) / (0.5 * h1), 0, 1)
+    folding = replace(table, V_m3=table.V_m3 * shrink[:, None])
+    def lifetime(suction):
+        cavity, u_start, _ = ROUTES["coupled"].cavity(replace(goal.model, suction=suction), ROUTES["coupled"].options)
+        return cavity.lifetime(5.0, u_start)
+    full = lifetime(folding)
+    assert full.reason == "fold"
+    built = np.ones(table.built.shape, dtype=bool)
+    built[table.u_m < full.u_m[-1] - 3 * (table.u_m[1] - table.u_m[0])] = False
+    assert not built.all()
+    holed = lifetime(holed_subtable(folding, built))
+    assert holed.reason == "fold" and holed.lifetime_s == pytest.approx(full.lifetime_s, rel=1e-9, abs=0)
 
 
 def test_stiffer_cup_reads_its_own_paths(lattice):

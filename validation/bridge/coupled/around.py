@@ -184,7 +184,7 @@ def _path_points(goal: SuctionGoal, table, memo: dict) -> list[tuple[float, floa
     points = [(u_start, dp_start)]
     for F in goal.forces_N:
         try:
-            r = cavity._lifetime(F, u_start)
+            r = cavity.lifetime(F, u_start)
         except ValueError:          # the coarse table fails where the lattice may not: no seed
             continue
         points += list(zip(r.u_m.tolist(), r.dp_Pa.tolist()))
@@ -206,7 +206,7 @@ def _missing(goal: SuctionGoal, table, memo: dict, pending: list[int]) -> tuple[
     failed = []
     for k in pending:
         try:
-            cavity._lifetime(forces[k], u_start) if k < len(forces) else cavity._largest_force(u_start)
+            cavity.lifetime(forces[k], u_start) if k < len(forces) else cavity.largest_force(u_start)
         except MissingStates as err:
             missing |= set(err.nodes)
             failed.append(k)
