@@ -16,10 +16,13 @@ a state reached by another dp ramp is the same state for frictionless contact). 
 2. on the lattice, the states the interpolation of those paths reads, widened by `margin` cells;
 3. the goal's lifetimes and largest holdable force on that table; where they read a hole, the
    missing states (widened by `margin`) are added and they are computed again, until they run
-   through. A missing state in a raised row (u <= 0) brings with it the `reach` rows below it,
-   in its column and two more either side: there the paths run down in u at nearly constant dp
-   (the plate rising as the gas leaks in), and a round that adds one row at a time would need one
-   round per row. What they read then is built, and nothing else is asked of the table.
+   through. A walk names the states next to its last point first (`reduced.coupled_holes`:
+   `Holes.near_missing`), not the whole line or gap it would otherwise have to search. A missing
+   state brings with it the `reach` rows below it, in its column and two more either side: the
+   paths run down in u (the plate rising as the gas leaks in; at nearly constant dp in the raised
+   rows, climbing in dp through cup B's pressed rows), and a round that adds one row at a time
+   would need one round per row. What they read then is built, and nothing else is asked of the
+   table.
 
 The cost and the lifetimes against the full grid: benchmarks/bench_coupled.py --around.
 """
