@@ -61,14 +61,15 @@ def main() -> None:
 
 
 def table_lifetime(model, table, force_N: float, u_start_m: float):
-    """The coupled route's lifetime record on `table` (its cavity as the route builds it; the
-    table around the lifetimes' paths does not hold the largest holdable force's path)."""
+    """The coupled route's lifetime record on `table` released at u_start_m (its cavity's
+    `lifetime`: `reduced.solve_lifetime` also gives the largest holdable force, whose path the
+    table around the lifetimes' paths does not hold)."""
     from reduced.lifetime.routes import ROUTES
 
     route = ROUTES["coupled"]
     cavity, u_start, _ = route.cavity(dataclasses.replace(model, suction=table),
                                       {**route.options, "u_start_m": u_start_m})
-    return cavity._lifetime(force_N, u_start)
+    return cavity.lifetime(force_N, u_start)
 
 
 if __name__ == "__main__":

@@ -102,7 +102,10 @@ class SuctionStates:
     `suction_grid`'s. Frictionless contact is path independent, so any order reaches the same
     states to the solver's tolerance; with sticking or Coulomb contact a state is the response
     to the path that reached it. A state at u <= 0 is raised from the kept state at the same dp
-    and the next larger u up to `anchor_m` (default 0.001 h1, the default grid's smallest u > 0)."""
+    and the next larger u up to `anchor_m` (default 0.001 h1, the default grid's smallest u > 0).
+    For frictionless contact Newton starts a raise (a dp interval) on the secant of the two kept
+    states above it at that dp (below it in that row): neighbouring states differ little and
+    nearly linearly, so this halves the iterations (tests/test_suction_adaptive.py)."""
 
     def __init__(self, mesh: Mesh, material: NeoHookean, contact: ContactLaw | str = ContactLaw(),
                  friction: float = 0.0, wetting_m: float = 0.0, anchor_m: float | None = None,
@@ -185,8 +188,11 @@ class SuctionStates:
                 lo = max(below)
                 mech = PressurizedMechanics(self._cup.mech, self._cavity, dp,
                                             schedule=lambda t, lo=lo, hi=dp: lo + t * (hi - lo))
-                state = self._segment(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
-                                      f"u = {u * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa")
+                lower = [d for d in below if d < lo]       # the secant of the two kept dp below (t: 1 is dp - lo)
+                predict = None if not lower else _secant(row[max(lower)][0].u, row[lo][0].u, lo - max(lower),
+                                                         dp - lo, RAMP_REACH_E * self.material.E_Pa, dp - lo)
+                state = self._guessed(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
+                                      f"u = {u * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa", predict)
                 row[dp] = (state, _measured(state, mech.at(1.0), self._cup, self._cavity))
         return row[dp][1]
 
@@ -195,7 +201,12 @@ class SuctionStates:
         next larger u (the anchor row's if none is kept; module docstring). Where that raise
         cannot reach u (the wall folds onto itself, `fem.integrity`, or Newton fails) no cup state
         is there: the state is returned as holding no seal, with nan numbers and no profile, and
-        kept in `unreached` with its cause, as is every state at that dp above which it lies."""
+        kept in `unreached` with its cause, as is every state at that dp above which it lies.
+        For frictionless contact, where no kept state at dp lies within RAISE_REACH_H1 h1 above
+        but a sealed one at a dp at most RAMP_REACH_E E smaller lies in this row, the state is
+        ramped from that one instead (`_ramped`): the same state, without a long raise from far
+        above (cup A, 6.9 mm raised at 80 kPa: 3 Newton iterations from 79 kPa against 170 from
+        the anchor row; a ramp over 10 kPa near u = 0 costs more than a raise over 0.12 h1)."""
         row = self._rows.setdefault(u, {})
         if dp not in row and u <= self._unreached_below.get(dp, -np.inf):
             return _UNREACHED
@@ -205,18 +216,42 @@ class SuctionStates:
                 self.state(self.anchor_m, dp)
                 above = [self.anchor_m]
             a = min(above)
+            lower = [d for d, kept in row.items() if dp - RAMP_REACH_E * self.material.E_Pa <= d < dp and kept[1][8]]
+            if a - u > RAISE_REACH_H1 * self.h1_m and lower and self._cup.plane.law.name == "frictionless":
+                ramped = self._ramped(u, dp, max(lower))
+                if ramped is not None:
+                    return ramped
             start = self._rows[a][dp][0]
             mech = (PressurizedMechanics(self._cup.mech, self._cavity, dp, schedule=lambda t, dp=dp: dp)
                     if dp > 0.0 else self._cup.mech)
+            where = f"plate raised from u = {a * 1e3:.4g} to {u * 1e3:.4g} mm at dp = {dp / 1e3:.4g} kPa"
+            further = [b for b in above if b > a]
+            predict = None if not further else _secant(self._rows[min(further)][dp][0].u, start.u, min(further) - a,
+                                                       a - u, RAISE_REACH_H1 * self.h1_m, 1.0)
             try:
-                state = self._segment(mech, _raising(self._cup, a), a - u, start, u,
-                                      f"plate raised from u = {a * 1e3:.4g} to {u * 1e3:.4g} mm at dp = "
-                                      f"{dp / 1e3:.4g} kPa", options=self._options)
+                state = self._guessed(mech, _raising(self._cup, a), a - u, start, u, where, predict, self._options)
             except ConvergenceError as err:             # StateRejected included
                 self.unreached[(u, dp)] = str(err)
                 self._unreached_below[dp] = max(u, self._unreached_below.get(dp, -np.inf))
                 return _UNREACHED
             row[dp] = (state, _measured(state, mech.at(1.0) if dp > 0.0 else mech, self._cup, self._cavity))
+        return row[dp][1]
+
+    def _ramped(self, u: float, dp: float, lo: float) -> tuple | None:
+        """The raised state at (u, dp) ramped at the held plate from the kept sealed state (u, lo),
+        lo < dp (`_raised`), or None where that ramp fails."""
+        row = self._rows[u]
+        mech = PressurizedMechanics(self._cup.mech, self._cavity, dp, schedule=lambda t: lo + t * (dp - lo))
+        lower = [d for d, kept in row.items() if d < lo and kept[1][8]]
+        predict = None if not lower else _secant(row[max(lower)][0].u, row[lo][0].u, lo - max(lower), dp - lo,
+                                                 RAMP_REACH_E * self.material.E_Pa, dp - lo)
+        try:
+            state = self._guessed(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
+                                  f"u = {u * 1e3:.4g} mm (raised), dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa",
+                                  predict)
+        except ConvergenceError:
+            return None
+        row[dp] = (state, _measured(state, mech.at(1.0), self._cup, self._cavity))
         return row[dp][1]
 
     def _press(self, u: float) -> StepResult:
@@ -229,15 +264,27 @@ class SuctionStates:
         self._pressed[u] = state
         return state
 
-    def _segment(self, mech, dirichlet, t_max, start, u_plate, where, options=None) -> StepResult:
+    def _guessed(self, mech, dirichlet, t_max, start, u_plate, where, predict, options=None) -> StepResult:
+        """`_segment` with Newton started on `predict`'s guess (None: on the start), and where that
+        fails, without it: the guess only saves iterations, the state is the one the path reaches
+        (for frictionless contact only, whose states do not depend on the path; with friction the
+        guess is not used)."""
+        if predict is not None and self._cup.plane.law.name == "frictionless":
+            try:
+                return self._segment(mech, dirichlet, t_max, start, u_plate, where, options, predict)
+            except ConvergenceError:
+                pass
+        return self._segment(mech, dirichlet, t_max, start, u_plate, where, options)
+
+    def _segment(self, mech, dirichlet, t_max, start, u_plate, where, options=None, predict=None) -> StepResult:
         """The converged state at the end of one path (pressing, a dp interval at u_plate, or a
-        raise at fixed dp)."""
+        raise at fixed dp); predict: Newton's first iterate of each step (`fem.solver.follow_path`)."""
         last: list[StepResult] = []
         if options is None:
             options = self._ramp_options if isinstance(mech, PressurizedMechanics) else self._options
         try:
             stats = follow_path(mech, dirichlet, t_max, plane=self._cup.plane, start=start,
-                                options=options, on_step=last.append)
+                                options=options, on_step=last.append, predict=predict)
         except RuntimeError as err:
             err.args = (f"{where}: {err}",)
             raise
@@ -245,6 +292,13 @@ class SuctionStates:
         end = last[-1]
         check_state(self.mesh, end.u, u_plate, 0, u_plate)     # contact kept between the nodes
         return StepResult(0.0, end.u, end.r_int, end.energy_J, end.contact, 0)
+
+
+#: how far above a raised state [h1] a kept state at its dp may lie to be raised from (`SuctionStates._raised`):
+#: two rows of the default grid; farther, a sealed state in its own row at a dp at most RAMP_REACH_E
+#: (of the modulus E; 2 kPa, two columns of the default grid, at E = 4 MPa) smaller is ramped instead
+RAISE_REACH_H1 = 0.011
+RAMP_REACH_E = 5e-4
 
 
 def plate_floor_of(mesh: Mesh, wetting_m: float = 0.0) -> float:
@@ -263,6 +317,22 @@ class _MeshCavity:
 
 #: the outputs of a raised state no raise reaches (`SuctionStates._raised`): no seal, no numbers
 _UNREACHED = (*(np.nan,) * 7, None, False, (np.zeros(0), np.zeros(0)))
+
+
+def _secant(u_far: np.ndarray, u_near: np.ndarray, base: float, step: float, reach: float, per_t: float
+            ) -> Callable[[float, np.ndarray, float], np.ndarray] | None:
+    """Newton's first iterate along a path of length `step` (`fem.solver.follow_path`'s
+    predict(t0, u0, t1), its t a length per_t per unit: a raise's t is its length, a ramp's runs
+    to 1): the start u_near moved on by the secant of it and
+    u_far, the kept state `base` before it on the same line (a raise at fixed dp, a dp ramp in a
+    row). None where base or step exceed `reach`: over longer distances the states are far from
+    linear and the guess costs iterations (cup A, rows 0.12 h1 apart: 825 against 462). The
+    prescribed dofs move exactly as prescribed, so the guess only saves iterations: a
+    frictionless state does not depend on how it was reached."""
+    if not (0 < base <= reach and 0 < step <= reach):
+        return None
+    slope = (u_near - u_far) * (per_t / base)
+    return lambda t0, u0, t1: u0 + (t1 - t0) * slope
 
 
 def _raising(cup: CupSetup, u_from: float) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:

@@ -40,7 +40,8 @@ inside built cells, and a value that would read a hole raises `MissingStates` na
 to add. Where they are built the values are the full table's; without relaxation only.
 
 The lifetime is t = int dN / Ndot from N0 to the end of the branch, by the trapezoid on a u
-grid of `samples` points from the start to the branch's end (found by a first walk of samples/8). A stiffness factor kappa makes the cup kappa times stiffer, as the
+grid of `samples` points from the start to the branch's end (found by a first walk of samples/8,
+which stops at its first sample past the fold: N has fallen). A stiffness factor kappa makes the cup kappa times stiffer, as the
 paper's kappa multiplies F0 (Fig. 1stiffnessFactor): a neo-Hookean body in frictionless contact
 with modulus kappa E answers dp exactly as the table's body answers dp / kappa, so F1(u, dp) =
 kappa F1_tab(u, dp / kappa), V(u, dp) = V_tab(u, dp / kappa) and the contact pressures scale
@@ -290,13 +291,16 @@ class CoupledCavity:
         dp = brentq(lambda d: self.F1(u_start_m, d), 0.0, top, xtol=1e-9)
         return dp, (self.p_a_Pa - dp) * self.V(u_start_m, dp) / self.gas.kT_J
 
-    def dp_holding(self, u: float, value: Callable[[float], float], target: float, rising: bool) -> float | None:
+    def dp_holding(self, u: float, value: Callable[[float], float], target: float, rising: bool,
+                   near: float | None = None) -> float | None:
         """dp in [0, top] with value(dp) = target at the plate displacement u (value monotone in
         dp, rising or falling); None if the target lies beyond the table's dp range. SealOpen
-        (`reduced.suction_table`) where the crossing lies among states without a seal."""
+        (`reduced.suction_table`) where the crossing lies among states without a seal. On a table
+        with holes `near` (a path's previous dp) says which missing states to name first
+        (`Holes.root_cell`)."""
         top = self._dp_top
         if self._holes is not None:
-            found = self._holes.root_cell("dp", u, value, target, rising=rising, top=top)
+            found = self._holes.root_cell("dp", u, value, target, rising=rising, top=top, near=near)
             if not isinstance(found, tuple):
                 return None
             a, b = found
@@ -314,18 +318,18 @@ class CoupledCavity:
         """N [molecules] of the state (u, dp): the gas law (p_a - dp) V = N k_B T."""
         return (self.p_a_Pa - dp) * self.V(u, dp) / self.gas.kT_J
 
-    def _walk(self, u_from: float, u_to: float, dp_of: Callable[[float], float | None],
+    def _walk(self, u_from: float, u_to: float, dp_of: Callable[[float, float | None], float | None],
               samples: int, stop: Callable[[float, float], bool] | None = None
               ) -> tuple[np.ndarray, np.ndarray, str]:
-        """The states (u, dp(u)) from u_from down to u_to on `samples` points, as far as they
-        exist: (u, dp, end) with end "table_edge" (u_to reached, or dp(u) beyond the table's dp),
-        "reached_r1" (the next state reads one without a seal: the seal has opened), or "stop"
-        (stop(u, dp) true at the last state)."""
+        """The states (u, dp(u, dp of the previous state or None)) from u_from down to u_to on
+        `samples` points, as far as they exist: (u, dp, end) with end "table_edge" (u_to reached,
+        or dp(u) beyond the table's dp), "reached_r1" (the next state reads one without a seal:
+        the seal has opened), or "stop" (stop(u, dp) true at the last state)."""
         us, dps = [], []
         end = "table_edge"
         for u in np.linspace(u_from, u_to, samples):
             try:
-                dp = dp_of(float(u))
+                dp = dp_of(float(u), dps[-1] if dps else None)
             except SealOpen:
                 end = "reached_r1"
                 break
@@ -342,8 +346,8 @@ class CoupledCavity:
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
         """The cup sealed with N0 at u_start and raised at fixed N0 (the plate from u_start to
         the table's smallest u, or until it pulls F1): (u, dp, F1 along it, how it ends, as `_walk`)."""
-        def dp_of(u: float) -> float | None:
-            return self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False)
+        def dp_of(u: float, near: float | None) -> float | None:
+            return self.dp_holding(u, lambda d: self._gas(u, d), N0, rising=False, near=near)
         stop = None if F1 is None else (lambda u, d: self.F1(u, d) >= F1)
         us, dps, end = self._walk(u_start_m, float(self._u[0]), dp_of, self.samples, stop)
         return us, dps, np.array([self.F1(u, d) for u, d in zip(us, dps)]), end
@@ -365,13 +369,13 @@ class CoupledCavity:
         u0 = brentq(excess, us[k], us[k - 1], xtol=1e-13, rtol=1e-12)
         return N0, self.dp_holding(u0, lambda d: self._gas(u0, d), N0, rising=False), u0
 
-    def _largest_force(self, u_start_m: float) -> float:
+    def largest_force(self, u_start_m: float) -> float:
         """The largest F1 [N] the cup released at u_start holds at t = 0: the largest pull of the
         cup raised at fixed N0 (`loaded`), refined between the samples around it. With
         relaxation: the cup at t = 0, kappa(phi = 0)."""
         if self.relaxation is not None:
             k0 = self._relaxed.kappa(0.0)[0]
-            return replace(self, kappa=k0, relaxation=None, phi0_s=None)._largest_force(u_start_m)
+            return replace(self, kappa=k0, relaxation=None, phi0_s=None).largest_force(u_start_m)
         _, N0 = self.start(u_start_m)
         us, _, pull, _ = self._raised_at(N0, u_start_m)
         if pull.size == 0:
@@ -386,7 +390,7 @@ class CoupledCavity:
                                options={"xatol": 1e-12})
         return max(float(-best.fun), float(pull[k]))
 
-    def _lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
+    def lifetime(self, force_N: float, u_start_m: float, *, t_max_s: float = 1e12,
                   rtol: float = 1e-6) -> _CoupledRecord:
         """Lifetime of the cup released at u_start and pulled by F1 = force_N (module docstring).
         With relaxation it is integrated in time (`reduced.coupled_relax`) up to t_max_s with the
@@ -404,13 +408,20 @@ class CoupledCavity:
                                    f"with its start content: it detaches at once", N0,
                                    *(np.zeros(0),) * 6, p_a_Pa=self.p_a_Pa)
 
-        def dp_of(u: float) -> float | None:
-            return dp0 if u == u0 else self.dp_holding(u, lambda d: self.F1(u, d), F1, rising=True)
-        # a first walk finds where the branch ends, the second samples it up to there
-        u_end = float(self._u[0])
-        u, _, _ = self._walk(u0, u_end, dp_of, max(self.samples // 8, 11))
-        if u.size < max(self.samples // 8, 11):
-            u_end = float(np.linspace(u0, u_end, max(self.samples // 8, 11))[u.size])
+        def dp_of(u: float, near: float | None) -> float | None:
+            return dp0 if u == u0 else self.dp_holding(u, lambda d: self.F1(u, d), F1, rising=True, near=near)
+        # a first walk finds where the branch ends (or has passed its fold: N fell), the second
+        # samples it up to there
+        u_end, coarse, contents = float(self._u[0]), max(self.samples // 8, 11), []
+
+        def past_fold(u: float, dp: float) -> bool:
+            contents.append(self._gas(u, dp))
+            return len(contents) > 1 and contents[-1] <= contents[-2]
+        u, _, end = self._walk(u0, u_end, dp_of, coarse, stop=past_fold)
+        if end == "stop":
+            u_end = float(u[-1])
+        elif u.size < coarse:
+            u_end = float(np.linspace(u0, u_end, coarse)[u.size])
         u, dps, reason = self._walk(u0, u_end, dp_of, self.samples)
         V = np.array([self.V(a, b) for a, b in zip(u, dps)])
         N = (self.p_a_Pa - dps) * V / self.gas.kT_J

@@ -28,7 +28,11 @@ from scipy.optimize import brentq
 from reduced.suction_table import MissingStates, SealOpen
 from reduced.table_surface import cell
 
-__all__ = ["Holes", "dp_low", "force_cell", "holding_dp", "start_dp", "u_at"]
+__all__ = ["Holes", "NEAR_CELLS", "dp_low", "force_cell", "holding_dp", "start_dp", "u_at"]
+
+#: the cells either side of a path's last crossing named first where a line has a gap there
+#: (`Holes.near_missing`)
+NEAR_CELLS = 2
 
 
 class Holes:
@@ -99,15 +103,20 @@ class Holes:
         return self._lines[key]
 
     def root_cell(self, axis: str, fixed: float, value: Callable[[float], float], target: float,
-                  rising: bool, top: float = np.inf) -> tuple[float, float] | str:
+                  rising: bool, top: float = np.inf, near: float | None = None) -> tuple[float, float] | str:
         """Along `axis` ('u' or 'dp', the other coordinate `fixed`), with value(x) monotone (rising
         or falling) and read only at built cells: the interval [x_a, x_b] of one built cell (x_b
         at most `top`; x_a = x_b where a node hits `target`) whose ends bracket `target`; 'below'
         or 'above' if the target lies beyond the axis' first node or its last one (at most `top`);
-        MissingStates (`gap_missing`) where the crossing lies in cells not built."""
+        MissingStates (`gap_missing`) where the crossing lies in cells not built. `near`, where
+        the caller expects the crossing (a path's previous point), names only the cells around it
+        while they are not built (`near_missing`); it never changes a value found."""
         xs = self._u_list if axis == "u" else self._dp_list
         last, ok, nodes = self.line(axis, fixed, top)
         if not nodes:                  # no readable cell: the states not built come first
+            guessed = self.near_missing(axis, fixed, near, 0, max(last, 1) - 1)
+            if guessed:
+                self.unreadable(guessed, f"along {axis} at {fixed:.6g}: nothing built near {near:.6g}")
             cells = [self.cell_missing(axis, k, fixed) for k in range(max(last, 1))]
             unsolved = sorted({n for c in cells for n in c if not self.solved[n]})
             self.unreadable(unsolved or cells[0], f"along {axis} at {fixed:.6g}: nothing built")
@@ -137,8 +146,21 @@ class Holes:
             if nodes[hi] == k + 1 and ok[k]:
                 return at(k), at(k + 1)
             gap = (k, nodes[hi] - 1, "")
-        self.unreadable(self.gap_missing(axis, fixed, *gap),
-                        f"along {axis} at {fixed:.6g}, where the value crosses {target:.6g}")
+        where = f"along {axis} at {fixed:.6g}, where the value crosses {target:.6g}"
+        self.unreadable(self.near_missing(axis, fixed, near, *gap[:2]) or self.gap_missing(axis, fixed, *gap), where)
+
+    def near_missing(self, axis: str, fixed: float, near: float | None, a: int, b: int) -> list[tuple[int, int]]:
+        """The missing nodes of the cells a ... b of a line that lie within NEAR_CELLS cells of
+        the one holding `near` (none without `near`, or where those are built: then the gap's
+        own rule, `gap_missing`, bisects or fills it). A path moves little from one point to the
+        next, so its next crossing lies next to its last one far more often than anywhere in a
+        gap; each round still adds cells of the gap, so the gap closes either way."""
+        if near is None or not math.isfinite(near):
+            return []
+        xs = self._u_list if axis == "u" else self._dp_list
+        k = min(max(bisect.bisect_right(xs, near) - 1, 0), len(xs) - 2)
+        cells = range(max(a, k - NEAR_CELLS), min(b, k + NEAR_CELLS) + 1)
+        return sorted({n for c in cells for n in self.cell_missing(axis, c, fixed) if not self.solved[n]})
 
     def gap_missing(self, axis: str, fixed: float, a: int, b: int, runs: str = "") -> list[tuple[int, int]]:
         """The missing nodes of the cells a ... b of a line in which a crossing lies unseen: of

@@ -13,6 +13,7 @@ from reduced.coupled import CoupledCavity
 from reduced.critical_gap import illustrative_uc_table
 from reduced.cup import cup_by_name
 from reduced.lifetime import largest_holdable_force, reference_model, solve_lifetime
+from reduced.lifetime.routes import ROUTES
 from reduced.suction_table import MissingStates, SuctionTable
 from reduced.viscoelastic import default_relaxation
 from tests.test_reduced_coupled import paper_table
@@ -90,6 +91,73 @@ def test_table_around_the_paths_gives_the_full_tables_lifetimes(lattice, around)
     assert build.asked.sum() < 0.5 * table.built.size and not build.table.complete
     rounds = asked[-len(build.rounds):]                      # the tables of the rounds, after the seed's
     assert len(rounds) >= 2 and all(np.all(later[earlier]) for earlier, later in zip(rounds, rounds[1:]))
+
+
+def test_a_line_names_first_the_states_next_to_the_paths_last_point(lattice):
+    """Along a line with nothing built near the crossing, the states named are those of the cells
+    within NEAR_CELLS of the path's last point (the whole line's without one), and once those
+    are built the gap's own rule names the rest; where the crossing is bracketed by built cells
+    `near` changes nothing."""
+    from reduced.coupled_holes import NEAR_CELLS, Holes
+
+    table, goal = lattice
+    u, dp = table.u_m, table.dp_Pa
+    built = np.zeros(table.built.shape, dtype=bool)
+    holes = Holes(built, u, dp, "pchip")
+    at = u[20]                                                 # on a node: the line reads row 20 only
+    value = lambda d: d                                        # noqa: E731  crosses 30.5 kPa in cell 30
+    with pytest.raises(MissingStates) as whole:
+        holes.root_cell("dp", at, value, dp[30] + 0.5 * (dp[31] - dp[30]), rising=True)
+    assert whole.value.nodes == tuple((20, j) for j in range(dp.size))
+    with pytest.raises(MissingStates) as near:
+        holes.root_cell("dp", at, value, dp[30] + 0.5 * (dp[31] - dp[30]), rising=True, near=dp[27])
+    assert near.value.nodes == tuple((20, j) for j in range(27 - NEAR_CELLS, 27 + NEAR_CELLS + 2))
+    built[20, 27 - NEAR_CELLS:27 + NEAR_CELLS + 2] = True      # built: the crossing lies above them
+    holes = Holes(built, u, dp, "pchip")
+    with pytest.raises(MissingStates) as gap:
+        holes.root_cell("dp", at, value, dp[30] + 0.5 * (dp[31] - dp[30]), rising=True, near=dp[27])
+    assert gap.value.nodes == tuple((20, j) for j in range(27 + NEAR_CELLS + 2, dp.size))
+    built[20, :] = True
+    holes = Holes(built, u, dp, "pchip")
+    target = dp[30] + 0.5 * (dp[31] - dp[30])
+    assert holes.root_cell("dp", at, value, target, rising=True, near=dp[3]) == \
+        holes.root_cell("dp", at, value, target, rising=True) == (dp[30], dp[31])
+
+
+def test_the_paths_last_point_saves_states_not_values(lattice, monkeypatch):
+    """Built with the missing states named next to each path's last point, the table gives the
+    same lifetimes and largest force as when whole gaps are named, from fewer states."""
+    import reduced.coupled_holes as coupled_holes
+
+    table, goal = lattice
+    near = around_paths(lambda built: holed_subtable(table, built), table.u_m.size, table.dp_Pa.size, goal,
+                        AroundSpec(u_every=8, dp_every=8))
+    monkeypatch.setattr(coupled_holes, "NEAR_CELLS", 10**6)     # every gap named whole
+    whole = around_paths(lambda built: holed_subtable(table, built), table.u_m.size, table.dp_Pa.size, goal,
+                         AroundSpec(u_every=8, dp_every=8))
+    np.testing.assert_allclose(_results(goal, near.table), _results(goal, whole.table), rtol=1e-9, atol=0)
+    assert near.asked.sum() < whole.asked.sum()
+
+
+def test_a_branch_that_folds_reads_no_state_past_its_fold(lattice):
+    """A branch whose gas content folds (here: the paper's table with a cavity that shrinks
+    below u = h1 / 2) ends at the fold, and its walks stop there: with every state three rows
+    past the fold missing, its lifetime is the complete table's (to the root finders' tolerance:
+    they bracket inside built cells), not MissingStates."""
+    table, goal = lattice
+    h1 = goal.model.cup.h1_m
+    shrink = 1 - 0.8 * np.clip((0.5 * h1 - table.u_m) / (0.5 * h1), 0, 1)
+    folding = replace(table, V_m3=table.V_m3 * shrink[:, None])
+    def lifetime(suction):
+        cavity, u_start, _ = ROUTES["coupled"].cavity(replace(goal.model, suction=suction), ROUTES["coupled"].options)
+        return cavity.lifetime(5.0, u_start)
+    full = lifetime(folding)
+    assert full.reason == "fold"
+    built = np.ones(table.built.shape, dtype=bool)
+    built[table.u_m < full.u_m[-1] - 3 * (table.u_m[1] - table.u_m[0])] = False
+    assert not built.all()
+    holed = lifetime(holed_subtable(folding, built))
+    assert holed.reason == "fold" and holed.lifetime_s == pytest.approx(full.lifetime_s, rel=1e-9, abs=0)
 
 
 def test_stiffer_cup_reads_its_own_paths(lattice):

@@ -137,7 +137,7 @@ def test_mu0_equals_the_table_coupled_route(model, table, sealed_start, fem_live
     cavity, u_start, _ = route.cavity(dataclasses.replace(model, suction=table),
                                       {**route.options, "u_start_m": sealed_start})
     life = fem_lives[force_N]
-    coupled = cavity._lifetime(force_N, u_start)
+    coupled = cavity.lifetime(force_N, u_start)
     tr = life.trajectory
     assert coupled.N[0] == pytest.approx(tr["N"][0], rel=2e-3)
     assert life.reason == coupled.reason == "reached_r1"

@@ -261,11 +261,11 @@ def test_a_raised_state_no_raise_reaches_holds_no_seal(coarse_cup, monkeypatch):
     states = SuctionStates(mesh, NeoHookean())
     real, calls = states._segment, []
 
-    def segment(mech, dirichlet, t_max, start, u_plate, where, options=None):
+    def segment(mech, dirichlet, t_max, start, u_plate, where, options=None, predict=None):
         calls.append(u_plate)
         if u_plate < -0.2 * h1:
             raise StateRejected(f"{where}: the wall folds onto itself", step=0, t_from=0.0, t_to=1.0, cause="folds")
-        return real(mech, dirichlet, t_max, start, u_plate, where, options)
+        return real(mech, dirichlet, t_max, start, u_plate, where, options, predict)
     monkeypatch.setattr(states, "_segment", segment)
     u, dp = np.array([-0.4 * h1, -0.3 * h1, -0.1 * h1, 0.05 * h1]), np.array([0.0, 3e4])
     built = np.zeros((4, 2), dtype=bool)
@@ -300,3 +300,54 @@ def test_the_default_grids_raised_rows_reach_the_plate_floor(coarse_cup):
         SuctionGridSpec((0.1,), (0.0, 1.0), raised_rows=-1)
     with pytest.raises(ValueError, match=r"u_m: .*h1 - 2 L"):
         SuctionStates(mesh, NeoHookean()).grid([1.01 * floor, 0.1 * h1], [0.0, 1e3])
+
+
+def test_a_raise_started_on_the_secant_reaches_the_cold_started_state(coarse_cup, monkeypatch):
+    """A raised state whose Newton starts on the secant of the two kept rows above it (at the same
+    dp) is the state raised from the row above without that guess, to the solver's tolerance, in
+    fewer Newton iterations."""
+    import fem.suction
+
+    mesh, h1 = coarse_cup
+    du, dp = 0.005 * h1, 6e4
+    rows = [-k * du for k in range(1, 7)]
+    solved, iterations = {}, {}
+    for name in ("cold", "warm"):
+        states = SuctionStates(mesh, NeoHookean())
+        for u in rows[:2]:
+            states.state(u, dp)
+        before = states.stats.newton_iterations
+        with monkeypatch.context() as m:
+            if name == "cold":                          # Newton from the row above as it is
+                m.setattr(fem.suction, "_secant", lambda *args: None)
+            solved[name] = [states.state(u, dp) for u in rows[2:]]
+        iterations[name] = states.stats.newton_iterations - before
+    tol = SolverOptions().rtol
+    for w, c in zip(solved["warm"], solved["cold"]):
+        assert w[8] and c[8]                            # both sealed
+        assert abs(w[0] - c[0]) <= 10 * tol * abs(c[0])     # F1
+        assert abs(w[2] - c[2]) <= 10 * tol * c[2]          # V
+        assert w[3] == pytest.approx(c[3], rel=10 * tol)    # the seal radius
+    assert iterations["warm"] < iterations["cold"]
+
+
+def test_a_raised_state_far_below_its_column_is_ramped_in_its_row(coarse_cup):
+    """A raised state with no kept state at its dp close above, but a sealed one at a smaller dp
+    in its row, is ramped from that one: the same state (F1, V, r_k to the solver's tolerance)
+    as the one raised from the anchor row, in fewer Newton iterations."""
+    from fem.suction import RAISE_REACH_H1
+
+    mesh, h1 = coarse_cup
+    u, dp = -0.1 * h1, 5.1e4
+    assert u < -RAISE_REACH_H1 * h1
+    ramped, raised = SuctionStates(mesh, NeoHookean()), SuctionStates(mesh, NeoHookean())
+    ramped.state(u, 5e4)
+    spent = lambda states: states.stats.newton_iterations if states.stats else 0      # noqa: E731
+    before = [spent(ramped), spent(raised)]
+    r, c = ramped.state(u, dp), raised.state(u, dp)        # both solve the anchor row's state at dp
+    iterations = [spent(ramped) - before[0], spent(raised) - before[1]]
+    assert r[8] and c[8]
+    tol = SolverOptions().rtol
+    assert abs(r[0] - c[0]) <= 10 * tol * abs(c[0]) and abs(r[2] - c[2]) <= 10 * tol * c[2]
+    assert r[3] == pytest.approx(c[3], rel=10 * tol)
+    assert iterations[0] < iterations[1]

@@ -184,7 +184,7 @@ class CoupledRoute:
     def largest_force(self, model: LeakageModel, options: Mapping[str, Any]) -> float:
         cc, u_start, cache = self.cavity(model, options)
         if "largest" not in cache:
-            cache["largest"] = float(cc._largest_force(u_start))
+            cache["largest"] = float(cc.largest_force(u_start))
         return cache["largest"]
 
     def solve(self, model: LeakageModel, force_N: float, run: Run, options: Mapping[str, Any]) -> Lifetime:
@@ -193,7 +193,7 @@ class CoupledRoute:
         from reduced.lifetime.paper import check_run
         check_run(force_N, run.t_max_s, run.rtol, run.refine)
         cc, u_start, _ = self.cavity(model, options)
-        record = cc._lifetime(force_N, u_start, t_max_s=run.t_max_s, rtol=run.rtol)
+        record = cc.lifetime(force_N, u_start, t_max_s=run.t_max_s, rtol=run.rtol)
         if run.progress:
             run.progress(1.0, f"F1 = {record.force_N:g} N: {record.reason}")
         return Lifetime(route=self.name, force_N=record.force_N, lifetime_s=record.lifetime_s,

@@ -16,10 +16,13 @@ a state reached by another dp ramp is the same state for frictionless contact). 
 2. on the lattice, the states the interpolation of those paths reads, widened by `margin` cells;
 3. the goal's lifetimes and largest holdable force on that table; where they read a hole, the
    missing states (widened by `margin`) are added and they are computed again, until they run
-   through. A missing state in a raised row (u <= 0) brings with it the `reach` rows below it,
-   in its column and two more either side: there the paths run down in u at nearly constant dp
-   (the plate rising as the gas leaks in), and a round that adds one row at a time would need one
-   round per row. What they read then is built, and nothing else is asked of the table.
+   through. A walk names the states next to its last point first (`reduced.coupled_holes`:
+   `Holes.near_missing`), not the whole line or gap it would otherwise have to search. A missing
+   state brings with it the `reach` rows below it, in its column and two more either side: the
+   paths run down in u (the plate rising as the gas leaks in; at nearly constant dp in the raised
+   rows, climbing in dp through cup B's pressed rows), and a round that adds one row at a time
+   would need one round per row. What they read then is built, and nothing else is asked of the
+   table.
 
 The cost and the lifetimes against the full grid: benchmarks/bench_coupled.py --around.
 """
@@ -144,11 +147,10 @@ class _Reads:
 
 
 def _reach_down(built: np.ndarray, nodes, u: np.ndarray, reach: int) -> None:
-    """Mark the `reach` rows below each missing node in a raised row (u <= 0: the paths run down
-    in u there at nearly constant dp) in its column and two more either side."""
+    """Mark the `reach` rows below each missing node (the paths run down in u as the gas leaks in)
+    in its column and two more either side."""
     for i, j in nodes:
-        if u[i] <= 0:
-            built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
+        built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
 
 
 def _widen(built: np.ndarray, nodes, margin: int, cols: int | None = None) -> None:
@@ -185,7 +187,7 @@ def _path_points(goal: SuctionGoal, table, memo: dict) -> list[tuple[float, floa
     points = [(u_start, dp_start)]
     for F in goal.forces_N:
         try:
-            r = cavity._lifetime(F, u_start)
+            r = cavity.lifetime(F, u_start)
         except ValueError:          # the coarse table fails where the lattice may not: no seed
             continue
         points += list(zip(r.u_m.tolist(), r.dp_Pa.tolist()))
@@ -207,7 +209,7 @@ def _missing(goal: SuctionGoal, table, memo: dict, pending: list[int]) -> tuple[
     failed = []
     for k in pending:
         try:
-            cavity._lifetime(forces[k], u_start) if k < len(forces) else cavity._largest_force(u_start)
+            cavity.lifetime(forces[k], u_start) if k < len(forces) else cavity.largest_force(u_start)
         except MissingStates as err:
             missing |= set(err.nodes)
             failed.append(k)

@@ -176,16 +176,19 @@ def around_table(states, u_m: np.ndarray, dp_Pa: np.ndarray, goal: SuctionGoal, 
     the provenance."""
     from validation.bridge.coupled.table import holed_suction_table
 
+    converted: dict = {}                 # the states' hand-off values, shared by the rounds' tables
+
     def table_on(built: np.ndarray):
         if progress:
             progress(0.0, f"{states.solved} states solved; table of {int(built.sum())}")
-        return holed_suction_table(states, u_m, dp_Pa, built, contact, provenance)
+        return holed_suction_table(states, u_m, dp_Pa, built, contact, provenance, converted)
 
     done = around_paths(table_on, u_m.size, dp_Pa.size, goal, spec)
     return holed_suction_table(states, u_m, dp_Pa, done.table.built, contact,
                                {**provenance, "grid": f"{int(done.table.built.sum())} states around the paths on "
                                 f"{lattice}", "lattice": lattice, "states_solved": states.solved,
-                                "rounds": [list(r) for r in done.rounds], "forces_N": list(goal.forces_N)})
+                                "rounds": [list(r) for r in done.rounds], "forces_N": list(goal.forces_N)},
+                               converted)
 
 
 def _build(geometry, fidelity, contact, E_Pa, nu, grid, code, progress=None):

@@ -55,30 +55,35 @@ def fem_beta(table: SuctionTable) -> np.ndarray:
 
 
 def holed_suction_table(states: SuctionStates, u_m: np.ndarray, dp_Pa: np.ndarray, built: np.ndarray,
-                        contact: ContactLaw, provenance: dict[str, Any] | None = None) -> SuctionTable:
+                        contact: ContactLaw, provenance: dict[str, Any] | None = None,
+                        converted: dict | None = None) -> SuctionTable:
     """The hand-off table (as `suction_table`) on the grid u_m x dp_Pa with only the states
     `built` [len(u), len(dp)] (solved by `states`, whose contact law is `contact`, pressed rows in
     increasing u and dp, raised rows (u <= 0) in decreasing u, where it lacks them), nan and None
     at the others: a table with holes (`reduced.suction_table`); a state without a seal as in
     `suction_table`, and so is a raised state no raise reaches (the wall folds onto itself, or
     Newton fails: no cup state is there, a path reaching it has let go; the provenance's
-    `unreached` says how many and why)."""
+    `unreached` says how many and why). `converted`: a dict of the states' hand-off values by
+    (u, dp), read and filled here, that the tables of a growing build share (each state is
+    converted once)."""
     shape = (len(u_m), len(dp_Pa))
     grids = {name: np.full(shape, np.nan) for name in ("F1_N", "V_m3", "seal_r_m", "cut_r_m")}
     profiles = [[None] * shape[1] for _ in range(shape[0])]
     rings = [[None] * shape[1] for _ in range(shape[0])]
     sealed = np.ones(shape, dtype=bool)
     nodes = sorted(zip(*np.nonzero(built)), key=lambda n: (u_m[n[0]] <= 0, abs(u_m[n[0]]), n[1]))
+    converted = {} if converted is None else converted
     for i, j in nodes:
-        F1, _, V, r_k, r_cut, _, _, p, closed, reactions = states.state(float(u_m[i]), float(dp_Pa[j]))
-        profile = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0] if closed else None
-        if profile is None:
+        key = (float(u_m[i]), float(dp_Pa[j]))
+        if key not in converted:
+            converted[key] = _handed_off(states.state(*key))
+        values = converted[key]
+        if values is None:
             sealed[i, j] = False
             continue
-        for name, x in zip(grids, (F1, V, r_k, r_cut)):
+        for name, x in zip(grids, values[:4]):
             grids[name][i, j] = x
-        profiles[i][j] = profile
-        rings[i][j] = _rings(profile, reactions)
+        profiles[i][j], rings[i][j] = values[4:]
     prov = _provenance(contact, states.material, states.h1_m, states.stats, provenance)
     if states.unreached:
         prov["unreached"] = _unreached(states.unreached)
@@ -86,6 +91,14 @@ def holed_suction_table(states: SuctionStates, u_m: np.ndarray, dp_Pa: np.ndarra
                         profiles=tuple(tuple(row) for row in profiles), E_Pa=states.material.E_Pa,
                         provenance=prov, sealed=None if sealed.all() else sealed,
                         seal_rings=tuple(tuple(row) for row in rings))
+
+
+def _handed_off(state: tuple) -> tuple | None:
+    """(F1, V, r_k, r_cut, profile, ring loads) of a state (`fem.suction.SuctionStates.state`) as
+    the table holds them, None for one without a seal."""
+    F1, _, V, r_k, r_cut, _, _, p, closed, reactions = state
+    profile = profiles_from_lists([1e3 * p.r_m], [1e-3 * p.p_Pa])[0] if closed else None
+    return None if profile is None else (F1, V, r_k, r_cut, profile, _rings(profile, reactions))
 
 
 def _unreached(unreached: dict) -> dict:
