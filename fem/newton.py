@@ -12,7 +12,7 @@ Converged: the prescribed values hold, no held node pulls on the plane beyond th
 ||r_f|| <= rtol * max(||reactions||, f_floor) (or at the round-off floor, `balanced`), the energy
 norm of the next correction |du . r| <= etol * f_ref * max|u| (the work scale), and Coulomb's
 condensed problem keeps its sets. Anything else raises `fem.failure.StepFailure` with its cause,
-and so does a Coulomb step whose residual creeps (`creeping`: it would fail all the same, later).
+and so does a Coulomb step whose residual creeps (`creeping`: such steps failed later all the same).
 
 `relax_step` is the load step of an incremental friction law across an instability (or where its
 quasi-static step has no solution): a sequence of damped sub-steps, the friction's anchors moved
