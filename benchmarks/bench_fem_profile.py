@@ -37,7 +37,9 @@ the leak), its CPU time per part as above plus
              the held plate's free block, `fem.free_block`, outside the solver's factorizations);
   setup      building a linear solver (`fem.condensation.make_solver`'s orderings and maps);
 
-and the calls of each, and the CPU time per solver factorization (each Newton iteration factors
+and the calls of each, the inclusive CPU time of the route's phases (pressing and sealing, the
+largest holdable force's pull at fixed N, the branch at F1; the rest is the leak along it and the
+states the route adds), and the CPU time per solver factorization (each Newton iteration factors
 once; a shifted retry or a freed contact node adds one) against one factorization of the last
 tangent the route factored.
 With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
@@ -142,6 +144,31 @@ def _instrument() -> None:
         fem.condensation._new_solver = w("setup", fem.condensation._new_solver)
 
 
+PHASES: dict[str, float] = {}
+
+
+def _phase(name: str, fn):
+    """fn, its inclusive CPU time added to PHASES[name]."""
+    @functools.wraps(fn)
+    def timed(*args, **kwargs):
+        t = time.process_time()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            PHASES[name] = PHASES.get(name, 0.0) + time.process_time() - t
+    return timed
+
+
+def _instrument_route() -> None:
+    """Time the fem route's phases (module docstring), once."""
+    import fem.gas_branch
+    import validation.bridge.fem_route as route
+
+    route.FemRoute.seal = _phase("press + seal", route.FemRoute.seal)
+    route.largest_pull_checked = _phase("largest pull", route.largest_pull_checked)
+    fem.gas_branch.equilibrium_branch = _phase("branch", fem.gas_branch.equilibrium_branch)
+
+
 def _median_time(fn, repeat: int = 7) -> float:
     times = []
     for _ in range(repeat):
@@ -189,6 +216,7 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     law = contact.split()
     law_args = ["--contact", law[0]] + (["--friction", law[1]] if len(law) > 1 else [])
     CLOCK.reset()
+    PHASES.clear()
     t = time.process_time()
     with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()) as err:
         code = cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level]
@@ -203,13 +231,17 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
         row = ["", "?", f"exit {code}: {last}"]
     return {"level": level, "force": force_N, "contact": contact, "cpu": cpu, "lifetime": row[1],
             "reason": row[2],
-            "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own}
+            "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own,
+            "phases": dict(PHASES)}
 
 
 def report_route(r: dict) -> None:
     total = r["cpu"]
     print(f"\nfem route, cup A {r['level']}, {r['contact']}, F1 = {r['force']:g} N: lifetime {r['lifetime']} s "
           f"({r['reason']}); in-process CPU time {total:.2f} s")
+    phases = r["phases"]
+    rest = total - sum(phases.values())
+    print("  phases: " + ", ".join(f"{k} {v:.2f} s" for k, v in phases.items()) + f", rest {rest:.2f} s")
     per = total / r["calls"]["factor"]
     print(f"  per solver factorization (~ per Newton iteration) {1e3 * per:.2f} ms; one factorization of the "
           f"last tangent {1e3 * r['own_factor']:.2f} ms: a Newton iteration costs {per / r['own_factor']:.1f} of them")
@@ -275,6 +307,8 @@ def main() -> None:
                     help='the route\'s contact laws: frictionless, sticking, "coulomb MU"')
     args = ap.parse_args()
     _instrument()
+    if args.route_forces:
+        _instrument_route()
     for level in args.levels:
         if not args.route_only:
             r = profile_curve(level, args.contact, args.repeat)

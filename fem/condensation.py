@@ -124,6 +124,7 @@ class CondensedCholesky:
         self._update_at = np.flatnonzero(to >= 0)
         self._update_to = to[self._update_at]
         self._Bb_local = lb
+        self._gather = _scatter_matrix(lb, len(B))
         self.n, self.kd, self._B = n, self._inner.kd, B
 
     def factor(self, K: sp.csr_matrix, free: np.ndarray, shift: float = 0.0) -> "CondensedFactor":
@@ -163,7 +164,8 @@ class CondensedFactor:
         b = _constrained_rhs(self._K, self.free, rhs, du_fixed)
         b2 = b.reshape(len(b), -1)                                           # [n, m] columns
         b_I = b2[o._I]                                                       # [nb, 2, m]
-        g = b2[o._B] - _scatter(o._Bb_local, np.transpose(self._W, (0, 2, 1)) @ b_I, len(o._B))
+        WTb = np.transpose(self._W, (0, 2, 1)) @ b_I                          # [nb, m_loc, m]
+        g = b2[o._B] - o._gather @ WTb.reshape(-1, b2.shape[1])
         g[~self.free[o._B]] = 0.0
         x_B = o._inner.band_solve(self._inner, g)                            # S x_B = g
         x = np.empty_like(b2)
@@ -180,15 +182,13 @@ class CondensedFactor:
         return BorderedFactor(self, np.asarray(dofs))
 
 
-def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
-    """The sums of `values` [*index.shape, (m)] into `size` slots by `index` (column by column)."""
+def _scatter_matrix(index: np.ndarray, size: int) -> sp.csr_matrix:
+    """The 0/1 matrix P [size, index.size] whose product P @ v sums the rows of v [index.size, m]
+    into `size` slots by `index` (flattened). Each slot's entries are in the order of the flat
+    index (COO -> CSR is a stable sort by row), so the sums are those of a bincount, bit for bit,
+    without building (slot, column) keys for every column."""
     flat = index.ravel()
-    if values.ndim == index.ndim:
-        return np.bincount(flat, weights=values.ravel(), minlength=size)
-    cols = values.reshape(flat.size, -1)
-    m = cols.shape[1]                      # one bincount over (slot, column) pairs
-    return np.bincount((flat[:, None] * m + np.arange(m)).ravel(), weights=cols.ravel(),
-                       minlength=size * m).reshape(size, m)
+    return sp.csr_matrix((np.ones(flat.size), (flat, np.arange(flat.size))), shape=(size, flat.size))
 
 
 def _positions(csr: sp.csr_matrix):

@@ -157,9 +157,12 @@ class _Condensed:
         self.g_all = plane.gap(u)
         self.d0 = u[rd[held]] - old.u_r_stick_m[held]
         self._Kc = _rows(K, self.rows)
+        self.F = np.zeros((len(self.rows), 0))               # the rows' reactions to the columns
         self.converged, self.y = False, np.zeros(0)
-        # a held node off the plane or off its anchor (pressed or landed in the last iteration)
-        self._columns(np.flatnonzero(np.concatenate([self.g_all[held] != 0.0, self.d0 != 0.0])))
+        # a held node off the plane or off its anchor (pressed or landed in the last iteration),
+        # and the rows the iterate's own sets need (the first guess of `ssn`): one solve
+        moved = np.concatenate([self.g_all[held] != 0.0, self.d0 != 0.0])
+        self._columns(np.flatnonzero(moved | self._needed(self.An, self.slip)))
 
     def _columns(self, rows: np.ndarray) -> None:
         """Add the columns of `rows` (one multi-column solve with the base factor)."""
@@ -175,6 +178,7 @@ class _Condensed:
         Z = self.fac.solve(E)
         Z[dofs[~force], k[~force]] = 1.0
         self.Z = np.hstack([self.Z, Z])
+        self.F = np.hstack([self.F, self._Kc @ Z])
         self.cols = np.concatenate([self.cols, rows])
         self.has[rows] = True
 
@@ -187,6 +191,7 @@ class _Condensed:
         self.nodes = np.concatenate([self.nodes, new])
         self.An = np.concatenate([self.An, np.ones(len(new), bool)])
         self._Kc = _rows(self.K, self.rows)
+        self.F = self._Kc @ self.Z
         self._columns(np.arange(start, len(self.rows)))
 
     def du(self) -> np.ndarray:
@@ -214,7 +219,7 @@ class _Condensed:
         self.converged = False
         for _ in range(_SSN_ITERATIONS):
             self._columns(np.flatnonzero(self._needed(An, slip)))
-            F, D = self._Kc @ self.Z, self.Z[self.rows]
+            F, D = self.F, self.Z[self.rows]
             A, b = F.copy(), -q.copy()          # default rows: reaction 0 (off the plane)
             on = iz[An]
             A[on], b[on] = D[on], -g[An] - w0[on]
@@ -250,5 +255,21 @@ class _Condensed:
 
 def _rows(K, dofs: np.ndarray):
     """Rows `dofs` of the tangent, its rank-one gas term included where it has one
-    (`fem.trapped_gas.GasTangent.rows`); plain slicing gives the sparse part only."""
-    return K.rows(dofs) if getattr(K, "rank_one", None) is not None else K[dofs]
+    (`fem.trapped_gas.GasTangent`: then a `_RankOneRows`); plain slicing gives the sparse part only."""
+    rank_one = getattr(K, "rank_one", None)
+    return K[dofs] if rank_one is None else _RankOneRows(K.plain()[dofs], *rank_one, dofs)
+
+
+class _RankOneRows:
+    """Rows of K_s + c g g^T kept as the sparse rows of K_s and the term's factors, so that their
+    products with the columns cost a product with g instead of a dense block added to K_s's rows
+    (g spans the whole cavity chain)."""
+
+    def __init__(self, sparse: sp.csr_matrix, c: float, g: np.ndarray, dofs: np.ndarray):
+        self.sparse, self.c, self.g, self.g_rows = sparse, c, g, g[dofs]
+
+    def __matmul__(self, X: np.ndarray) -> np.ndarray:
+        return self.sparse @ X + self.c * np.multiply.outer(self.g_rows, self.g @ X)
+
+    def toarray(self) -> np.ndarray:
+        return self.sparse.toarray() + self.c * np.outer(self.g_rows, self.g)

@@ -11,7 +11,8 @@ factorization (`fem.factorization`) and the line search (`fem.linesearch`).
 Converged: the prescribed values hold, no held node pulls on the plane beyond the tolerance,
 ||r_f|| <= rtol * max(||reactions||, f_floor) (or at the round-off floor, `balanced`), the energy
 norm of the next correction |du . r| <= etol * f_ref * max|u| (the work scale), and Coulomb's
-condensed problem keeps its sets. Anything else raises `fem.failure.StepFailure` with its cause.
+condensed problem keeps its sets. Anything else raises `fem.failure.StepFailure` with its cause,
+and so does a Coulomb step whose residual creeps (`creeping`: such steps failed later all the same).
 
 `relax_step` is the load step of an incremental friction law across an instability (or where its
 quasi-static step has no solution): a sequence of damped sub-steps, the friction's anchors moved
@@ -28,9 +29,10 @@ from .contact_step import ContactStep
 from .failure import StepFailure
 from .linesearch import line_search, total_potential
 
-__all__ = ["newton_step", "relax_step", "balanced", "largest_move", "largest_slip", "SLIP"]
+__all__ = ["newton_step", "relax_step", "balanced", "creeping", "largest_move", "largest_slip", "SLIP"]
 
 _STALLED = 12           # Newton iterations in a row whose linearized frictional problem found no set
+_CREEP = 20             # Newton iterations of a coupled (Coulomb) step in which the residual must halve
 
 
 def newton_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy,
@@ -104,6 +106,10 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
                                   "or a friction bound falling steeply with the slip", history)
             return u, r, state, it, indefinite
         it += 1
+        if getattr(step, "coupled", False) and creeping(history):
+            raise StepFailure(f"the residual of Coulomb's Newton iteration stopped falling (not halved in "
+                              f"{_CREEP} iterations); likely cause: a contact set the line search does not "
+                              "reach (nodes the step presses, short steps that never press them)", history)
         if it >= opts.max_iterations:
             raise StepFailure(f"no convergence in {opts.max_iterations} Newton iterations; likely cause: a "
                               "structural instability (snap-through/buckling) that the step jumps "
@@ -115,6 +121,18 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
             released |= step.release
             u_free = u_prev + max(alpha, 1.0) * step.du0
             state = plane.hold(step.state, step.holds(alpha), u, u_start, u_free, released)
+
+
+def creeping(history: list[float], window: int = _CREEP) -> bool:
+    """Whether a Newton iteration goes nowhere: the residuals of its last `window` iterations all
+    stay above half the least one before them (the first, taken before the prescribed increment is
+    imposed, not counted). Under Coulomb's law the line search may accept ever shorter steps
+    towards a contact set they never reach; such a step would fail only when the line search
+    reaches round-off, hundreds of iterations later, while a converging step halves its residual
+    well within the window (benchmarks/fem_route_mesh_study.md, cost)."""
+    if len(history) <= window + 1:
+        return False
+    return min(history[-window:]) > 0.5 * min(history[1:-window])
 
 
 def balanced(rnorm: float, tol: float, du: np.ndarray, u: np.ndarray) -> bool:
