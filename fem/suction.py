@@ -216,7 +216,7 @@ class SuctionStates:
                 self.state(self.anchor_m, dp)
                 above = [self.anchor_m]
             a = min(above)
-            lower = [d for d, kept in row.items() if dp - RAMP_REACH_E * self.material.E_Pa <= d < dp and kept[1][8]]
+            lower = [d for d, kept in row.items() if dp - RAMP_REACH_E * self.material.E_Pa <= d < dp and _sealed(kept)]
             if a - u > RAISE_REACH_H1 * self.h1_m and lower and self._cup.plane.law.name == "frictionless":
                 ramped = self._ramped(u, dp, max(lower))
                 if ramped is not None:
@@ -242,7 +242,7 @@ class SuctionStates:
         lo < dp (`_raised`), or None where that ramp fails."""
         row = self._rows[u]
         mech = PressurizedMechanics(self._cup.mech, self._cavity, dp, schedule=lambda t: lo + t * (dp - lo))
-        lower = [d for d, kept in row.items() if d < lo and kept[1][8]]
+        lower = [d for d, kept in row.items() if d < lo and _sealed(kept)]
         predict = None if not lower else _secant(row[max(lower)][0].u, row[lo][0].u, lo - max(lower), dp - lo,
                                                  RAMP_REACH_E * self.material.E_Pa, dp - lo)
         try:
@@ -363,6 +363,11 @@ def _measured(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> 
     x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])
     return (*_outputs(state, mech, cup, cavity), bool(np.any(x[1, cavity.nodes] <= cavity.tolerance_m)),
             cup.plane.held_reactions(state))
+
+
+def _sealed(kept: tuple) -> bool:
+    """Whether a kept (state, `_measured`) pair holds a seal."""
+    return kept[1][8]
 
 
 def _check_axes(u: np.ndarray, dp: np.ndarray, h1: float, floor: float, material: NeoHookean) -> None:
