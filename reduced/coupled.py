@@ -22,17 +22,9 @@ The leak rate at a state is the series flow through its own contact-pressure pro
 (`reduced.profile_leak`), computed at the table's nodes (p_b = p_a - dp_j exactly there) as the
 conductance Ndot / dp and interpolated in its logarithm; F1, V and ln(Ndot / dp) are monotone
 cubic (PCHIP) along u and linear along dp (monotone data stay monotone, so the branch is unique).
-The interpolation error is measured by grid refinement (benchmarks/bench_coupled.py). The solid pressure in
-the contact zone next to the seal is the table's (the plane's reaction with the interface gas at
-p_b) less the gas pressure rise across the zone, P - p_b = dp (r - r_k) / (r_cut - r_k), linear from
-the seal to the zone's outer edge (``interface="linear"``; "p_b" keeps the table's, "p_a" takes the
-whole dp off: the two bounds). When the u_c table carries a patch length (`UcTable.patch_length_m`,
-from the roughness spectrum) that solid pressure is averaged over patches of that width before
-u_c is read, as on the profile route (`reduced.profile_leak.patch_average`): the nominal pressure
-of rough-contact theory. A node that touches alone (a seal narrowed to its last ring) enters by
-the plane's reaction on it where the table records it (`SuctionTable.seal_rings`), a ring load
-spread over the patch: the fem route's reading of the same state (`reduced.coupled_seal`), which
-makes the leak independent of the mesh there.
+The interpolation error is measured by grid refinement (benchmarks/bench_coupled.py). The solid
+pressure each node's leak reads (the interface gas, patches, a seal's last ring) is
+`reduced.coupled_leak`'s.
 
 A table with holes (`SuctionTable.built`: states only where the paths go) is read only where
 every state the interpolation reads is built (`reduced.coupled_holes`); the root finders bracket
@@ -65,12 +57,12 @@ from scipy.optimize import brentq, minimize_scalar
 
 from reduced import coupled_holes as holes
 from reduced.coupled_holes import Holes
+from reduced.coupled_leak import NodeLeak
 from reduced.coupled_relax import RelaxedParts, relaxed_lifetime, relaxed_parts
 from reduced.coupled_result import _CoupledRecord
 from reduced.gas import AIR, Gas
-from reduced.profile_leak import ContactProfile, profile_leak_rate, ring_gaps
 from reduced.suction_table import SealOpen, SuctionTable
-from reduced.table_surface import INTERFACES, TableSurface, solid_profile
+from reduced.table_surface import INTERFACES, TableSurface
 from reduced.viscoelastic import RelaxationModulus
 
 __all__ = ["CoupledCavity", "INTERFACES"]
@@ -199,36 +191,11 @@ class CoupledCavity:
 
     @cached_property
     def _node_conductance(self) -> np.ndarray:
-        """Ndot / dp [1/(s Pa)] at every node (u_i, dp_j) through its profile with p_b = p_a - dp_j;
-        at dp = 0 its limit, from a 1 Pa difference (nan beyond p_a and at a hole)."""
-        E = self.table.E_Pa
-        out = np.full((self._u.size, self._dp.size), np.nan)
-        built, memo = self.table.built & self.table.sealed, self.conductances
-        for i in range(self._u.size):
-            for j, dp in enumerate(self._dp):
-                if dp > self.p_a_Pa or not built[i, j]:
-                    continue
-                key = (float(self._u[i]), float(self.table.dp_Pa[j]))
-                if memo is not None and key in memo:
-                    out[i, j] = memo[key]
-                    continue
-                out[i, j] = self._conductance(i, j, dp, E)
-                if memo is not None:
-                    memo[key] = out[i, j]
-        return out
-
-    def _conductance(self, i: int, j: int, dp: float, E: float) -> float:
-        """Ndot / dp at node (i, j) (`_node_conductance`)."""
-        prof = self._solid_profile(i, j)
-        drive = max(dp, 1.0)
-        gaps = ring_gaps(prof, self.u_c, E)
-        if np.all(np.isinf(gaps)):       # no solid contact left (the gas holds the seal
-            return np.inf                # open): no resistance, see _rate_surface
-        return profile_leak_rate(self.gas, self.p_a_Pa, self.p_a_Pa - drive, prof.r_m, gaps, self.radial) / drive
-
-    def _solid_profile(self, i: int, j: int) -> ContactProfile:
-        """The solid contact pressure at node (i, j) of the kappa-times-stiffer cup (`solid_profile`)."""
-        return solid_profile(self.table, i, j, self.kappa, self._dp[j], self.interface, self.patch_length_m)
+        """Ndot / dp [1/(s Pa)] at every node (u_i, dp_j) through its profile with p_b = p_a - dp_j
+        (`reduced.coupled_leak`; nan beyond p_a and at a hole)."""
+        leak = NodeLeak(self.table, self.u_c, self.gas, self.p_a_Pa, self.kappa, self.interface, self.radial,
+                        self.patch_length_m)
+        return leak.conductances(self._dp, self.conductances)
 
     @property
     def patch_length_m(self) -> float | None:
