@@ -186,14 +186,7 @@ class SuctionStates:
                 below = [0.0]
             if dp > 0.0:
                 lo = max(below)
-                mech = PressurizedMechanics(self._cup.mech, self._cavity, dp,
-                                            schedule=lambda t, lo=lo, hi=dp: lo + t * (hi - lo))
-                lower = [d for d in below if d < lo]       # the secant of the two kept dp below (t: 1 is dp - lo)
-                predict = None if not lower else _secant(row[max(lower)][0].u, row[lo][0].u, lo - max(lower),
-                                                         dp - lo, RAMP_REACH_E * self.material.E_Pa, dp - lo)
-                state = self._guessed(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
-                                      f"u = {u * 1e3:.4g} mm, dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa", predict)
-                row[dp] = (state, _measured(state, mech.at(1.0), self._cup, self._cavity))
+                return self._ramp(u, dp, lo, [d for d in below if d < lo])
         return row[dp][1]
 
     def _raised(self, u: float, dp: float) -> tuple:
@@ -240,17 +233,22 @@ class SuctionStates:
     def _ramped(self, u: float, dp: float, lo: float) -> tuple | None:
         """The raised state at (u, dp) ramped at the held plate from the kept sealed state (u, lo),
         lo < dp (`_raised`), or None where that ramp fails."""
-        row = self._rows[u]
-        mech = PressurizedMechanics(self._cup.mech, self._cavity, dp, schedule=lambda t: lo + t * (dp - lo))
-        lower = [d for d, kept in row.items() if d < lo and _sealed(kept)]
-        predict = None if not lower else _secant(row[max(lower)][0].u, row[lo][0].u, lo - max(lower), dp - lo,
-                                                 RAMP_REACH_E * self.material.E_Pa, dp - lo)
+        lower = [d for d, kept in self._rows[u].items() if d < lo and _sealed(kept)]
         try:
-            state = self._guessed(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
-                                  f"u = {u * 1e3:.4g} mm (raised), dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa",
-                                  predict)
+            return self._ramp(u, dp, lo, lower, " (raised)")
         except ConvergenceError:
             return None
+
+    def _ramp(self, u: float, dp: float, lo: float, lower: list[float], label: str = "") -> tuple:
+        """The state at (u, dp) reached by a dp ramp at the held plate from the kept state (u, lo),
+        lo < dp, and kept; Newton starts on the secant of the kept states at max(`lower`) and lo
+        (`_secant`; the ramp's t runs to 1 over dp - lo)."""
+        row = self._rows[u]
+        mech = PressurizedMechanics(self._cup.mech, self._cavity, dp, schedule=lambda t: lo + t * (dp - lo))
+        predict = None if not lower else _secant(row[max(lower)][0].u, row[lo][0].u, lo - max(lower), dp - lo,
+                                                 RAMP_REACH_E * self.material.E_Pa, dp - lo)
+        state = self._guessed(mech, self._cup.plate_at(u, moving=False), 1.0, row[lo][0], u,
+                              f"u = {u * 1e3:.4g} mm{label}, dp from {lo / 1e3:.4g} to {dp / 1e3:.4g} kPa", predict)
         row[dp] = (state, _measured(state, mech.at(1.0), self._cup, self._cavity))
         return row[dp][1]
 

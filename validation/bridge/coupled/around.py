@@ -130,7 +130,7 @@ def around_paths(table_on: Callable[[np.ndarray], Any], n_u: int, n_dp: int, goa
         if not missing:
             return AroundBuild(table, asked, tuple(rounds))
         _widen(built, missing, spec.margin)
-        _reach_down(built, missing, lattice.u_m, spec.reach)
+        _reach_down(built, missing, spec.reach)
     raise RuntimeError(f"suction table around the paths: states still missing after {spec.max_rounds} rounds")
 
 
@@ -146,7 +146,7 @@ class _Reads:
         return self.holes.missing(u, dp)
 
 
-def _reach_down(built: np.ndarray, nodes, u: np.ndarray, reach: int) -> None:
+def _reach_down(built: np.ndarray, nodes, reach: int) -> None:
     """Mark the `reach` rows below each missing node (the paths run down in u as the gas leaks in)
     in its column and two more either side."""
     for i, j in nodes:
