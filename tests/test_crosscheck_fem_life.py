@@ -129,3 +129,40 @@ def test_parts_filled_by_two_workers_are_what_one_process_computes(tmp_path):
     here = live(LifeRun("A", "coulomb", 0.5, 10.0))
     there = back[("A", "coulomb", 0.5, 10.0)]
     assert there.lifetime_s == here.lifetime_s and there.reason == here.reason
+
+
+def test_a_life_over_its_cpu_limit_is_an_unfinished_cell_and_the_timer_is_restored():
+    """A real life (cup A coarse, 10 N: ~3 s of CPU) given 0.5 s of CPU stops there and says so;
+    afterwards the profiling signal is the process's own again and no timer is left running."""
+    import signal
+    import time
+
+    before = signal.getsignal(signal.SIGPROF)
+    t0 = time.process_time()
+    out = live(LifeRun("A", "frictionless", None, 10.0, cpu_limit_s=0.5))
+    spent = time.process_time() - t0
+    assert out.reason == "unfinished" and out.failed and math.isnan(out.lifetime_s)
+    assert out.cell().startswith("unfinished: not finished within")
+    assert 0.5 <= spent < 1.5
+    assert signal.getsignal(signal.SIGPROF) is before and signal.getitimer(signal.ITIMER_PROF) == (0.0, 0.0)
+
+
+def test_one_section_rerun_into_a_report_keeps_the_others(tmp_path, capsys):
+    """`python -m validation.crosscheck.rerun speed --quick`: section 4's files, README section and
+    summary keys go in; the other sections' text and summary keys stay; a bad section name is one
+    line, exit 2, nothing written."""
+    from validation.crosscheck.rerun import main
+
+    (tmp_path / "README.md").write_text(README)
+    (tmp_path / "summary.json").write_text('{"keep": 1}\n')
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert main(["spead", "--into", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "'spead'" in err[0]
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    assert main(["speed", "--quick", "--into", str(tmp_path), "--cache-dir", str(tmp_path / "c")]) == 0
+    text = (tmp_path / "README.md").read_text()
+    assert text.index("seven") < text.index("## 4. Speed") < text.index("## Deformed cup")
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["keep"] == 1 and len(summary) > 1
+    assert (tmp_path / "pareto.png").stat().st_size > 10_000

@@ -16,7 +16,8 @@ parameter is fitted to a measured number.
 A cell gives the lifetime [s] and why it ended: fold (the branch's largest N at F1), reached_r1
 (the seal opened at the rim), over_force (F1 above what the sealed cup holds: it lets go at
 once), sealed or horizon (no detachment: inf). A run that ends without a detachment or fails says
-so ("no branch: stopped: ...", "failed: ..."), never a number. The largest holdable force is the
+so ("no branch: stopped: ...", "failed: ..."), never a number, and so does a run still going after
+10 min of CPU ("unfinished"). The largest holdable force is the
 largest pull at fixed N0 from the sealed state; a force above it is over_force by the route's own
 definition (its branch does not start), so that branch is not run. The seal radii are the inner contact radius r_c,
 the seal node r_k and the outer end of the contact r_out, at the sealed state (pressed, before the
@@ -31,8 +32,11 @@ from __future__ import annotations
 
 import math
 import re
+import signal
+import threading
 import time
 from collections.abc import Callable
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,6 +57,7 @@ SEAL_FORCES_N = (10.0, 40.0)
 FIGURE_LAWS = (("frictionless", None), ("coulomb", 0.5), ("coulomb", 2.0), ("sticking", None))
 FIGURE_FORCE_N = 10.0
 FIDELITY = CROSSCHECK_FIDELITY           # coarse: 72 lives (`cupcheck lifetime --route fem` defaults to medium)
+CPU_LIMIT_S = 600.0                      # a life still running after this much CPU becomes an "unfinished" cell
 PAPER_HOLD_N = 88.0                      # the paper's cup A held about 9 kg (Sec. 5)
 P_A_PA = 1e5
 
@@ -67,6 +72,7 @@ class LifeRun:
     friction: float | None
     force_N: float | None
     fidelity: str = FIDELITY
+    cpu_limit_s: float = CPU_LIMIT_S
 
     def law_label(self) -> str:
         return f"mu {self.friction:g}" if self.law == "coulomb" else self.law
@@ -99,7 +105,7 @@ class LifeOutcome:
 
     @property
     def failed(self) -> bool:
-        return self.reason in ("failed", "no branch", "not run")
+        return self.reason in ("failed", "no branch", "not run", "unfinished")
 
     def cell(self) -> str:
         """The table cell: 'lifetime (reason)', or what stopped the run."""
@@ -130,9 +136,50 @@ def model_for(cup: str):
     return reference_model(CUPS[cup], pmma_uc_table())
 
 
+class CpuLimitReached(BaseException):
+    """A life ran out of its CPU time (a BaseException, so that no handler inside the route takes it
+    for a solver failure)."""
+
+
+@contextmanager
+def cpu_limit(seconds: float):
+    """Raise `CpuLimitReached` in the enclosed block once the process has spent `seconds` of CPU
+    (user + system) in it: the profiling timer's SIGPROF. Signal handlers belong to the main thread;
+    elsewhere the block runs without a limit. (A library timeout such as func_timeout or
+    timeout-decorator measures wall time, which a shared machine stretches.)"""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    armed = [True]
+
+    def reached(signum, frame):
+        if armed[0]:
+            armed[0] = False
+            raise CpuLimitReached(seconds)
+
+    previous = signal.signal(signal.SIGPROF, reached)
+    signal.setitimer(signal.ITIMER_PROF, seconds)
+    try:
+        yield
+    finally:
+        armed[0] = False
+        signal.setitimer(signal.ITIMER_PROF, 0.0)
+        signal.signal(signal.SIGPROF, previous)
+
+
 def live(run: LifeRun, code: str = "", progress: Callable[[float, str], None] | None = None) -> LifeOutcome:
     """Run one FEM life (`code`, the sources' hash, is only the cache key); a failure becomes an
-    outcome that names it."""
+    outcome that names it, and so does a life still running after its CPU limit ("unfinished")."""
+    t0 = time.perf_counter()
+    try:
+        with cpu_limit(run.cpu_limit_s):
+            return _live(run)
+    except CpuLimitReached:
+        return LifeOutcome(run, math.nan, "unfinished", f"not finished within {run.cpu_limit_s:g} s of CPU",
+                           math.nan, wall_s=time.perf_counter() - t0)
+
+
+def _live(run: LifeRun) -> LifeOutcome:
     from reduced.lifetime import largest_holdable_force, solve_lifetime
     from validation.bridge.fem_route import FemRouteError, register
 

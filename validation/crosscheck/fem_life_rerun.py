@@ -17,6 +17,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from validation.crosscheck.rerun import replace_section
+
 __all__ = ["merge_into", "replace_section", "parse_law"]
 
 
@@ -25,33 +27,9 @@ def merge_into(report_dir, quick: bool = False, cache_dir=None, cached_only: boo
     put its files, its README section and its summary entry into an existing report directory,
     leaving the other sections' files as they are; returns the files written. `cached_only`: runs
     not in the cache are not run, their cells say so (a report cut at a time budget)."""
-    import json
-    import shutil
-    import tempfile
-
-    from validation.bridge.cache import user_cache_dir
-    from validation.crosscheck import fem_life
-    from validation.crosscheck.context import Context
-    from validation.crosscheck.report import Report, _finite
-    from validation.crosscheck.runs import RunMemo
-    from validation.output import terminal_progress
-
-    root = Path(report_dir)
-    memo = RunMemo(cache_dir=user_cache_dir("validate") if cache_dir is None else cache_dir)
-    with tempfile.TemporaryDirectory() as tmp:
-        rep = Report(Path(tmp))
-        fem_life.run(Context(memo=memo, report=rep, quick=quick, progress=terminal_progress(fem_life.NAME)),
-                     cached_only=cached_only)
-        for name in rep.files:
-            shutil.copyfile(Path(tmp) / name, root / name)
-    header = f"## {fem_life.TITLE}\n"
-    readme = root / "README.md"
-    readme.write_text(replace_section(readme.read_text(), header, "\n".join(rep.pages[fem_life.NAME])))
-    summary_path = root / "summary.json"
-    summary = json.loads(summary_path.read_text())
-    summary[fem_life.NAME] = _finite(json.loads(json.dumps(rep.summary[fem_life.NAME], default=float)))
-    summary_path.write_text(json.dumps(summary, indent=1, sort_keys=True) + "\n")
-    return [*rep.files, readme.name, summary_path.name]
+    from validation.crosscheck import rerun
+    from validation.crosscheck.fem_life import NAME
+    return rerun.merge_into(report_dir, NAME, quick, cache_dir, cached_only)
 
 
 def parse_law(text: str) -> tuple[str, float | None]:
@@ -67,20 +45,6 @@ def parse_law(text: str) -> tuple[str, float | None]:
         raise ValueError(f"--law {text!r}: not one of the section's laws "
                          + ", ".join(f"{n} {m:g}" if m else n for n, m in LAWS))
     return law
-
-
-def replace_section(text: str, header: str, body: str) -> str:
-    """`text` (a report's README) with the section under `header` replaced by `body`, or the section
-    added before the next numbered-or-not section that follows the numbered ones ("## Deformed cup")."""
-    lines = text.splitlines(keepends=True)
-    new = [header, "\n", body, "\n"]
-    if header in lines:
-        i = lines.index(header)
-        j = next((k for k in range(i + 1, len(lines)) if lines[k].startswith("## ")), len(lines))
-        return "".join(lines[:i] + new + lines[j:])
-    j = next((k for k, line in enumerate(lines) if line.startswith("## ") and not line[3:4].isdigit()),
-             len(lines))
-    return "".join(lines[:j] + new + lines[j:])
 
 
 def main(argv=None) -> int:
