@@ -13,10 +13,10 @@ nodes the LCP lets go are released. Coulomb's step is `fem.friction.FrictionStep
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import nnls
 
 from .factorization import factor_shifted
 from .linsolve import NotPositiveDefinite
+from .nnls import nnls
 
 __all__ = ["ContactStep", "lcp"]
 
@@ -105,5 +105,5 @@ def lcp(S, q):
     Sn = S / np.outer(scale, scale)
     L = np.linalg.cholesky(Sn)
     y = np.linalg.solve(L, q / scale)
-    x, _ = nnls(L.T, -y)
+    x = nnls(L.T, -y)
     return x / scale

@@ -4,7 +4,7 @@ machinery, no plotting, no dask, no pyvista, no scipy.signal; the paper route's 
 surface imports no scipy at all (its u_c table is stored, its interpolants and roots are the
 project's own: scipy.interpolate and scipy.optimize cost ~0.5 s to import, more than the command);
 the profile route's lifetime on an FEM curve's CSV imports no scipy either (its flow tables' spline
-is the project's own); a stiffness curve without a mesh file imports no meshio. Each case is a fresh process (the modules
+is the project's own); a stiffness curve without a mesh file imports no meshio, nor scipy.optimize. Each case is a fresh process (the modules
 a test session has already loaded say nothing), its `sys.modules` read after the command ran.
 """
 
@@ -95,10 +95,13 @@ def coarse_curve(tmp_path_factory) -> tuple[Path, set[str]]:
 
 def test_a_fem_command_does_import_the_fem(coarse_curve):
     """The checks above see imports: a command that runs the FEM shows skfem (and scipy); without
-    a mesh file it reads none (no meshio)."""
+    a mesh file it reads none (no meshio); its contact step's NNLS is scipy's compiled one, without
+    the package scipy.optimize (`fem.nnls`: ~0.17 s of its import)."""
     _, modules = coarse_curve
     assert {"skfem", "scipy"} <= _top(modules)
     assert "meshio" not in _top(modules)
+    assert "fem.nnls" in modules and "scipy.optimize._slsqplib" in modules
+    assert not {"scipy.optimize", "scipy.special", "scipy.fft"} & modules
 
 
 def test_the_profile_route_on_a_curve_imports_no_scipy(coarse_curve, tmp_path):
