@@ -133,6 +133,8 @@ def _instrument() -> None:
     fem.linsolve.BorderedFactor.__init__ = w("factor", fem.linsolve.BorderedFactor.__init__)
     for cls in (fem.linsolve.Factor, fem.linsolve.BorderedFactor, fem.condensation.CondensedFactor):
         cls.solve = w("solve", cls.solve)
+        if hasattr(cls, "solve_at"):             # (a solve exact at a few dofs only)
+            cls.solve_at = w("solve", cls.solve_at)
     fem.contact_step.lcp = w("lcp", fem.contact_step.lcp)
     fem.cup._measure = w("post", fem.cup._measure)
     fem.cup.check_state = w("post", fem.cup.check_state)

@@ -126,6 +126,14 @@ class CondensedCholesky:
         self._Bb_local = lb
         self._gather = _scatter_matrix(lb, len(B))
         self.n, self.kd, self._B = n, self._inner.kd, B
+        # `CondensedFactor.solve_at`: the inner band position from which x_B is needed for a dof's
+        # value (its own; an interior dof's: its element's first), and each interior dof's element
+        position_B = self._inner.position[lb]                                  # [nb, m]
+        self._start = np.empty(n, np.int64)
+        self._start[B] = self._inner.position
+        self._start[I] = position_B.min(axis=1)[:, None]
+        self._element = np.full(n, -1)
+        self._element[I] = np.arange(len(I))[:, None]
 
     def factor(self, K: sp.csr_matrix, free: np.ndarray, shift: float = 0.0) -> "CondensedFactor":
         """Factor K_ff (+ shift diag(K_ff)) by condensing the interior nodes (module docstring).
@@ -176,6 +184,31 @@ class CondensedFactor:
             fixed = ~self.free
             x[fixed] = du_fixed[fixed] if rhs.ndim == 1 else du_fixed[fixed, None]
         return x
+
+    def solve_at(self, rhs: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+        """x = K_ff^-1 rhs_f (x_c = 0) exact at `dofs` only, elsewhere partial (`Factor.solve_at`):
+        the interior nodes condensed only where rhs has entries, recovered only where `dofs` are,
+        the band's sweeps from the first position those reach."""
+        o, dofs = self._owner, np.asarray(dofs)
+        b = _constrained_rhs(self._K, self.free, rhs, None)
+        b2 = b.reshape(len(b), -1)
+        b_I = b2[o._I]                                                       # [nb, 2, m]
+        g = b2[o._B]
+        loaded = np.flatnonzero(b_I.any(axis=(1, 2)))
+        if loaded.size:
+            WTb = np.transpose(self._W[loaded], (0, 2, 1)) @ b_I[loaded]        # [k, m_loc, m]
+            g = g - _scatter_matrix(o._Bb_local[loaded], len(o._B)) @ WTb.reshape(-1, b2.shape[1])
+        g[~self.free[o._B]] = 0.0
+        start = min(o._inner.start_of(np.zeros(0, int), g), int(o._start[dofs].min(initial=o._inner.n)))
+        x_B = o._inner.band_solve_at(self._inner, g, start)
+        x = np.zeros_like(b2)
+        x[o._B] = x_B
+        wanted = np.unique(o._element[dofs])
+        wanted = wanted[wanted >= 0]
+        if wanted.size:
+            I = o._I[wanted]
+            x[I] = self._inv[wanted] @ (b_I[wanted] - self._K_IB[wanted] @ x_B[o._Bb_local[wanted]])
+        return x.reshape(b.shape)
 
     def freeing(self, dofs: np.ndarray) -> BorderedFactor:
         """As `Factor.freeing`."""

@@ -149,6 +149,11 @@ class BandedCholesky:
         return Factor(self, K, free, self.band_factor(K.data, free, shift), shift)
 
     @property
+    def position(self) -> np.ndarray:
+        """The band position of each dof."""
+        return self._inv
+
+    @property
     def upper_entries(self) -> np.ndarray:
         """The positions in the pattern's CSR data of the entries the band holds (the upper
         triangle in the band's ordering), in the order `upper_band_factor` takes them."""
@@ -186,6 +191,23 @@ class BandedCholesky:
             x = sla.cho_solve_banded((c, False), b[self._perm], overwrite_b=True, check_finite=False)
         return x[self._inv]
 
+    def band_solve_at(self, c: np.ndarray, b: np.ndarray, start: int) -> np.ndarray:
+        """x = K_ff^-1 b on the band positions >= `start` (0 before), for b zero before `start`:
+        both triangular sweeps then run on the factor's trailing block alone (forward, x is zero
+        before `start`; backward, x at a position needs x only after it)."""
+        bp = b[self._perm]
+        x = np.zeros_like(bp)
+        if start < self.n:
+            with _one_thread():
+                x[start:] = sla.cho_solve_banded((c[:, start:], False), bp[start:], overwrite_b=True,
+                                                 check_finite=False)
+        return x[self._inv]
+
+    def start_of(self, dofs: np.ndarray, b: np.ndarray) -> int:
+        """The first band position that the dofs `dofs` or the nonzero rows of b [n, m] reach."""
+        rows = np.flatnonzero(b.reshape(len(b), -1).any(axis=1))
+        return int(min(self._inv[dofs].min(initial=self.n), self._inv[rows].min(initial=self.n)))
+
     def solve(self, K: sp.csr_matrix, rhs: np.ndarray, free: np.ndarray, du_fixed: np.ndarray,
               shift: float = 0.0) -> np.ndarray:
         """du with K_ff du_f = rhs_f - K_fc du_fixed_c and du_c = du_fixed_c on the constrained dofs
@@ -203,6 +225,14 @@ class Factor:
     def solve(self, rhs: np.ndarray, du_fixed: np.ndarray | None = None) -> np.ndarray:
         """x with K_ff x_f = rhs_f - K_fc du_fixed_c, x_c = du_fixed_c (0 if None); rhs [n] or [n, m]."""
         return self._owner.band_solve(self._c, _constrained_rhs(self._K, self.free, rhs, du_fixed))
+
+    def solve_at(self, rhs: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+        """x = K_ff^-1 rhs_f (x_c = 0) exact at `dofs` only, elsewhere partial: the sweeps run from
+        the first band position that `dofs` or rhs reach (`BandedCholesky.band_solve_at`). A few
+        contact rows at the band's end (the cup's rim) cost a fraction of a whole solve."""
+        o = self._owner
+        b = _constrained_rhs(self._K, self.free, rhs, None)
+        return o.band_solve_at(self._c, b, o.start_of(np.asarray(dofs), b))
 
     def freeing(self, dofs: np.ndarray) -> "BorderedFactor":
         """The factor of the free block with the constrained `dofs` freed as well (e.g. contact

@@ -167,6 +167,19 @@ class RankOneFactor:
         scale = self._c * (self._gf @ x) / self._den
         return x - np.multiply.outer(self._y, scale)
 
+    @property
+    def solved_g(self) -> np.ndarray:
+        """(K_s + c g g^T)_ff^-1 g_f = y / (1 + c g_f.y), y = (K_s)_ff^-1 g_f, without a solve."""
+        return self._y / self._den
+
+    def solve_at(self, rhs: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+        """`solve` (no prescribed values) exact at `dofs` only, where the base factor solves so
+        (`fem.linsolve.Factor.solve_at`): the term's weight g_f.x is y.rhs_f (K_s symmetric)."""
+        at = getattr(self._base, "solve_at", None)
+        x = at(rhs, dofs) if at is not None else self._base.solve(rhs)
+        scale = self._c * (self._y @ rhs) / self._den
+        return x - np.multiply.outer(self._y, scale)
+
     def freeing(self, dofs: np.ndarray) -> "RankOneFactor":
         """As `fem.linsolve.Factor.freeing`, with the rank-one term on the larger block."""
         return _definite(RankOneFactor(self._base.freeing(dofs), self._c, self._g))
