@@ -27,7 +27,8 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Mesh, MeshQuad2
 
-from .linsolve import BandedCholesky, BorderedFactor, NotPositiveDefinite, _constrained_rhs, strip_ordering
+from .linsolve import (BandedCholesky, BorderedFactor, NotPositiveDefinite, _constrained_rhs, _scatter_matrix,
+                       strip_ordering)
 
 __all__ = ["CondensedCholesky", "make_solver", "interior_nodes"]
 
@@ -126,14 +127,17 @@ class CondensedCholesky:
         self._Bb_local = lb
         self._gather = _scatter_matrix(lb, len(B))
         self.n, self.kd, self._B = n, self._inner.kd, B
-        # `CondensedFactor.solve_at`: the inner band position from which x_B is needed for a dof's
-        # value (its own; an interior dof's: its element's first), and each interior dof's element
-        position_B = self._inner.position[lb]                                  # [nb, m]
-        self._start = np.empty(n, np.int64)
-        self._start[B] = self._inner.position
-        self._start[I] = position_B.min(axis=1)[:, None]
+        # `CondensedFactor.solve_at`: each dof's boundary index (-1: interior), interior element
+        # and slot (-1: boundary), and the inner band position from which x_B gives its value
+        # (a boundary dof's own; an interior dof's: its element's first)
+        self._local = local
         self._element = np.full(n, -1)
         self._element[I] = np.arange(len(I))[:, None]
+        self._slot = np.full(n, -1)
+        self._slot[I] = np.arange(2)
+        self._start = np.empty(n, np.int64)
+        self._start[B] = self._inner.position
+        self._start[I] = self._inner.position[lb].min(axis=1)[:, None]
 
     def factor(self, K: sp.csr_matrix, free: np.ndarray, shift: float = 0.0) -> "CondensedFactor":
         """Factor K_ff (+ shift diag(K_ff)) by condensing the interior nodes (module docstring).
@@ -185,43 +189,41 @@ class CondensedFactor:
             x[fixed] = du_fixed[fixed] if rhs.ndim == 1 else du_fixed[fixed, None]
         return x
 
-    def solve_at(self, rhs: np.ndarray, dofs: np.ndarray) -> np.ndarray:
-        """x = K_ff^-1 rhs_f (x_c = 0) exact at `dofs` only, elsewhere partial (`Factor.solve_at`):
-        the interior nodes condensed only where rhs has entries, recovered only where `dofs` are,
-        the band's sweeps from the first position those reach."""
-        o, dofs = self._owner, np.asarray(dofs)
-        b = _constrained_rhs(self._K, self.free, rhs, None)
-        b2 = b.reshape(len(b), -1)
-        b_I = b2[o._I]                                                       # [nb, 2, m]
-        g = b2[o._B]
-        loaded = np.flatnonzero(b_I.any(axis=(1, 2)))
-        if loaded.size:
-            WTb = np.transpose(self._W[loaded], (0, 2, 1)) @ b_I[loaded]        # [k, m_loc, m]
-            g = g - _scatter_matrix(o._Bb_local[loaded], len(o._B)) @ WTb.reshape(-1, b2.shape[1])
-        g[~self.free[o._B]] = 0.0
-        start = min(o._inner.start_of(np.zeros(0, int), g), int(o._start[dofs].min(initial=o._inner.n)))
-        x_B = o._inner.band_solve_at(self._inner, g, start)
-        x = np.zeros_like(b2)
-        x[o._B] = x_B
-        wanted = np.unique(o._element[dofs])
-        wanted = wanted[wanted >= 0]
+    def solve_at(self, rows: np.ndarray, values: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+        """x = K_ff^-1 b at `dofs` only (`Factor.solve_at`): the interior nodes condensed only in
+        the elements b loads, recovered only in those of `dofs`, the band's sweeps from the first
+        position these reach."""
+        o, inner = self._owner, self._owner._inner
+        values = np.where(self.free[rows][:, None], values, 0.0)
+        m = values.shape[1]
+        if m == 0:
+            return np.zeros((len(dofs), 0))
+        interior = o._element[rows] >= 0
+        loaded, which = np.unique(o._element[rows[interior]], return_inverse=True)
+        b_I = np.zeros((len(loaded), 2, m))
+        b_I[which, o._slot[rows[interior]]] = values[interior]
+        WTb = np.transpose(self._W[loaded], (0, 2, 1)) @ b_I                 # [k, m_loc, m]
+        pos = inner.position[np.concatenate([o._local[rows[~interior]], o._Bb_local[loaded].ravel()])]
+        g = np.concatenate([values[~interior], -WTb.reshape(-1, m)])
+        start = int(min(pos.min(initial=inner.n), o._start[dofs].min(initial=inner.n)))
+        x_B = inner.tail_solve(self._inner, pos, g, start)                  # from `start` on
+        x = np.empty((len(dofs), m))
+        boundary = o._element[dofs] < 0
+        x[boundary] = x_B[inner.position[o._local[dofs[boundary]]] - start]
+        wanted, at = np.unique(o._element[dofs[~boundary]], return_inverse=True)
         if wanted.size:
-            I = o._I[wanted]
-            x[I] = self._inv[wanted] @ (b_I[wanted] - self._K_IB[wanted] @ x_B[o._Bb_local[wanted]])
-        return x.reshape(b.shape)
+            b_w = np.zeros((len(wanted), 2, m))
+            hit = np.searchsorted(loaded, wanted)                            # b's interior rows there
+            found = hit < len(loaded)
+            found[found] = loaded[hit[found]] == wanted[found]
+            b_w[found] = b_I[hit[found]]
+            x_w = self._inv[wanted] @ (b_w - self._K_IB[wanted] @ x_B[inner.position[o._Bb_local[wanted]] - start])
+            x[~boundary] = x_w[at, o._slot[dofs[~boundary]]]
+        return x
 
     def freeing(self, dofs: np.ndarray) -> BorderedFactor:
         """As `Factor.freeing`."""
         return BorderedFactor(self, np.asarray(dofs))
-
-
-def _scatter_matrix(index: np.ndarray, size: int) -> sp.csr_matrix:
-    """The 0/1 matrix P [size, index.size] whose product P @ v sums the rows of v [index.size, m]
-    into `size` slots by `index` (flattened). Each slot's entries are in the order of the flat
-    index (COO -> CSR is a stable sort by row), so the sums are those of a bincount, bit for bit,
-    without building (slot, column) keys for every column."""
-    flat = index.ravel()
-    return sp.csr_matrix((np.ones(flat.size), (flat, np.arange(flat.size))), shape=(size, flat.size))
 
 
 def _positions(csr: sp.csr_matrix):

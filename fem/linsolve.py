@@ -191,22 +191,17 @@ class BandedCholesky:
             x = sla.cho_solve_banded((c, False), b[self._perm], overwrite_b=True, check_finite=False)
         return x[self._inv]
 
-    def band_solve_at(self, c: np.ndarray, b: np.ndarray, start: int) -> np.ndarray:
-        """x = K_ff^-1 b on the band positions >= `start` (0 before), for b zero before `start`:
-        both triangular sweeps then run on the factor's trailing block alone (forward, x is zero
-        before `start`; backward, x at a position needs x only after it)."""
-        bp = b[self._perm]
-        x = np.zeros_like(bp)
-        if start < self.n:
-            with _one_thread():
-                x[start:] = sla.cho_solve_banded((c[:, start:], False), bp[start:], overwrite_b=True,
-                                                 check_finite=False)
-        return x[self._inv]
-
-    def start_of(self, dofs: np.ndarray, b: np.ndarray) -> int:
-        """The first band position that the dofs `dofs` or the nonzero rows of b [n, m] reach."""
-        rows = np.flatnonzero(b.reshape(len(b), -1).any(axis=1))
-        return int(min(self._inv[dofs].min(initial=self.n), self._inv[rows].min(initial=self.n)))
+    def tail_solve(self, c: np.ndarray, positions: np.ndarray, values: np.ndarray,
+                   start: int) -> np.ndarray:
+        """x = K_ff^-1 b at the band positions >= `start`, [n - start, m], for b with the rows
+        `values` [len(positions), m] at `positions` (>= start; repeated ones summed) and zero
+        elsewhere: both triangular sweeps run on the factor's trailing block alone (forward, x
+        is zero before `start`; backward, x at a position needs x only after it)."""
+        b = _scatter_matrix(positions - start, self.n - start) @ values
+        if start >= self.n:
+            return b
+        with _one_thread():
+            return sla.cho_solve_banded((c[:, start:], False), b, overwrite_b=True, check_finite=False)
 
     def solve(self, K: sp.csr_matrix, rhs: np.ndarray, free: np.ndarray, du_fixed: np.ndarray,
               shift: float = 0.0) -> np.ndarray:
@@ -226,13 +221,17 @@ class Factor:
         """x with K_ff x_f = rhs_f - K_fc du_fixed_c, x_c = du_fixed_c (0 if None); rhs [n] or [n, m]."""
         return self._owner.band_solve(self._c, _constrained_rhs(self._K, self.free, rhs, du_fixed))
 
-    def solve_at(self, rhs: np.ndarray, dofs: np.ndarray) -> np.ndarray:
-        """x = K_ff^-1 rhs_f (x_c = 0) exact at `dofs` only, elsewhere partial: the sweeps run from
-        the first band position that `dofs` or rhs reach (`BandedCholesky.band_solve_at`). A few
-        contact rows at the band's end (the cup's rim) cost a fraction of a whole solve."""
+    def solve_at(self, rows: np.ndarray, values: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+        """x = K_ff^-1 b at `dofs` only, [len(dofs), m], for the right-hand side b with the rows
+        `values` [len(rows), m] at the distinct dofs `rows` and zero elsewhere (constrained rows
+        dropped; a constrained dof's x is 0): the sweeps run from the first band position that
+        `rows` and `dofs` reach (`BandedCholesky.tail_solve`). A few contact rows at the band's
+        end (the cup's rim) cost a fraction of a whole solve, and nothing of size n is formed."""
         o = self._owner
-        b = _constrained_rhs(self._K, self.free, rhs, None)
-        return o.band_solve_at(self._c, b, o.start_of(np.asarray(dofs), b))
+        values = np.where(self.free[rows][:, None], values, 0.0)
+        pos, at = o.position[rows], o.position[dofs]
+        start = int(min(pos.min(initial=o.n), at.min(initial=o.n)))
+        return o.tail_solve(self._c, pos, values, start)[at - start]
 
     def freeing(self, dofs: np.ndarray) -> "BorderedFactor":
         """The factor of the free block with the constrained `dofs` freed as well (e.g. contact
@@ -276,6 +275,15 @@ class BorderedFactor:
             fixed = ~self.free
             x[fixed] = du_fixed[fixed] if rhs.ndim == 1 else du_fixed[fixed, None]
         return x
+
+
+def _scatter_matrix(index: np.ndarray, size: int) -> sp.csr_matrix:
+    """The 0/1 matrix P [size, index.size] whose product P @ v sums the rows of v [index.size, m]
+    into `size` slots by `index` (flattened). Each slot's entries are in the order of the flat
+    index (COO -> CSR is a stable sort by row), so the sums are those of a bincount, bit for bit,
+    without building (slot, column) keys for every column."""
+    flat = index.ravel()
+    return sp.csr_matrix((np.ones(flat.size), (flat, np.arange(flat.size))), shape=(size, flat.size))
 
 
 def _constrained_rhs(K: sp.csr_matrix, free: np.ndarray, rhs: np.ndarray,
