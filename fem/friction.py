@@ -202,6 +202,8 @@ class _Condensed:
         dofs, disp = self.rows[cols], ~self.force[cols]
         k = np.arange(len(cols))
         sup = self.support
+        if len(cols) == 0:
+            return np.zeros((len(sup), 0)), np.zeros((len(self.rows), 0))
         at = getattr(self.fac, "solve_at", None)
         if at is not None:
             Z = at(sup, E, sup)
