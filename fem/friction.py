@@ -164,7 +164,6 @@ class _Condensed:
         self.g_all = plane.gap(u)
         self.d0 = u[rd[held]] - old.u_r_stick_m[held]
         self.rank_one = getattr(K, "rank_one", None)
-        self._sparse = K.plain() if self.rank_one is not None else K
         if self.rank_one is not None:
             solved = getattr(fac, "solved_g", None)           # K_ff^-1 g_f
             self._v = solved if solved is not None else fac.solve(np.where(fac.free, self.rank_one[1], 0.0))
@@ -183,7 +182,7 @@ class _Condensed:
         """The rows' tangent rows, the support (class docstring) and the rows' sparse part on it
         (dense, [rows, support]); the columns' right-hand sides moved onto a grown support."""
         self._Kc = _rows(self.K, self.rows)
-        Ks = self._sparse[self.rows]
+        Ks = self._Kc.sparse if self.rank_one is not None else self._Kc
         old = self.support
         self.support = np.union1d(self.rows, Ks.indices)
         self._Kd = np.zeros((len(self.rows), len(self.support)))

@@ -197,7 +197,11 @@ class BandedCholesky:
         `values` [len(positions), m] at `positions` (>= start; repeated ones summed) and zero
         elsewhere: both triangular sweeps run on the factor's trailing block alone (forward, x
         is zero before `start`; backward, x at a position needs x only after it)."""
-        b = _scatter_matrix(positions - start, self.n - start) @ values
+        b = np.zeros((self.n - start, values.shape[1]))
+        if len(positions):                       # the sums of repeated positions, in their order
+            order = np.argsort(positions, kind="stable")
+            at, first = np.unique(positions[order], return_index=True)
+            b[at - start] = np.add.reduceat(values[order], first, axis=0)
         if start >= self.n:
             return b
         with _one_thread():
