@@ -16,7 +16,8 @@ its share of the wall time:
              condensation of the interior nodes) and the Schur complements of freed contact
              nodes (`fem.linsolve.BorderedFactor`); its calls count the requests, a reused
              factor included (the header gives the factorizations done);
-  solve      the triangular solves with those factors;
+  solve      the triangular solves with those factors (whole, and `solve_at`'s on a factor's
+             trailing block: Coulomb's condensed columns read at the contact rows only);
   lcp        the contact step's small LCP (non-negative least squares);
   post       the per-step outputs (`fem.cup._measure`: pressure profile, r_c, l, V, stretch) and
              the admissibility check of each converged state (`fem.integrity.check_state`);

@@ -27,8 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Mesh, MeshQuad2
 
-from .linsolve import (BandedCholesky, BorderedFactor, NotPositiveDefinite, _constrained_rhs, _scatter_matrix,
-                       strip_ordering)
+from .linsolve import BandedCholesky, BorderedFactor, NotPositiveDefinite, _constrained_rhs, strip_ordering
 
 __all__ = ["CondensedCholesky", "make_solver", "interior_nodes"]
 
@@ -217,13 +216,23 @@ class CondensedFactor:
             found = hit < len(loaded)
             found[found] = loaded[hit[found]] == wanted[found]
             b_w[found] = b_I[hit[found]]
-            x_w = self._inv[wanted] @ (b_w - self._K_IB[wanted] @ x_B[inner.position[o._Bb_local[wanted]] - start])
+            x_Bb = x_B[inner.position[o._Bb_local[wanted]] - start]
+            x_w = self._inv[wanted] @ (b_w - self._K_IB[wanted] @ x_Bb)
             x[~boundary] = x_w[at, o._slot[dofs[~boundary]]]
         return x
 
     def freeing(self, dofs: np.ndarray) -> BorderedFactor:
         """As `Factor.freeing`."""
         return BorderedFactor(self, np.asarray(dofs))
+
+
+def _scatter_matrix(index: np.ndarray, size: int) -> sp.csr_matrix:
+    """The 0/1 matrix P [size, index.size] whose product P @ v sums the rows of v [index.size, m]
+    into `size` slots by `index` (flattened). Each slot's entries are in the order of the flat
+    index (COO -> CSR is a stable sort by row), so the sums are those of a bincount, bit for bit,
+    without building (slot, column) keys for every column."""
+    flat = index.ravel()
+    return sp.csr_matrix((np.ones(flat.size), (flat, np.arange(flat.size))), shape=(size, flat.size))
 
 
 def _positions(csr: sp.csr_matrix):

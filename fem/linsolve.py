@@ -281,15 +281,6 @@ class BorderedFactor:
         return x
 
 
-def _scatter_matrix(index: np.ndarray, size: int) -> sp.csr_matrix:
-    """The 0/1 matrix P [size, index.size] whose product P @ v sums the rows of v [index.size, m]
-    into `size` slots by `index` (flattened). Each slot's entries are in the order of the flat
-    index (COO -> CSR is a stable sort by row), so the sums are those of a bincount, bit for bit,
-    without building (slot, column) keys for every column."""
-    flat = index.ravel()
-    return sp.csr_matrix((np.ones(flat.size), (flat, np.arange(flat.size))), shape=(size, flat.size))
-
-
 def _constrained_rhs(K: sp.csr_matrix, free: np.ndarray, rhs: np.ndarray,
                      du_fixed: np.ndarray | None) -> np.ndarray:
     """rhs - K du_fixed on the free dofs and du_fixed on the constrained ones (0 if None)."""
