@@ -126,11 +126,12 @@ def _rim_rhs(fac, K, plane, rng, m=5):
 
 def test_solve_at_equals_the_whole_solve_at_the_asked_dofs(frictional_iterate):
     """The condensed (interior nodes) and the plain banded factor, and the gas tangent's
-    rank-one factor over each: x at the asked dofs equals the whole solve's there (round-off of
-    another summation order), constrained dofs 0."""
+    rank-one factor over each and over a sparse LU (no `solve_at` of its own): x at the asked
+    dofs equals the whole solve's there (round-off of another summation order), constrained
+    dofs 0."""
     from fem.condensation import make_solver
     from fem.linsolve import BandedCholesky
-    from fem.trapped_gas import RankOneSolver
+    from fem.trapped_gas import RankOneFactor, RankOneSolver, SymmetricLU
 
     plane, old, u, res0, K, fac, du0, held, tol = frictional_iterate
     rng = np.random.default_rng(11)
@@ -142,7 +143,8 @@ def test_solve_at_equals_the_whole_solve_at_the_asked_dofs(frictional_iterate):
     g[rng.choice(np.flatnonzero(free), 40, replace=False)] = rng.normal(size=40)
     gas = GasTangent.of(K, K.data, 3.0 * K.diagonal().max(), g / np.linalg.norm(g))
     factors = [condensed.factor(K, free), plain.factor(K, free),
-               RankOneSolver(condensed).factor(gas, free), RankOneSolver(plain).factor(gas, free)]
+               RankOneSolver(condensed).factor(gas, free), RankOneSolver(plain).factor(gas, free),
+               RankOneFactor(SymmetricLU(K, free), *gas.rank_one)]     # a base with whole solves only
     rows, values, dofs, b = _rim_rhs(fac, K, plane, rng)
     assert np.any(~free[rows]) and np.any(~free[dofs])
     for f in factors:
