@@ -16,7 +16,8 @@ its share of the wall time:
              condensation of the interior nodes) and the Schur complements of freed contact
              nodes (`fem.linsolve.BorderedFactor`); its calls count the requests, a reused
              factor included (the header gives the factorizations done);
-  solve      the triangular solves with those factors;
+  solve      the triangular solves with those factors (whole, and `solve_at`'s on a factor's
+             trailing block: Coulomb's condensed columns read at the contact rows only);
   lcp        the contact step's small LCP (non-negative least squares);
   post       the per-step outputs (`fem.cup._measure`: pressure profile, r_c, l, V, stretch) and
              the admissibility check of each converged state (`fem.integrity.check_state`);
@@ -133,6 +134,8 @@ def _instrument() -> None:
     fem.linsolve.BorderedFactor.__init__ = w("factor", fem.linsolve.BorderedFactor.__init__)
     for cls in (fem.linsolve.Factor, fem.linsolve.BorderedFactor, fem.condensation.CondensedFactor):
         cls.solve = w("solve", cls.solve)
+        if hasattr(cls, "solve_at"):             # (a solve exact at a few dofs only)
+            cls.solve_at = w("solve", cls.solve_at)
     fem.contact_step.lcp = w("lcp", fem.contact_step.lcp)
     fem.cup._measure = w("post", fem.cup._measure)
     fem.cup.check_state = w("post", fem.cup.check_state)

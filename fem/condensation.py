@@ -126,6 +126,17 @@ class CondensedCholesky:
         self._Bb_local = lb
         self._gather = _scatter_matrix(lb, len(B))
         self.n, self.kd, self._B = n, self._inner.kd, B
+        # `CondensedFactor.solve_at`: each dof's boundary index (-1: interior), interior element
+        # and slot (-1: boundary), and the inner band position from which x_B gives its value
+        # (a boundary dof's own; an interior dof's: its element's first)
+        self._local = local
+        self._element = np.full(n, -1)
+        self._element[I] = np.arange(len(I))[:, None]
+        self._slot = np.full(n, -1)
+        self._slot[I] = np.arange(2)
+        self._start = np.empty(n, np.int64)
+        self._start[B] = self._inner.position
+        self._start[I] = self._inner.position[lb].min(axis=1)[:, None]
 
     def factor(self, K: sp.csr_matrix, free: np.ndarray, shift: float = 0.0) -> "CondensedFactor":
         """Factor K_ff (+ shift diag(K_ff)) by condensing the interior nodes (module docstring).
@@ -175,6 +186,39 @@ class CondensedFactor:
         if du_fixed is not None:
             fixed = ~self.free
             x[fixed] = du_fixed[fixed] if rhs.ndim == 1 else du_fixed[fixed, None]
+        return x
+
+    def solve_at(self, rows: np.ndarray, values: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+        """x = K_ff^-1 b at `dofs` only (`Factor.solve_at`): the interior nodes condensed only in
+        the elements b loads, recovered only in those of `dofs`, the band's sweeps from the first
+        position these reach."""
+        o, inner = self._owner, self._owner._inner
+        values = np.where(self.free[rows][:, None], values, 0.0)
+        m = values.shape[1]
+        if m == 0:
+            return np.zeros((len(dofs), 0))
+        interior = o._element[rows] >= 0
+        loaded, which = np.unique(o._element[rows[interior]], return_inverse=True)
+        b_I = np.zeros((len(loaded), 2, m))
+        b_I[which, o._slot[rows[interior]]] = values[interior]
+        WTb = np.transpose(self._W[loaded], (0, 2, 1)) @ b_I                 # [k, m_loc, m]
+        pos = inner.position[np.concatenate([o._local[rows[~interior]], o._Bb_local[loaded].ravel()])]
+        g = np.concatenate([values[~interior], -WTb.reshape(-1, m)])
+        start = int(min(pos.min(initial=inner.n), o._start[dofs].min(initial=inner.n)))
+        x_B = inner.tail_solve(self._inner, pos, g, start)                  # from `start` on
+        x = np.empty((len(dofs), m))
+        boundary = o._element[dofs] < 0
+        x[boundary] = x_B[inner.position[o._local[dofs[boundary]]] - start]
+        wanted, at = np.unique(o._element[dofs[~boundary]], return_inverse=True)
+        if wanted.size:
+            b_w = np.zeros((len(wanted), 2, m))
+            hit = np.searchsorted(loaded, wanted)                            # b's interior rows there
+            found = hit < len(loaded)
+            found[found] = loaded[hit[found]] == wanted[found]
+            b_w[found] = b_I[hit[found]]
+            x_Bb = x_B[inner.position[o._Bb_local[wanted]] - start]
+            x_w = self._inv[wanted] @ (b_w - self._K_IB[wanted] @ x_Bb)
+            x[~boundary] = x_w[at, o._slot[dofs[~boundary]]]
         return x
 
     def freeing(self, dofs: np.ndarray) -> BorderedFactor:

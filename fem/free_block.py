@@ -10,9 +10,11 @@ combined rows S are added by the Woodbury identity,
 
     (K_ff + E_S V)^-1 b = y - Z (I + V Z)^-1 V y,   y = K_ff^-1 b,  Z = K_ff^-1 E_S,  V = (W K)_Sf,
 
-k more right-hand sides of the same factor. Its result is accepted where its componentwise
-backward error is at round-off (|R K x - b| <= 1e-9 (|R| |K| |x| + |b|)); otherwise, and where
-K_ff is not definite (the gas alone holding the wall), SuperLU factors (R K)_ff itself.
+Z read only at V's columns (`solve_at`: the sliding rows sit at the band's end), and x as one
+more solve, K_ff x = b - E_S (I + V Z)^-1 V y, instead of k whole columns. Its result is accepted
+where its componentwise backward error is at round-off (|R K x - b| <= 1e-9 (|R| |K| |x| + |b|));
+otherwise, and where K_ff is not definite (the gas alone holding the wall), SuperLU factors
+(R K)_ff itself.
 """
 
 from __future__ import annotations
@@ -47,17 +49,25 @@ def solve_free_block(K: sp.csr_matrix, rows: sp.csr_matrix, free: np.ndarray, rh
     full[free] = rhs
     if S.size == 0:
         return factor.solve(full)[free]
-    m = full.reshape(n, -1).shape[1]
-    E = np.zeros((n, S.size))
-    E[S, np.arange(S.size)] = 1.0
-    YZ = factor.solve(np.concatenate([full.reshape(n, -1), E], axis=1))     # [y | Z], zero off f
-    Y, Z = YZ[:, :m], YZ[:, m:]
+    full2 = full.reshape(n, -1)
+    Y = factor.solve(full2)                         # y, zero off f
     WK = (W[S] @ K).toarray()
     WK[:, ~free] = 0.0                               # V = (W K)_Sf
+    reach = np.flatnonzero(WK.any(axis=0))          # V's columns: Z is read there only
+    at = getattr(factor, "solve_at", None)
+    if at is not None:
+        Z = at(S, np.eye(S.size), reach)
+    else:
+        E = np.zeros((n, S.size))
+        E[S, np.arange(S.size)] = 1.0
+        Z = factor.solve(E)[reach]
     try:
-        X = Y - Z @ np.linalg.solve(np.eye(S.size) + WK @ Z, WK @ Y)
+        C = np.linalg.solve(np.eye(S.size) + WK[:, reach] @ Z, WK @ Y)
     except np.linalg.LinAlgError:                   # a singular capacitance matrix
         return _lu(K, rows, free, rhs)
+    b = full2.copy()
+    b[S] -= C
+    X = factor.solve(b)                             # y - Z C, one more solve of m columns
     R = sp.csr_matrix(rows)
     residual = R @ (K @ X) - full.reshape(n, -1)
     bound = abs(R) @ (abs(K) @ np.abs(X)) + np.abs(full.reshape(n, -1))

@@ -141,7 +141,14 @@ class _Condensed:
     step du0 and the columns Z, du = du0 + Z y and the reactions at the rows are f = q + F y. A
     held row gets its column only when its equation is not the base's own (a held node at the
     plane, g = 0, that stays pressed; a stuck one at its anchor that stays stuck): at the end of
-    a sliding front most nodes slide, few change."""
+    a sliding front most nodes slide, few change.
+
+    Only the columns' entries at the rows and at the dofs their tangent rows couple to (the
+    `support`) enter D = Z[rows] and F, and the columns' right-hand sides live there too: the
+    columns are solved there alone (`solve_at` of the factor: the contact rows sit at the band's
+    end, at the rim), and du = du0 + Z y is one whole solve of the combined right-hand side. The
+    gas tangent's rank-one term c g g^T, whose g spans the cavity chain, enters by its weights
+    g.Z, from v = K_ff^-1 g_f (K_ff symmetric)."""
 
     def __init__(self, plane: RigidPlane, old: ContactState, u, res0, K: sp.csr_matrix, fac,
                  du0, held: np.ndarray, tol: float):
@@ -151,12 +158,19 @@ class _Condensed:
         self.rows = np.concatenate([rd[held] + 1, rd[held]])
         self.force = np.zeros(len(self.rows), bool)          # the unknown is a force
         self.has = np.zeros(len(self.rows), bool)            # the row has its column
-        self.cols, self.Z = np.zeros(0, int), np.zeros((len(u), 0))
+        self.cols = np.zeros(0, int)
         self.An = np.ones(len(held), bool)
         self.slip = old.slip[held].astype(np.int8)
         self.g_all = plane.gap(u)
         self.d0 = u[rd[held]] - old.u_r_stick_m[held]
-        self._Kc = _rows(K, self.rows)
+        self.rank_one = getattr(K, "rank_one", None)
+        if self.rank_one is not None:
+            solved = getattr(fac, "solved_g", None)           # K_ff^-1 g_f
+            self._v = solved if solved is not None else fac.solve(np.where(fac.free, self.rank_one[1], 0.0))
+            self._gv = float(self._v @ self.rank_one[1])
+        self.support, self.E = np.zeros(0, int), np.zeros((0, 0))
+        self._set_rows()
+        self.Z = np.zeros((len(self.support), 0))
         self.F = np.zeros((len(self.rows), 0))               # the rows' reactions to the columns
         self.converged, self.y = False, np.zeros(0)
         # a held node off the plane or off its anchor (pressed or landed in the last iteration),
@@ -164,21 +178,63 @@ class _Condensed:
         moved = np.concatenate([self.g_all[held] != 0.0, self.d0 != 0.0])
         self._columns(np.flatnonzero(moved | self._needed(self.An, self.slip)))
 
+    def _set_rows(self) -> None:
+        """The rows' tangent rows, the support (class docstring) and the rows' sparse part on it
+        (dense, [rows, support]); the columns' right-hand sides moved onto a grown support."""
+        self._Kc = _rows(self.K, self.rows)
+        Ks = self._Kc.sparse if self.rank_one is not None else self._Kc
+        old = self.support
+        self.support = np.union1d(self.rows, Ks.indices)
+        self._Kd = np.zeros((len(self.rows), len(self.support)))
+        self._Kd[np.repeat(np.arange(len(self.rows)), np.diff(Ks.indptr)),
+                 np.searchsorted(self.support, Ks.indices)] = Ks.data
+        self._at = np.searchsorted(self.support, self.rows)     # the rows in the support
+        self._diag = self._Kd[np.arange(len(self.rows)), self._at]
+        if len(old) != len(self.support):
+            E = np.zeros((len(self.support), self.E.shape[1]))
+            E[np.searchsorted(self.support, old)] = self.E
+            self.E = E
+
+    def _solve(self, E: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The columns Z on the support of the right-hand sides E [support, k] (the sparse
+        part's, zero on the constrained dofs) of rows `cols`, and their reactions at the rows."""
+        dofs, disp = self.rows[cols], ~self.force[cols]
+        k = np.arange(len(cols))
+        sup = self.support
+        if len(cols) == 0:
+            return np.zeros((len(sup), 0)), np.zeros((len(self.rows), 0))
+        at = getattr(self.fac, "solve_at", None)
+        if at is not None:
+            Z = at(sup, E, sup)
+        else:
+            b = np.zeros((len(self.du0), len(cols)))
+            b[sup] = E
+            Z = self.fac.solve(b)[sup]
+        if self.rank_one is not None:       # E's whole columns: -(K_s + c g g^T)_f,dof
+            c, g = self.rank_one
+            gd = np.where(disp, c * g[dofs], 0.0)
+            Z -= np.multiply.outer(self._v[sup], gd)
+            gZ = self._v[sup] @ E - self._gv * gd + np.where(disp, g[dofs], 0.0)
+        Z[self._at[cols[disp]], k[disp]] = 1.0
+        F = self._Kd @ Z
+        if self.rank_one is not None:
+            F += self.rank_one[0] * np.multiply.outer(self._Kc.g_rows, gZ)
+        return Z, F
+
     def _columns(self, rows: np.ndarray) -> None:
         """Add the columns of `rows` (one multi-column solve with the base factor)."""
         rows = rows[~self.has[rows]]
         if len(rows) == 0:
             return
-        dofs, n = self.rows[rows], len(self.du0)
         k = np.arange(len(rows))
         force = self.force[rows]
-        E = np.zeros((n, len(rows)))
-        E[dofs[force], k[force]] = 1.0
-        E[:, ~force] = -_rows(self.K, dofs[~force]).toarray().T      # K symmetric: its columns
-        Z = self.fac.solve(E)
-        Z[dofs[~force], k[~force]] = 1.0
-        self.Z = np.hstack([self.Z, Z])
-        self.F = np.hstack([self.F, self._Kc @ Z])
+        E = np.zeros((len(self.support), len(rows)))
+        E[self._at[rows[force]], k[force]] = 1.0
+        E[:, ~force] = -self._Kd[rows[~force]].T             # K symmetric: its columns
+        E[~self.fac.free[self.support]] = 0.0
+        Z, F = self._solve(E, rows)
+        self.E, self.Z = np.hstack([self.E, E]), np.hstack([self.Z, Z])
+        self.F = np.hstack([self.F, F])
         self.cols = np.concatenate([self.cols, rows])
         self.has[rows] = True
 
@@ -190,12 +246,22 @@ class _Condensed:
         self.has = np.concatenate([self.has, np.zeros(len(new), bool)])
         self.nodes = np.concatenate([self.nodes, new])
         self.An = np.concatenate([self.An, np.ones(len(new), bool)])
-        self._Kc = _rows(self.K, self.rows)
-        self.F = self._Kc @ self.Z
+        self._set_rows()
+        self.Z, self.F = self._solve(self.E, self.cols)      # on the larger support
         self._columns(np.arange(start, len(self.rows)))
 
     def du(self) -> np.ndarray:
-        return self.du0 + self.Z @ self.y
+        """du0 + Z y: one solve of the columns' right-hand sides combined by y."""
+        if len(self.cols) == 0:
+            return self.du0.copy()
+        dofs, disp = self.rows[self.cols], ~self.force[self.cols]
+        b = np.zeros(len(self.du0))
+        b[self.support] = self.E @ self.y
+        du = self.du0 + self.fac.solve(b)
+        if self.rank_one is not None:
+            du -= self._v * (self.rank_one[0] * self.rank_one[1][dofs[disp]] @ self.y[disp])
+        du[dofs[disp]] += self.y[disp]
+        return du
 
     def _needed(self, An: np.ndarray, slip: np.ndarray) -> np.ndarray:
         """The rows whose equation under the sets (An, slip) is not the base's own."""
@@ -212,14 +278,14 @@ class _Condensed:
         iz = np.concatenate([np.arange(nh), 2 * nh + np.arange(nn - nh)])
         ir = nh + np.arange(nh)
         g, d0, mu = self.g_all[self.nodes], self.d0, self.mu
-        c = np.abs(self.K.diagonal()[self.rows])     # the augmentation (module docstring)
+        c = np.abs(self._diag)                      # the augmentation (module docstring)
         q = self.res0[self.rows] + self._Kc @ self.du0
         w0 = self.du0[self.rows]
         An, slip = self.An.copy(), self.slip.copy()
         self.converged = False
         for _ in range(_SSN_ITERATIONS):
             self._columns(np.flatnonzero(self._needed(An, slip)))
-            F, D = self.F, self.Z[self.rows]
+            F, D = self.F, self.Z[self._at]
             A, b = F.copy(), -q.copy()          # default rows: reaction 0 (off the plane)
             on = iz[An]
             A[on], b[on] = D[on], -g[An] - w0[on]

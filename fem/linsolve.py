@@ -149,6 +149,11 @@ class BandedCholesky:
         return Factor(self, K, free, self.band_factor(K.data, free, shift), shift)
 
     @property
+    def position(self) -> np.ndarray:
+        """The band position of each dof."""
+        return self._inv
+
+    @property
     def upper_entries(self) -> np.ndarray:
         """The positions in the pattern's CSR data of the entries the band holds (the upper
         triangle in the band's ordering), in the order `upper_band_factor` takes them."""
@@ -186,6 +191,22 @@ class BandedCholesky:
             x = sla.cho_solve_banded((c, False), b[self._perm], overwrite_b=True, check_finite=False)
         return x[self._inv]
 
+    def tail_solve(self, c: np.ndarray, positions: np.ndarray, values: np.ndarray,
+                   start: int) -> np.ndarray:
+        """x = K_ff^-1 b at the band positions >= `start`, [n - start, m], for b with the rows
+        `values` [len(positions), m] at `positions` (>= start; repeated ones summed) and zero
+        elsewhere: both triangular sweeps run on the factor's trailing block alone (forward, x
+        is zero before `start`; backward, x at a position needs x only after it)."""
+        b = np.zeros((self.n - start, values.shape[1]))
+        if len(positions):                       # the sums of repeated positions, in their order
+            order = np.argsort(positions, kind="stable")
+            at, first = np.unique(positions[order], return_index=True)
+            b[at - start] = np.add.reduceat(values[order], first, axis=0)
+        if start >= self.n:
+            return b
+        with _one_thread():
+            return sla.cho_solve_banded((c[:, start:], False), b, overwrite_b=True, check_finite=False)
+
     def solve(self, K: sp.csr_matrix, rhs: np.ndarray, free: np.ndarray, du_fixed: np.ndarray,
               shift: float = 0.0) -> np.ndarray:
         """du with K_ff du_f = rhs_f - K_fc du_fixed_c and du_c = du_fixed_c on the constrained dofs
@@ -203,6 +224,18 @@ class Factor:
     def solve(self, rhs: np.ndarray, du_fixed: np.ndarray | None = None) -> np.ndarray:
         """x with K_ff x_f = rhs_f - K_fc du_fixed_c, x_c = du_fixed_c (0 if None); rhs [n] or [n, m]."""
         return self._owner.band_solve(self._c, _constrained_rhs(self._K, self.free, rhs, du_fixed))
+
+    def solve_at(self, rows: np.ndarray, values: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+        """x = K_ff^-1 b at `dofs` only, [len(dofs), m], for the right-hand side b with the rows
+        `values` [len(rows), m] at the distinct dofs `rows` and zero elsewhere (constrained rows
+        dropped; a constrained dof's x is 0): the sweeps run from the first band position that
+        `rows` and `dofs` reach (`BandedCholesky.tail_solve`). A few contact rows at the band's
+        end (the cup's rim) cost a fraction of a whole solve, and nothing of size n is formed."""
+        o = self._owner
+        values = np.where(self.free[rows][:, None], values, 0.0)
+        pos, at = o.position[rows], o.position[dofs]
+        start = int(min(pos.min(initial=o.n), at.min(initial=o.n)))
+        return o.tail_solve(self._c, pos, values, start)[at - start]
 
     def freeing(self, dofs: np.ndarray) -> "BorderedFactor":
         """The factor of the free block with the constrained `dofs` freed as well (e.g. contact

@@ -167,6 +167,24 @@ class RankOneFactor:
         scale = self._c * (self._gf @ x) / self._den
         return x - np.multiply.outer(self._y, scale)
 
+    @property
+    def solved_g(self) -> np.ndarray:
+        """(K_s + c g g^T)_ff^-1 g_f = y / (1 + c g_f.y), y = (K_s)_ff^-1 g_f, without a solve."""
+        return self._y / self._den
+
+    def solve_at(self, rows: np.ndarray, values: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+        """`fem.linsolve.Factor.solve_at` (x at `dofs` for a right-hand side on `rows`) where the
+        base factor has it, else from its whole solve: the term's weight g_f.x is y.b_f."""
+        at = getattr(self._base, "solve_at", None)
+        if at is not None:
+            x = at(rows, values, dofs)
+        else:
+            b = np.zeros((len(self._y), values.shape[1]))
+            b[rows] = values
+            x = self._base.solve(b)[dofs]
+        scale = self._c * (self._y[rows] @ values) / self._den
+        return x - np.multiply.outer(self._y[dofs], scale)
+
     def freeing(self, dofs: np.ndarray) -> "RankOneFactor":
         """As `fem.linsolve.Factor.freeing`, with the rank-one term on the larger block."""
         return _definite(RankOneFactor(self._base.freeing(dofs), self._c, self._g))
