@@ -40,9 +40,9 @@ the leak), its CPU time per part as above plus
 
 and the calls of each, the inclusive CPU time of the route's phases (pressing and sealing, the
 largest holdable force's pull at fixed N, the branch at F1; the rest is the leak along it and the
-states the route adds), the largest pull's Newton iterations per load step, and the CPU time per solver factorization (each Newton iteration factors
-once; a shifted retry or a freed contact node adds one) against one factorization of the last
-tangent the route factored.
+states the route adds), the largest pull's Newton iterations per load step, and the CPU time
+per solver factorization (each Newton iteration factors once; a shifted retry or a freed contact
+node adds one) against one factorization of the last tangent the route factored.
 With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
 --repeat runs, CPU time of the child and wall time), whose excess over the in-process curve is
 start-up (imports), the mesh and the output files.

@@ -55,7 +55,8 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
 
 
 class _OffGrid(Exception):
-    """Stops a scout whose path left the grid of single steps (a cut-back, the floor's last step) or slipped."""
+    """Stops a scout whose path left the grid of single steps (a cut-back, the floor's last
+    step) or slipped."""
 
 
 class _Pull:
@@ -77,7 +78,8 @@ class _Pull:
 
     def plate(self, t0: float):
         """The plate's prescribed displacement at t0 + t."""
-        return lambda t: (self.dofs, np.concatenate([self.zeros, np.full(self.top.size, -(self.u0 - t0 - t))]))
+        z = lambda t: np.full(self.top.size, -(self.u0 - t0 - t))           # noqa: E731
+        return lambda t: (self.dofs, np.concatenate([self.zeros, z(t)]))
 
     def pull_N(self, step) -> float:
         return float(np.sum(step.r_int[2 * self.top + 1]))
@@ -103,8 +105,8 @@ class _Pull:
             seen.append((step.t, F1, step))
             if best > 0 and len(since_slip) > 1 and F1 < (1.0 - drop) * max(since_slip):
                 raise _Past
-        options = self.options if stride == 1 else \
-            replace(self.options, initial_step=stride * self.options.max_step, max_step=stride * self.options.max_step)
+        size = stride * self.options.max_step
+        options = self.options if stride == 1 else replace(self.options, initial_step=size, max_step=size)
         stopped = None
         try:
             follow_gas_path(self.mech, self.plate(0.0), self.span, plane=self.cup.cup.plane,
