@@ -40,9 +40,9 @@ the leak), its CPU time per part as above plus
 
 and the calls of each, the inclusive CPU time of the route's phases (pressing and sealing, the
 largest holdable force's pull at fixed N, the branch at F1; the rest is the leak along it and the
-states the route adds), and the CPU time per solver factorization (each Newton iteration factors
-once; a shifted retry or a freed contact node adds one) against one factorization of the last
-tangent the route factored.
+states the route adds), the largest pull's Newton iterations per load step, and the CPU time
+per solver factorization (each Newton iteration factors once; a shifted retry or a freed contact
+node adds one) against one factorization of the last tangent the route factored.
 With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
 --repeat runs, CPU time of the child and wall time), whose excess over the in-process curve is
 start-up (imports), the mesh and the output files.
@@ -162,6 +162,25 @@ def _phase(name: str, fn):
     return timed
 
 
+PULL_STEPS: list[list[int]] = []
+
+
+def _counted_steps(follow):
+    """follow (`fem.gas_pull`'s path follower), the Newton iterations of each of its load steps
+    appended to PULL_STEPS, one list per path."""
+    @functools.wraps(follow)
+    def counted(*args, on_step, **kwargs):
+        its = []
+        PULL_STEPS.append(its)
+
+        def step(s):
+            if s.t > 0:
+                its.append(s.iterations)
+            on_step(s)
+        return follow(*args, on_step=step, **kwargs)
+    return counted
+
+
 def _instrument_route() -> None:
     """Time the fem route's phases (module docstring), once."""
     import fem.gas_branch
@@ -170,6 +189,7 @@ def _instrument_route() -> None:
 
     route.FemRoute.seal = _phase("press + seal", route.FemRoute.seal)
     fem.gas_pull.largest_pull_checked = _phase("largest pull", fem.gas_pull.largest_pull_checked)
+    fem.gas_pull.follow_gas_path = _counted_steps(fem.gas_pull.follow_gas_path)
     fem.gas_branch.equilibrium_branch = _phase("branch", fem.gas_branch.equilibrium_branch)
 
 
@@ -221,6 +241,7 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     law_args = ["--contact", law[0]] + (["--friction", law[1]] if len(law) > 1 else [])
     CLOCK.reset()
     PHASES.clear()
+    PULL_STEPS.clear()
     t = time.process_time()
     with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()) as err:
         code = cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level]
@@ -236,7 +257,7 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     return {"level": level, "force": force_N, "contact": contact, "cpu": cpu, "lifetime": row[1],
             "reason": row[2],
             "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own,
-            "phases": dict(PHASES)}
+            "phases": dict(PHASES), "pull_steps": [list(p) for p in PULL_STEPS]}
 
 
 def report_route(r: dict) -> None:
@@ -246,6 +267,9 @@ def report_route(r: dict) -> None:
     phases = r["phases"]
     rest = total - sum(phases.values())
     print("  phases: " + ", ".join(f"{k} {v:.2f} s" for k, v in phases.items()) + f", rest {rest:.2f} s")
+    pull = r["pull_steps"]
+    print(f"  largest pull: {sum(map(len, pull))} load steps, {sum(map(sum, pull))} Newton iterations; per step "
+          f"(a path per group): " + " | ".join(" ".join(map(str, p)) for p in pull))
     per = total / r["calls"]["factor"]
     print(f"  per solver factorization (~ per Newton iteration) {1e3 * per:.2f} ms; one factorization of the "
           f"last tangent {1e3 * r['own_factor']:.2f} ms: a Newton iteration costs {per / r['own_factor']:.1f} of them")

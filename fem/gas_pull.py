@@ -14,6 +14,7 @@ counterpart is `fem.water_branch.largest_pull`.
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -41,46 +42,134 @@ def largest_pull(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> float
 
 def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) -> tuple[float, str | None]:
     """`largest_pull` and, where the solver stopped or the plate reached its floor while the pull
-    was still rising (the maximum not reached: a lower bound only), why; else None."""
-    mech = GasMechanics(cup.cup.mech, cup.cavity, TrappedGas(sealed.N, cup.T_K, cup.p_a_Pa))
-    top = cup.cup.top
-    dofs, zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
-    u0, span = sealed.u_m, sealed.u_m - plate_floor_m(cup)
-    plate = lambda t: (dofs, np.concatenate([zeros, np.full(top.size, -(u0 - t))]))  # noqa: E731
-    seen: list[tuple[float, float]] = [(u0, sealed.F1_N)]
+    was still rising (the maximum not reached: a lower bound only), why; else None.
+    A law without a history (frictionless: the state at a plate position does not depend on the
+    steps that led there) is scouted with double steps and the single steps filled in around the
+    maximum only (`_Pull.scouted`); a pull the scout finds irregular is followed in single steps."""
+    pull = _Pull(cup, sealed, drop)
+    if cup.cup.plane.law.conservative:
+        found = pull.scouted()
+        if found is not None:
+            return found
+    return pull.largest(*pull.follow(1))
 
-    since_slip = [sealed.F1_N]                   # the pulls since the last slip
 
-    def on_step(step) -> None:
-        F1 = float(np.sum(step.r_int[2 * top + 1]))
-        best = max(since_slip)
-        if best > 0 and seen[-1][1] - F1 > drop * best:        # fell by more than drop in one step: a slip
-            since_slip[:] = [F1]
-        else:
-            since_slip.append(F1)
-        seen.append((u0 - step.t, F1))
-        if best > 0 and len(since_slip) > 1 and F1 < (1.0 - drop) * max(since_slip):
-            raise _Past
-    # the solver's steps are fractions of the whole range: scaled to give the same steps in u
-    # whatever the floor's depth, those of 1 % of the way from the sealed plate to -h1
-    o, f = cup.options, (u0 + cup.h1_m) / span
-    options = replace(o, initial_step=f * o.initial_step, max_step=f * min(o.max_step, 0.01),
-                      min_step=f * o.min_step, jump_min_step=f * o.jump_min_step)
-    stopped = None
-    try:
-        follow_gas_path(mech, plate, span, plane=cup.cup.plane, start=sealed.state, options=options,
-                        on_step=on_step)
-    except _Past:
-        pass
-    except ConvergenceError as err:
-        stopped = str(err)
-    u, F = np.array(seen).T
-    k = int(np.argmax(F))
-    partial = stopped if stopped is not None and k == F.size - 1 else None
-    if stopped is None and k == F.size - 1 > 0:            # still rising at the plate's floor
-        partial = f"the pull still rising at the plate's floor u = {1e3 * u[-1]:.4g} mm"
-    if 0 < k < F.size - 1:
-        a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
-        if a < 0:
-            return float(max(F[k], c - b * b / (4 * a))), partial
-    return float(F[k]), partial
+class _OffGrid(Exception):
+    """Stops a scout whose path left the grid of single steps (a cut-back, the floor's last
+    step) or slipped."""
+
+
+class _Pull:
+    """The plate raised at the sealed N on the grid of single steps t_i = i dt [m]."""
+
+    def __init__(self, cup: CupWithGas, sealed: GasState, drop: float):
+        self.cup, self.sealed, self.drop = cup, sealed, drop
+        self.mech = GasMechanics(cup.cup.mech, cup.cavity, TrappedGas(sealed.N, cup.T_K, cup.p_a_Pa))
+        top = self.top = cup.cup.top
+        self.dofs, self.zeros = np.concatenate([2 * top, 2 * top + 1]), np.zeros(top.size)
+        self.u0, self.span = sealed.u_m, sealed.u_m - plate_floor_m(cup)
+        # the solver's steps are fractions of the whole range: scaled to give the same steps in u
+        # whatever the floor's depth, those of 1 % of the way from the sealed plate to -h1
+        o, f = cup.options, (self.u0 + cup.h1_m) / self.span
+        self.options = replace(o, initial_step=f * o.initial_step, max_step=f * min(o.max_step, 0.01),
+                               min_step=f * o.min_step, jump_min_step=f * o.jump_min_step)
+        self.uniform = self.options.initial_step >= self.options.max_step
+        self.dt = self.options.max_step * self.span
+
+    def plate(self, t0: float):
+        """The plate's prescribed displacement at t0 + t."""
+        z = lambda t: np.full(self.top.size, -(self.u0 - t0 - t))           # noqa: E731
+        return lambda t: (self.dofs, np.concatenate([self.zeros, z(t)]))
+
+    def pull_N(self, step) -> float:
+        return float(np.sum(step.r_int[2 * self.top + 1]))
+
+    def follow(self, stride: int) -> tuple[list[tuple[float, float, Any]], str | None]:
+        """The states (t, F1, state) along the path in steps of `stride` dt up to the stop
+        (`largest_pull`), and the solver's message where it stopped; stride > 1 raises `_OffGrid`
+        at a step off the grid or a slip."""
+        drop, seen = self.drop, [(0.0, self.sealed.F1_N, self.sealed.state)]
+        since_slip = [self.sealed.F1_N]              # the pulls since the last slip
+
+        def on_step(step) -> None:
+            F1 = self.pull_N(step)
+            if stride > 1 and step.t > 0 and abs(step.t - seen[-1][0] - stride * self.dt) > 1e-9 * self.dt:
+                raise _OffGrid
+            best = max(since_slip)
+            if best > 0 and seen[-1][1] - F1 > drop * best:    # fell by more than drop in one step: a slip
+                if stride > 1:
+                    raise _OffGrid
+                since_slip[:] = [F1]
+            else:
+                since_slip.append(F1)
+            seen.append((step.t, F1, step))
+            if best > 0 and len(since_slip) > 1 and F1 < (1.0 - drop) * max(since_slip):
+                raise _Past
+        size = stride * self.options.max_step
+        options = self.options if stride == 1 else replace(self.options, initial_step=size, max_step=size)
+        stopped = None
+        try:
+            follow_gas_path(self.mech, self.plate(0.0), self.span, plane=self.cup.cup.plane,
+                            start=self.sealed.state, options=options, on_step=on_step)
+        except _Past:
+            pass
+        except ConvergenceError as err:
+            stopped = str(err)
+        return seen, stopped
+
+    def largest(self, seen, stopped: str | None) -> tuple[float, str | None]:
+        """The largest pull over `seen` refined by the parabola through the three states around
+        it, and why it is a lower bound (`largest_pull_checked`)."""
+        u, F = self.u0 - np.array([s[0] for s in seen]), np.array([s[1] for s in seen])
+        k = int(np.argmax(F))
+        partial = stopped if stopped is not None and k == F.size - 1 else None
+        if stopped is None and k == F.size - 1 > 0:            # still rising at the plate's floor
+            partial = f"the pull still rising at the plate's floor u = {1e3 * u[-1]:.4g} mm"
+        if 0 < k < F.size - 1:
+            a, b, c = np.polyfit(u[k - 1:k + 2], F[k - 1:k + 2], 2)
+            if a < 0:
+                return float(max(F[k], c - b * b / (4 * a))), partial
+        return float(F[k]), partial
+
+    def scouted(self) -> tuple[float, str | None] | None:
+        """The largest pull from double steps, the single steps between them filled in next to
+        every double step within one double step's change of the pull from its maximum, and
+        next to the largest until its neighbours are known; None (follow single steps) where the
+        scout leaves the grid, slips, stops in the solver or ends at its largest pull."""
+        if not self.uniform:
+            return None
+        try:
+            seen, stopped = self.follow(2)
+        except _OffGrid:
+            return None
+        F = [s[1] for s in seen]
+        k = int(np.argmax(F))
+        if stopped is not None or not 0 < k < len(F) - 1:
+            return None
+        grid = {round(t / self.dt): (t, F1, step) for t, F1, step in seen}
+        last = max(grid)
+        near = max(abs(F[k] - F[k - 1]), abs(F[k + 1] - F[k]))
+        wanted = {i + j for i, (_, F1, _) in grid.items() if F1 >= F[k] - near for j in (-1, 1)}
+        while True:
+            for i in sorted(wanted - grid.keys()):
+                if not 0 < i < last:
+                    return None
+                grid[i] = self.single_step(*grid[i - 1][::2])
+                if grid[i] is None:
+                    return None
+            best = max(grid, key=lambda i: grid[i][1])
+            wanted = {best - 1, best + 1}
+            if wanted <= grid.keys():
+                break
+        return self.largest([grid[i] for i in (best - 1, best, best + 1)], None)
+
+    def single_step(self, t0: float, start) -> tuple[float, float, Any] | None:
+        """(t, F1, state) one single step on from the state `start` at t0 (None: not converged)."""
+        end: list = []
+        try:
+            follow_gas_path(self.mech, self.plate(t0), self.dt, plane=self.cup.cup.plane, start=start,
+                            options=replace(self.cup.options, initial_step=1.0, max_step=1.0),
+                            on_step=lambda step: end.append(step))
+        except ConvergenceError:
+            return None
+        return t0 + self.dt, self.pull_N(end[-1]), end[-1]
