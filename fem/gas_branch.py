@@ -102,12 +102,16 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     if not (u_min < sealed.u_m):
         raise ValueError(f"u_min_m: must be below the sealed plate position {sealed.u_m * 1e3:.4g} mm, "
                          f"got {u_min * 1e3:.4g} mm")
+    content = "N" if walk is None else "V_w"        # the gas's, or the water's volume
+
+    def where(s: _Trial, what: str = "after the state at") -> str:
+        return _where(s, sealed.N, what, content)
     walk = (walk or _Walk)(cup, float(F1_N))
     start = _Trial(sealed.u_m, sealed.N, sealed.F1_N, sealed.state)
     try:
         first = walk.pull_to_force(start, du_m, u_min)
     except RuntimeError as err:
-        return walk.result(None, f"stopped {_where(start, sealed.N, 'raising the plate at N0 from')}: {err}")
+        return walk.result(None, f"stopped {where(start, f'raising the plate at {content}0 from')}: {err}")
     if first is None:
         return walk.result(None, "not held")
     trials, slopes = [first], [walk.slope(first)]
@@ -136,7 +140,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
                 if h > 1.0 / 16.0 * (1 + 1e-9):
                     h *= 0.5
                     continue
-                return walk.result(None, f"stopped {_where(prev, sealed.N)}: {err}", trials, slopes)
+                return walk.result(None, f"stopped {where(prev)}: {err}", trials, slopes)
             if s is None:
                 return walk.result(prev if why != "u_min" else None, why, trials, slopes)
             h = min(1.0, 2.0 * h) if part == 1.0 else h * part
@@ -163,7 +167,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             except LetGo:
                 return walk.result(prev, "fold", trials, slopes)
             except RuntimeError as err:
-                return walk.result(None, f"stopped {_where(prev, sealed.N)}: {jump}; then {err}", trials,
+                return walk.result(None, f"stopped {where(prev)}: {jump}; then {err}", trials,
                                    slopes)
             if restored is None:
                 return walk.result(None, why, trials, slopes)
@@ -181,7 +185,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             try:
                 restored, why, _ = leak_to_hold(walk, prev, dN, du_m, u_min, lambda t: seal_open(cup, t))
             except RuntimeError as again:
-                return walk.result(None, f"stopped {_where(prev, sealed.N)}: {err}; then {again}", trials,
+                return walk.result(None, f"stopped {where(prev)}: {err}; then {again}", trials,
                                    slopes)
             if restored is None:
                 return walk.result(prev if why != "u_min" else None, why, trials, slopes)
@@ -205,9 +209,10 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
 
 
-def _where(s: _Trial, N0: float, what: str = "after the state at") -> str:
-    """Where a branch stopped: the last state it holds, by plate position and gas content."""
-    return f"{what} u = {s.u_m * 1e3:.4g} mm, N = {s.N / N0:.4g} N0"
+def _where(s: _Trial, N0: float, what: str = "after the state at", content: str = "N") -> str:
+    """Where a branch stopped: the last state it holds, by plate position and cavity content
+    (the gas's N, or the water's volume for `fem.water_branch`), relative to the sealed one."""
+    return f"{what} u = {s.u_m * 1e3:.4g} mm, {content} = {s.N / N0:.4g} {content}0"
 
 
 def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float,
