@@ -51,7 +51,8 @@ from validation.bridge.pipeline import surface_uc_table
 LAWS = {"frictionless": ContactLaw(), "coulomb 0.3": ContactLaw("coulomb", 0.3),
         "coulomb 0.5": ContactLaw("coulomb", 0.5),
         "coulomb 1": ContactLaw("coulomb", 1.0), "coulomb 2": ContactLaw("coulomb", 2.0),
-        "sticking": ContactLaw("sticking")}
+        "coulomb 5": ContactLaw("coulomb", 5.0), "coulomb 10": ContactLaw("coulomb", 10.0),
+        "coulomb 20": ContactLaw("coulomb", 20.0), "sticking": ContactLaw("sticking")}
 
 
 def _explain(life) -> dict:

@@ -37,7 +37,7 @@ class Branch:
     states: tuple[GasState, ...]
     dN_du: np.ndarray
     detachment: GasState | None       # the fold (largest N) or the state where the seal opened
-    reason: str                       # "fold", "seal opened", "u_min", "not held", "stopped: why"
+    reason: str                       # "fold", "seal opened", "u_min", "not held", "stopped <where>: why"
     stats: SolverStats
     snaps: int = 0                    # jumps of the pull crossed (`fem.branch_jumps`)
 

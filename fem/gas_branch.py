@@ -49,7 +49,8 @@ state, dN/du = -(dF1/du)/(dF1/dN), and the fold located by a secant on it). The 
 where the seal opens, no node of the cavity chain being on the plane any more: the detachment is
 then the last state with the seal closed, bisected to 1/64 of a step ("seal opened"). It ends
 without a detachment where the plate reaches u_min_m ("u_min"), or where no state holds F1 even
-with 1/16 of a step ("stopped: why"). Where the cup moves by the leak and the held pull, it lets go
+with 1/16 of a step ("stopped after the state at u = .. mm, N = .. N0: why", the last state the
+branch holds and the solver's cause). Where the cup moves by the leak and the held pull, it lets go
 (a "fold") where the pull is below F1 and falls as the plate rises (`fem.branch_jumps`).
 """
 
@@ -92,7 +93,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     plane); progress(k, u_m, N): called with every state k of the branch as it is found;
     walk: the walk's class for another cavity content (None: the gas's; `fem.water_branch`).
     Raises ValueError for bad input; where no state is found even with the smallest step, the
-    branch ends there with reason "stopped: <why>" and no detachment."""
+    branch ends there with reason "stopped <where>: <why>" and no detachment."""
     if not (isinstance(F1_N, (int, float)) and math.isfinite(F1_N)):
         raise ValueError(f"F1_N: must be a finite number, got {F1_N!r}")
     if not (math.isfinite(du_m) and 0.0 < du_m <= 0.1 * cup.h1_m):
@@ -101,12 +102,16 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
     if not (u_min < sealed.u_m):
         raise ValueError(f"u_min_m: must be below the sealed plate position {sealed.u_m * 1e3:.4g} mm, "
                          f"got {u_min * 1e3:.4g} mm")
+    content = "N" if walk is None else "V_w"        # the gas's, or the water's volume
+
+    def where(s: _Trial, what: str = "after the state at") -> str:
+        return _where(s, sealed.N, what, content)
     walk = (walk or _Walk)(cup, float(F1_N))
     start = _Trial(sealed.u_m, sealed.N, sealed.F1_N, sealed.state)
     try:
         first = walk.pull_to_force(start, du_m, u_min)
     except RuntimeError as err:
-        return walk.result(None, f"stopped: {err}")
+        return walk.result(None, f"stopped {where(start, f'raising the plate at {content}0 from')}: {err}")
     if first is None:
         return walk.result(None, "not held")
     trials, slopes = [first], [walk.slope(first)]
@@ -135,7 +140,7 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
                 if h > 1.0 / 16.0 * (1 + 1e-9):
                     h *= 0.5
                     continue
-                return walk.result(None, f"stopped: {err}", trials, slopes)
+                return walk.result(None, f"stopped {where(prev)}: {err}", trials, slopes)
             if s is None:
                 return walk.result(prev if why != "u_min" else None, why, trials, slopes)
             h = min(1.0, 2.0 * h) if part == 1.0 else h * part
@@ -162,7 +167,8 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             except LetGo:
                 return walk.result(prev, "fold", trials, slopes)
             except RuntimeError as err:
-                return walk.result(None, f"stopped: {jump}; then {err}", trials, slopes)
+                return walk.result(None, f"stopped {where(prev)}: {jump}; then {err}", trials,
+                                   slopes)
             if restored is None:
                 return walk.result(None, why, trials, slopes)
             if seal_open(cup, restored):
@@ -179,7 +185,8 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
             try:
                 restored, why, _ = leak_to_hold(walk, prev, dN, du_m, u_min, lambda t: seal_open(cup, t))
             except RuntimeError as again:
-                return walk.result(None, f"stopped: {err}; then {again}", trials, slopes)
+                return walk.result(None, f"stopped {where(prev)}: {err}; then {again}", trials,
+                                   slopes)
             if restored is None:
                 return walk.result(prev if why != "u_min" else None, why, trials, slopes)
             tangent, h = crossed(restored), 1.0
@@ -200,6 +207,12 @@ def equilibrium_branch(cup: CupWithGas, sealed: GasState, F1_N: float, du_m: flo
         slopes.append(walk.slope(s))
         tangent = t
     raise RuntimeError(f"F1_N = {F1_N:g} N: no detachment within {max_states} states of {du_m * 1e3:g} mm")
+
+
+def _where(s: _Trial, N0: float, what: str = "after the state at", content: str = "N") -> str:
+    """Where a branch stopped: the last state it holds, by plate position and cavity content
+    (the gas's N, or the water's volume for `fem.water_branch`), relative to the sealed one."""
+    return f"{what} u = {s.u_m * 1e3:.4g} mm, {content} = {s.N / N0:.4g} {content}0"
 
 
 def state_between(cup: CupWithGas, a: GasState, b: GasState, F1_N: float,

@@ -118,3 +118,23 @@ def test_tangent_rows_carry_the_gas_rank_one_term():
     assert np.allclose(tangent_rows(K, dofs).toarray(), whole[dofs], rtol=0, atol=1e-12)
     assert np.allclose(K.rows(dofs).toarray(), whole[dofs], rtol=0, atol=1e-12)
     assert np.array_equal(tangent_rows(Ks, dofs).toarray(), Ks[dofs].toarray())
+
+
+def test_a_branch_that_stops_says_where_and_why(model):
+    """A branch whose solver cannot go on ends with reason "stopped ...", never a number: the
+    reason names the last state it holds (plate position, N / N0) and the solver's cause. Here
+    with two Newton iterations allowed per load step (frictionless, 10 N: a few states, then a
+    move that does not converge)."""
+    from dataclasses import replace
+
+    route = register()
+    sealed = route.seal(model, {**route.options, "cup": FemCup("A", "coarse", contact=ContactLaw())})
+    cup = replace(sealed.cup, options=replace(sealed.cup.options, max_iterations=2))
+    b = equilibrium_branch(cup, sealed.state, F1, du_m=DEFAULT_DU_M)
+    print(b.reason)
+    assert b.detachment is None
+    last = b.states[-1] if b.states else sealed.state
+    where = "stopped after the state at" if b.states else "stopped raising the plate at N0 from"
+    where += f" u = {last.u_m * 1e3:.4g} mm, N = {last.N / sealed.state.N:.4g} N0: "
+    assert b.reason.startswith(where), b.reason
+    assert "Newton" in b.reason
