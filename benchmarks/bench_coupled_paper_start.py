@@ -31,6 +31,7 @@ build = time.process_time() - t
 print(f"build: {table.provenance.get('states_solved')} states solved, {build:.1f} s CPU", flush=True)
 if counted is not None:
     print(counted.report(), flush=True)
+    print("rounds (states built, missing):", table.provenance.get("rounds"), flush=True)
     if args.asked:
         import json
         with open(args.asked, "w") as f:
