@@ -3,7 +3,7 @@ from the fem route's sealed content, the table route on the default grid's table
 paths (raised rows evenly down to the plate's floor h1 - 2 L, `DEFAULT_GRID`), beside the fem
 route, and the same with the raised rows' spacing halved (the grid's interpolation error).
 
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled_raised.py [--half] [--cup B] [--forces 10 20 40]
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_coupled_raised.py [--half] [--cup B] [--forces 10 20 40] [--counters]
 
 Prints the fem route's lifetimes, the table's build (states solved, CPU seconds) and per force
 the table route's lifetime, how it ended, its last u, and its difference from the fem route's.
@@ -12,6 +12,7 @@ the table route's lifetime, how it ended, its last u, and its difference from th
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import time
 
@@ -31,6 +32,7 @@ def main() -> None:
     parser.add_argument("--cup", choices=("A", "B"), default="A")
     parser.add_argument("--forces", type=float, nargs="+", default=[5.0, 10.0, 20.0])
     parser.add_argument("--out", default=None, help="also write the table (JSON) here")
+    parser.add_argument("--counters", action="store_true", help="the build's paths by kind (bench_coupled_counters.py)")
     args = parser.parse_args()
     model = reduced.reference_model(reduced.CUP_A if args.cup == "A" else reduced.CUP_B, surface_uc_table())
     route, cup = register(), FemCup(args.cup, "coarse")
@@ -48,9 +50,14 @@ def main() -> None:
     goal = SuctionGoal(dataclasses.replace(model, suction=None, stiffness=None), tuple(args.forces),
                        u_start_m=u_start, hint=tuple(hint), largest=False)
     t = time.process_time()
-    table = suction_table_for(args.cup, fidelity="coarse", goal=goal, grid=grid)
+    if args.counters:
+        from bench_coupled_counters import counting
+    with counting(grid.raised_rows) if args.counters else contextlib.nullcontext() as counted:
+        table = suction_table_for(args.cup, fidelity="coarse", goal=goal, grid=grid)
     print(f"table {table.provenance['grid']}: {table.provenance['states_solved']} states solved, "
           f"{int((~table.sealed).sum())} without a seal, {time.process_time() - t:.1f} s CPU", flush=True)
+    if counted is not None:
+        print(counted.report(), flush=True)
     if args.out:
         table.to_json(args.out)
     for F in args.forces:

@@ -40,7 +40,7 @@ from .branch_end import plate_floor_m
 from .cavity import CavitySurface, PressurizedMechanics
 from .contact import PressureProfile
 from .cup import CupSetup, _joined, _measure, cup_height
-from .integrity import check_state
+from .integrity import StateRejected, check_state
 from .interface import ContactLaw
 from .material import NeoHookean
 from .solver import ConvergenceError, SolverOptions, SolverStats, StepResult, follow_path
@@ -266,10 +266,15 @@ class SuctionStates:
         """`_segment` with Newton started on `predict`'s guess (None: on the start), and where that
         fails, without it: the guess only saves iterations, the state is the one the path reaches
         (for frictionless contact only, whose states do not depend on the path; with friction the
-        guess is not used)."""
+        guess is not used). Where the path converged but its state is rejected (the wall folds onto
+        itself, `fem.integrity.StateRejected`) it is not repeated: that is the state the path
+        reaches (cup A and B's builds: every such path repeated without the guess was rejected
+        again, at 2-5 s each)."""
         if predict is not None and self._cup.plane.law.name == "frictionless":
             try:
                 return self._segment(mech, dirichlet, t_max, start, u_plate, where, options, predict)
+            except StateRejected:
+                raise
             except ConvergenceError:
                 pass
         return self._segment(mech, dirichlet, t_max, start, u_plate, where, options)

@@ -351,3 +351,27 @@ def test_a_raised_state_far_below_its_column_is_ramped_in_its_row(coarse_cup):
     assert abs(r[0] - c[0]) <= 10 * tol * abs(c[0]) and abs(r[2] - c[2]) <= 10 * tol * c[2]
     assert r[3] == pytest.approx(c[3], rel=10 * tol)
     assert iterations[0] < iterations[1]
+
+
+def test_a_guessed_raise_whose_state_folds_is_not_repeated(coarse_cup, monkeypatch):
+    """A raise started on the secant that converges to a rejected state (the wall folds onto
+    itself) is that raise's state: it is not solved again without the guess, and the state holds
+    no seal, with the cause kept in `unreached`."""
+    from fem.integrity import StateRejected
+
+    mesh, h1 = coarse_cup
+    du, dp = 0.005 * h1, 6e4
+    states = SuctionStates(mesh, NeoHookean())
+    for u in (-du, -2 * du):
+        assert states.state(u, dp)[8]
+    real, guessed = states._segment, []
+
+    def segment(mech, dirichlet, t_max, start, u_plate, where, options=None, predict=None):
+        guessed.append(predict is not None)
+        if u_plate < -2.5 * du:
+            raise StateRejected(f"{where}: the wall folds onto itself", step=0, t_from=0.0, t_to=1.0, cause="folds")
+        return real(mech, dirichlet, t_max, start, u_plate, where, options, predict)
+    monkeypatch.setattr(states, "_segment", segment)
+    assert not states.state(-3 * du, dp)[8]
+    assert guessed == [True]                                   # started on the secant, once
+    assert "folds" in states.unreached[(-3 * du, dp)]

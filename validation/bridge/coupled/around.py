@@ -18,7 +18,7 @@ a state reached by another dp ramp is the same state for frictionless contact). 
    missing states (widened by `margin`) are added and they are computed again, until they run
    through. A walk names the states next to its last point first (`reduced.coupled_holes`:
    `Holes.near_missing`), not the whole line or gap it would otherwise have to search. A missing
-   state brings with it the `reach` rows below it, in its column and two more either side: the
+   state brings with it the `reach` rows below it, in its column and the next either side: the
    paths run down in u (the plate rising as the gas leaks in; at nearly constant dp in the raised
    rows, climbing in dp through cup B's pressed rows), and a round that adds one row at a time
    would need one round per row. What they read then is built, and nothing else is asked of the
@@ -148,9 +148,9 @@ class _Reads:
 
 def _reach_down(built: np.ndarray, nodes, reach: int) -> None:
     """Mark the `reach` rows below each missing node (the paths run down in u as the gas leaks in)
-    in its column and two more either side."""
+    in its column and the next either side."""
     for i, j in nodes:
-        built[max(i - reach, 0):i + 1, max(j - 2, 0):min(j + 3, built.shape[1])] = True
+        built[max(i - reach, 0):i + 1, max(j - 1, 0):min(j + 2, built.shape[1])] = True
 
 
 def _widen(built: np.ndarray, nodes, margin: int, cols: int | None = None) -> None:
