@@ -132,19 +132,48 @@ def test_parts_filled_by_two_workers_are_what_one_process_computes(tmp_path):
 
 
 def test_a_life_over_its_cpu_limit_is_an_unfinished_cell_and_the_timer_is_restored():
-    """A real life (cup A coarse, 10 N: ~3 s of CPU) given 0.5 s of CPU stops there and says so;
+    """A real life (cup A medium, 10 N: ~7 s of CPU) given 1 s of CPU stops there and says so;
     afterwards the profiling signal is the process's own again and no timer is left running."""
     import signal
     import time
 
     before = signal.getsignal(signal.SIGPROF)
     t0 = time.process_time()
-    out = live(LifeRun("A", "frictionless", None, 10.0, cpu_limit_s=0.5))
+    out = live(LifeRun("A", "frictionless", None, 10.0, "medium", cpu_limit_s=1.0))
     spent = time.process_time() - t0
     assert out.reason == "unfinished" and out.failed and math.isnan(out.lifetime_s)
-    assert out.cell().startswith("unfinished: not finished within")
-    assert 0.5 <= spent < 1.5
+    assert out.cell() == "unfinished: not finished within 1 s of CPU"
+    assert 1.0 <= spent < 3.0
     assert signal.getsignal(signal.SIGPROF) is before and signal.getitimer(signal.ITIMER_PROF) == (0.0, 0.0)
+
+
+def test_cpu_limits_nest_the_sooner_one_fires_and_the_outer_one_is_re_armed():
+    """An inner limit leaves the outer one running (less the CPU spent inside); an inner limit
+    longer than what is left of the outer one does not push the outer deadline back."""
+    import signal
+    import time
+
+    from validation.crosscheck.fem_life import CpuLimitReached, cpu_limit
+
+    def spin(seconds):
+        t = time.process_time()
+        while time.process_time() - t < seconds:
+            sum(range(1000))
+
+    t0 = time.process_time()
+    with pytest.raises(CpuLimitReached):
+        with cpu_limit(0.6):
+            with cpu_limit(0.2):
+                spin(0.05)                       # the inner block ends well inside both limits
+            spin(5.0)                            # the outer limit still fires
+    assert 0.5 <= time.process_time() - t0 < 1.2
+    t0 = time.process_time()
+    with pytest.raises(CpuLimitReached):
+        with cpu_limit(0.3):
+            with cpu_limit(100.0):               # longer than the outer: the outer's deadline holds
+                spin(5.0)
+    assert 0.25 <= time.process_time() - t0 < 0.9
+    assert signal.getitimer(signal.ITIMER_PROF) == (0.0, 0.0)
 
 
 def test_one_section_rerun_into_a_report_keeps_the_others(tmp_path, capsys):
@@ -166,3 +195,21 @@ def test_one_section_rerun_into_a_report_keeps_the_others(tmp_path, capsys):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["keep"] == 1 and len(summary) > 1
     assert (tmp_path / "pareto.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("module", ["rerun", "fem_life_rerun"])
+def test_a_quick_rerun_into_a_full_report_is_refused(tmp_path, capsys, module):
+    """A --quick section would put the CI subset's numbers into a full report: one line naming
+    --into, exit 2, nothing written (and a full section into a quick report likewise)."""
+    import importlib
+
+    main = importlib.import_module(f"validation.crosscheck.{module}").main
+    args = ["speed"] if module == "rerun" else []
+    for kind, flag in (("false", ["--quick"]), ("true", [])):
+        (tmp_path / "README.md").write_text(README)
+        (tmp_path / "summary.json").write_text(f'{{"quick": {kind}}}\n')
+        before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+        assert main([*args, "--into", str(tmp_path), "--cache-dir", str(tmp_path / "c"), *flag]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"--into {tmp_path}" in err[0] and "report" in err[0]
+        assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before

@@ -45,6 +45,23 @@ def ships_the_kernel() -> bool:
 
 
 def test_the_compiled_kernel_is_scipys_own_and_bad_input_is_refused():
-    assert (fem_nnls._compiled() is not None) == ships_the_kernel()   # shipped: the fast path is taken
+    import sys
+
+    import scipy.optimize  # noqa: F401  (imported after fem.nnls may have loaded its module)
+
+    kernel = fem_nnls._compiled()
+    assert (kernel is not None) == ships_the_kernel()                 # shipped: the fast path is taken
+    if kernel is not None:                                            # one module, not a second copy
+        assert kernel is sys.modules["scipy.optimize._slsqplib"].nnls
     with pytest.raises(ValueError):
         fem_nnls.nnls(np.array([[1.0, np.nan]]), np.array([1.0]))
+
+
+def test_without_the_compiled_kernel_it_is_scipy_optimize_nnls(monkeypatch):
+    from scipy.optimize import nnls
+
+    monkeypatch.setattr(fem_nnls, "_compiled", lambda: None)
+    rng = np.random.default_rng(3)
+    A, b = rng.standard_normal((7, 5)), rng.standard_normal(7)
+    assert np.array_equal(fem_nnls.nnls(A, b), nnls(A, b)[0])
+    assert not fem_nnls._answers(lambda A, b, maxiter: (np.zeros(2), 0.0, 0))   # a kernel that answers wrongly

@@ -4,8 +4,9 @@ machinery, no plotting, no dask, no pyvista, no scipy.signal; the paper route's 
 surface imports no scipy at all (its u_c table is stored, its interpolants and roots are the
 project's own: scipy.interpolate and scipy.optimize cost ~0.5 s to import, more than the command);
 the profile route's lifetime on an FEM curve's CSV imports no scipy either (its flow tables' spline
-is the project's own); a stiffness curve without a mesh file imports no meshio, nor scipy.optimize. Each case is a fresh process (the modules
-a test session has already loaded say nothing), its `sys.modules` read after the command ran.
+is the project's own); a stiffness curve without a mesh file imports no meshio, nor scipy.optimize.
+Each case is a fresh process (the modules a test session has already loaded say nothing), its
+`sys.modules` read after the command ran.
 """
 
 from __future__ import annotations

@@ -35,7 +35,7 @@ import re
 import signal
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -90,9 +90,9 @@ class LifeRun:
 @dataclass(frozen=True, eq=False)
 class LifeOutcome:
     """What the section keeps of one `LifeRun` (plain data, cached on disk): the lifetime [s] (nan
-    when the run failed), its reason ("failed" or "no branch" when there is no lifetime), the
-    route's message, the largest holdable force [N] (nan if unknown), the seal radii [mm] of the
-    sealed state, the branch's trajectory columns and the wall time [s]."""
+    when the run failed), its reason ("failed", "no branch" or "unfinished" when there is no
+    lifetime), the route's message, the largest holdable force [N] (nan if unknown), the seal radii
+    [mm] of the sealed state, the branch's trajectory columns and the wall time [s]."""
 
     run: LifeRun
     lifetime_s: float
@@ -142,12 +142,18 @@ class CpuLimitReached(BaseException):
 
 
 @contextmanager
-def cpu_limit(seconds: float):
+def cpu_limit(seconds: float) -> Iterator[None]:
     """Raise `CpuLimitReached` in the enclosed block once the process has spent `seconds` of CPU
-    (user + system) in it: the profiling timer's SIGPROF. Signal handlers belong to the main thread;
-    elsewhere the block runs without a limit. (A library timeout such as func_timeout or
+    (user + system, all its threads) in it: the profiling timer's SIGPROF. An enclosing limit that
+    ends sooner keeps its own deadline, and a later one is re-armed with what is left of it.
+    Signal handlers belong to the main thread: elsewhere, and where the platform has no profiling
+    timer, the block runs without a limit. (A library timeout such as func_timeout or
     timeout-decorator measures wall time, which a shared machine stretches.)"""
-    if threading.current_thread() is not threading.main_thread():
+    if not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    outer, _ = signal.getitimer(signal.ITIMER_PROF)
+    if 0.0 < outer <= seconds:                   # the enclosing limit comes first: it is the one
         yield
         return
     armed = [True]
@@ -158,13 +164,16 @@ def cpu_limit(seconds: float):
             raise CpuLimitReached(seconds)
 
     previous = signal.signal(signal.SIGPROF, reached)
+    start = time.process_time()
     signal.setitimer(signal.ITIMER_PROF, seconds)
     try:
         yield
     finally:
         armed[0] = False
         signal.setitimer(signal.ITIMER_PROF, 0.0)
-        signal.signal(signal.SIGPROF, previous)
+        signal.signal(signal.SIGPROF, signal.SIG_DFL if previous is None else previous)
+        if outer > 0.0:                          # the enclosing limit, less the CPU spent here
+            signal.setitimer(signal.ITIMER_PROF, max(outer - (time.process_time() - start), 1e-6))
 
 
 def live(run: LifeRun, code: str = "", progress: Callable[[float, str], None] | None = None) -> LifeOutcome:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from validation.crosscheck.rerun import replace_section
+from validation.crosscheck.rerun import replace_section, report_problem
 
 __all__ = ["merge_into", "replace_section", "parse_law"]
 
@@ -69,8 +69,9 @@ def main(argv=None) -> int:
         laws = None if a.law is None else {parse_law(t) for t in a.law}
         if a.jobs < 1:
             raise ValueError(f"--jobs {a.jobs}: must be at least 1")
-        if not (into / "README.md").is_file() or not (into / "summary.json").is_file():
-            raise ValueError(f"--into {a.into}: not a report directory (README.md and summary.json)")
+        problem = report_problem(into, a.into, a.quick)
+        if problem:
+            raise ValueError(problem)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

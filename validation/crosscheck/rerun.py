@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["merge_into", "replace_section"]
+__all__ = ["merge_into", "replace_section", "report_problem"]
 
 
 def merge_into(report_dir, section: str, quick: bool = False, cache_dir=None,
@@ -65,6 +65,23 @@ def replace_section(text: str, header: str, body: str) -> str:
     return "".join(lines[:j] + new + lines[j:])
 
 
+def report_problem(into: Path, written: str, quick: bool) -> str | None:
+    """Why `into` cannot take a rerun section (None if it can): not a report directory, or a report
+    of the other kind (a --quick section into a full report, or a full one into a quick report)."""
+    import json
+
+    if not (into / "README.md").is_file() or not (into / "summary.json").is_file():
+        return f"--into {written}: not a report directory (README.md and summary.json)"
+    try:
+        kind = json.loads((into / "summary.json").read_text()).get("quick")
+    except (ValueError, AttributeError):
+        return f"--into {written}: its summary.json is not a report's summary"
+    if kind is not None and bool(kind) != quick:
+        return (f"--into {written}: a {'quick' if kind else 'full'} report; rerun its sections "
+                + ("with" if kind else "without") + " --quick")
+    return None
+
+
 def main(argv=None) -> int:
     import argparse
     import sys
@@ -82,8 +99,9 @@ def main(argv=None) -> int:
     if a.section not in section_names():
         print(f"error: section {a.section!r}: not one of {', '.join(section_names())}", file=sys.stderr)
         return 2
-    if not (into / "README.md").is_file() or not (into / "summary.json").is_file():
-        print(f"error: --into {a.into}: not a report directory (README.md and summary.json)", file=sys.stderr)
+    problem = report_problem(into, a.into, a.quick)
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
         return 2
     print("wrote " + ", ".join(merge_into(into, a.section, a.quick, a.cache_dir)))
     return 0
