@@ -58,3 +58,23 @@ def test_sticking_law_is_mu_infinity_and_friction_only_with_coulomb():
         FemRun(contact="frictionless", friction=0.3)
     with pytest.raises(ValueError, match="friction"):
         FemRun(contact="coulomb")
+
+
+def test_the_reasons_named_under_the_lifetimes_table():
+    """A curve whose F0 falls by more than half in one step folds with the cone laws (said, with
+    where), a fold without such a drop is not explained by it, and a 'sealed' own-geometry cell
+    under a sub-element strip says the width is the mesh's."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from validation.crosscheck.friction import _why_not_reached
+
+    r = SimpleNamespace(u_m=np.array([0.0, 1.0, 2.0, 3.0]) * 1e-3, F0_N=np.array([0.0, 5.0, 1.3, 4.0]),
+                        l_m=np.array([0.0, 0.01, 0.5, 1.0]) * 1e-3)
+    notes = _why_not_reached("mu 1.2", r, {"mu_1.2_cone": {"fold"}, "mu_1.2_own": {"sealed"}})
+    assert len(notes) == 2
+    assert "from 5 to 1.3 N at u = 2 mm" in notes[0] and "0.01-0.01 mm wide at u = 1-1 mm" in notes[1]
+    assert _why_not_reached("mu 1.2", r, {"mu_1.2_cone": {"reached_r1"}, "mu_1.2_own": {"reached_r1"}}) == []
+    smooth = SimpleNamespace(u_m=r.u_m, F0_N=np.array([0.0, 1.0, 2.0, 3.0]), l_m=r.l_m)
+    assert _why_not_reached("mu 1.2", smooth, {"mu_1.2_cone": {"fold"}}) == []
