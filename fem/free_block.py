@@ -25,7 +25,7 @@ import scipy.sparse.linalg as spla
 
 from .condensation import make_solver
 from .kinematics import Kinematics
-from .linsolve import NotPositiveDefinite
+from .linsolve import NotPositiveDefinite, solve_at
 
 __all__ = ["solve_free_block"]
 
@@ -54,13 +54,7 @@ def solve_free_block(K: sp.csr_matrix, rows: sp.csr_matrix, free: np.ndarray, rh
     WK = (W[S] @ K).toarray()
     WK[:, ~free] = 0.0                               # V = (W K)_Sf
     reach = np.flatnonzero(WK.any(axis=0))          # V's columns: Z is read there only
-    at = getattr(factor, "solve_at", None)
-    if at is not None:
-        Z = at(S, np.eye(S.size), reach)
-    else:
-        E = np.zeros((n, S.size))
-        E[S, np.arange(S.size)] = 1.0
-        Z = factor.solve(E)[reach]
+    Z = solve_at(factor, S, np.eye(S.size), reach, n)
     try:
         C = np.linalg.solve(np.eye(S.size) + WK[:, reach] @ Z, WK @ Y)
     except np.linalg.LinAlgError:                   # a singular capacitance matrix

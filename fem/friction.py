@@ -40,6 +40,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .contact import ContactState, RigidPlane
+from .linsolve import solve_at
 
 __all__ = ["FrictionStep"]
 
@@ -203,13 +204,7 @@ class _Condensed:
         sup = self.support
         if len(cols) == 0:
             return np.zeros((len(sup), 0)), np.zeros((len(self.rows), 0))
-        at = getattr(self.fac, "solve_at", None)
-        if at is not None:
-            Z = at(sup, E, sup)
-        else:
-            b = np.zeros((len(self.du0), len(cols)))
-            b[sup] = E
-            Z = self.fac.solve(b)[sup]
+        Z = solve_at(self.fac, sup, E, sup, len(self.du0))
         if self.rank_one is not None:       # E's whole columns: -(K_s + c g g^T)_f,dof
             c, g = self.rank_one
             gd = np.where(disp, c * g[dofs], 0.0)

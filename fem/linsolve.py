@@ -41,7 +41,8 @@ from scipy.sparse.csgraph import dijkstra, reverse_cuthill_mckee
 from skfem import Mesh
 from threadpoolctl import ThreadpoolController
 
-__all__ = ["BandedCholesky", "BorderedFactor", "Factor", "NotPositiveDefinite", "strip_ordering", "wall_ordering"]
+__all__ = ["BandedCholesky", "BorderedFactor", "Factor", "NotPositiveDefinite", "solve_at", "strip_ordering",
+           "wall_ordering"]
 
 
 class NotPositiveDefinite(np.linalg.LinAlgError):
@@ -119,6 +120,18 @@ def _half_bandwidth(pattern: sp.csr_matrix, perm: np.ndarray) -> int:
     inv[perm] = np.arange(len(perm))
     rows = np.repeat(np.arange(pattern.shape[0]), np.diff(pattern.indptr))
     return int(np.max(np.abs(inv[rows] - inv[pattern.indices])))
+
+
+def solve_at(factor, rows: np.ndarray, values: np.ndarray, dofs: np.ndarray, n: int) -> np.ndarray:
+    """x = K_ff^-1 b at `dofs`, [len(dofs), m], for b [n, m] with the rows `values` at `rows` and
+    zero elsewhere: the factor's own `solve_at` (`Factor.solve_at`) where it has one, else its
+    whole solve, read at `dofs`."""
+    at = getattr(factor, "solve_at", None)
+    if at is not None:
+        return at(rows, values, dofs)
+    b = np.zeros((n, values.shape[1]))
+    b[rows] = values
+    return factor.solve(b)[dofs]
 
 
 class BandedCholesky:

@@ -51,7 +51,7 @@ from .cavity import CavitySurface, PressurizedMechanics
 from .condensation import make_solver
 from .contact import RigidPlane
 from .forms import Mechanics
-from .linsolve import NotPositiveDefinite
+from .linsolve import NotPositiveDefinite, solve_at
 from .solver import SolverOptions, SolverStats, StepResult, follow_path
 
 __all__ = ["K_B", "TrappedGas", "GasMechanics", "GasTangent", "RankOneSolver", "RankOneFactor",
@@ -175,13 +175,7 @@ class RankOneFactor:
     def solve_at(self, rows: np.ndarray, values: np.ndarray, dofs: np.ndarray) -> np.ndarray:
         """`fem.linsolve.Factor.solve_at` (x at `dofs` for a right-hand side on `rows`) where the
         base factor has it, else from its whole solve: the term's weight g_f.x is y.b_f."""
-        at = getattr(self._base, "solve_at", None)
-        if at is not None:
-            x = at(rows, values, dofs)
-        else:
-            b = np.zeros((len(self._y), values.shape[1]))
-            b[rows] = values
-            x = self._base.solve(b)[dofs]
+        x = solve_at(self._base, rows, values, dofs, len(self._y))
         scale = self._c * (self._y[rows] @ values) / self._den
         return x - np.multiply.outer(self._y[dofs], scale)
 

@@ -249,7 +249,7 @@ def _lifetimes(ctx: Context, runs: dict) -> None:
 
     uc = pmma_uc_table()
     forces = QUICK_FORCES_N if ctx.quick else FORCES_N
-    cols, columns = ["force_N"], []
+    cols, columns, reasons = ["force_N"], [], {}
     for k, r in runs.items():
         curve = r.stiffness_curve()
         for geometry, src, tag in (("cone", curve, "cone"), ("curve", fem_width(curve), "own")):
@@ -261,6 +261,7 @@ def _lifetimes(ctx: Context, runs: dict) -> None:
             except (ValueError, RuntimeError, ArithmeticError) as exc:
                 columns.append([(math.nan, f"failed: {str(exc).splitlines()[0][:80]}")] * len(forces))
             cols.append(f"{k.replace(' ', '_')}_{tag}_s")
+            reasons[k, tag] = {why for _, why in columns[-1]}
     rows = [[F] + [f"{c[i][0]:.4g}" + ("" if c[i][1] == "reached_r1" else f" ({c[i][1]})") for c in columns]
             for i, F in enumerate(forces)]
     ctx.report.table(NAME, "friction_lifetimes", cols, rows,
@@ -268,27 +269,27 @@ def _lifetimes(ctx: Context, runs: dict) -> None:
                      f"the cone laws (cone) or with the FEM's own r_c, V, l (own); reason when not reached_r1")
     ctx.report.summary["friction_lifetime_s"] = {
         c: {f"{F:g}N": col[i][0] for i, F in enumerate(forces)} for c, col in zip(cols[1:], columns)}
-    reasons = {c[:-2]: {why for _, why in col} for c, col in zip(cols[1:], columns)}
-    notes = [n for k, r in runs.items() for n in _why_not_reached(k, r, reasons)]
+    notes = [n for k, r in runs.items()
+             for n in _why_not_reached(k, r, reasons[k, "cone"], reasons[k, "own"])]
     if notes:
         ctx.report.text(NAME, "Why some cells end otherwise: " + " ".join(notes))
     _figure_geometry(ctx, runs)
 
 
-def _why_not_reached(law: str, r: FemResult, reasons: dict) -> list[str]:
+def _why_not_reached(law: str, r: FemResult, cone: set[str], own: set[str]) -> list[str]:
     """The sentences that explain a law's folds with the cone laws (F0 falls after a slip: the force
     balance has no state past that peak) and its "sealed" cells with its own geometry (a strip
-    narrower than the mesh resolves carries the force: the rough contact is closed)."""
-    tag = law.replace(" ", "_")
+    narrower than the mesh resolves carries the force: the rough contact is closed); `cone`, `own`:
+    the reasons of its lifetimes with each geometry."""
     out = []
     u, F, l = 1e3 * np.asarray(r.u_m), np.asarray(r.F0_N), 1e3 * np.asarray(r.l_m)
     drop = F[:-1] - F[1:]
     i = int(np.argmax(drop)) if drop.size else 0
-    if {"fold", "over_force"} & reasons.get(f"{tag}_cone", set()) and drop.size and drop[i] > 0.5 * F[i]:
+    if {"fold", "over_force"} & cone and drop.size and drop[i] > 0.5 * F[i]:
         out.append(f"{law}: F0 drops from {F[i]:.3g} to {F[i + 1]:.3g} N at u = {u[i + 1]:.3g} mm (a slip), "
                    f"so with the cone laws the force balance folds past that peak.")
     thin = (l > 0) & (l < 0.2)
-    if "sealed" in reasons.get(f"{tag}_own", set()) and thin.any():
+    if "sealed" in own and thin.any():
         out.append(f"{law}: its FEM strip is {l[thin].min():.2g}-{l[thin].max():.2g} mm wide at u = "
                    f"{u[thin].min():.3g}-{u[thin].max():.3g} mm (the rim corner alone, a fraction of an element), "
                    f"and the force on it closes the rough contact (u_c = 0): 'sealed' there is the mesh's "
