@@ -169,6 +169,12 @@ class _Condensed:
             solved = getattr(fac, "solved_g", None)           # K_ff^-1 g_f
             self._v = solved if solved is not None else fac.solve(np.where(fac.free, self.rank_one[1], 0.0))
             self._gv = float(self._v @ self.rank_one[1])
+        self.chain_cut = getattr(K, "chain_cut", None)        # the gas load's cut (`fem.cavity.ChainCut`)
+        if self.chain_cut is not None:
+            self._chain_at = self.chain_cut.positions(plane.nodes)
+            self._chain_on, self._cut0 = self.chain_cut.on_plane(), self.chain_cut.index
+        self._bases: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._du0 = du0                                       # du0 at the cut of the last sets
         self.support, self.E = np.zeros(0, int), np.zeros((0, 0))
         self._set_rows()
         self.Z = np.zeros((len(self.support), 0))
@@ -245,14 +251,37 @@ class _Condensed:
         self.Z, self.F = self._solve(self.E, self.cols)      # on the larger support
         self._columns(np.arange(start, len(self.rows)))
 
+    def _cut(self, An: np.ndarray) -> int | None:
+        """The chain's cut after a step with the rows' nodes pressed where An: the last chain
+        node on the plane, the rows' nodes on it where pressed, the others where they are."""
+        if self.chain_cut is None:
+            return None
+        on, at = self._chain_on.copy(), self._chain_at[self.nodes]
+        on[at[at >= 0]] = An[at >= 0]
+        return self.chain_cut.cut_of(on)
+
+    def _base(self, k: int | None) -> tuple[np.ndarray, np.ndarray]:
+        """The residual and the base step with the chain cut at k: the cavity load's jump
+        (`fem.cavity.ChainCut.load_change`) added to res0, and the body's response to it to du0
+        (one solve per cut; the jump on the held dofs is a reaction only)."""
+        if k is None or k == self._cut0:
+            return self.res0, self.du0
+        if k not in self._bases:
+            jump = self.chain_cut.load_change(k)
+            free = jump != 0.0
+            free &= self.fac.free               # (a release's jump is on held dofs alone)
+            self._bases[k] = (self.res0 + jump,
+                              self.du0 + self.fac.solve(-np.where(free, jump, 0.0)) if free.any() else self.du0)
+        return self._bases[k]
+
     def du(self) -> np.ndarray:
         """du0 + Z y: one solve of the columns' right-hand sides combined by y."""
         if len(self.cols) == 0:
-            return self.du0.copy()
+            return self._du0.copy()
         dofs, disp = self.rows[self.cols], ~self.force[self.cols]
         b = np.zeros(len(self.du0))
         b[self.support] = self.E @ self.y
-        du = self.du0 + self.fac.solve(b)
+        du = self._du0 + self.fac.solve(b)
         if self.rank_one is not None:
             du -= self._v * (self.rank_one[0] * self.rank_one[1][dofs[disp]] @ self.y[disp])
         du[dofs[disp]] += self.y[disp]
@@ -274,11 +303,13 @@ class _Condensed:
         ir = nh + np.arange(nh)
         g, d0, mu = self.g_all[self.nodes], self.d0, self.mu
         c = np.abs(self._diag)                      # the augmentation (module docstring)
-        q = self.res0[self.rows] + self._Kc @ self.du0
-        w0 = self.du0[self.rows]
         An, slip = self.An.copy(), self.slip.copy()
-        self.converged = False
+        self.converged, cut = False, -1
         for _ in range(_SSN_ITERATIONS):
+            if self._cut(An) != cut:             # the load at the sets' cut (`_base`)
+                cut = self._cut(An)
+                res0, du0 = self._base(cut)
+                q, w0 = res0[self.rows] + self._Kc @ du0, du0[self.rows]
             self._columns(np.flatnonzero(self._needed(An, slip)))
             F, D = self.F, self.Z[self._at]
             A, b = F.copy(), -q.copy()          # default rows: reaction 0 (off the plane)
@@ -292,7 +323,7 @@ class _Condensed:
             b[ir[sl]] = -(q[ir[sl]] - k * q[iz[:nh][sl]])
             y = np.linalg.solve(A[self.cols], b[self.cols]) if len(self.cols) else np.zeros(0)
             f, w = q + F @ y, w0 + D @ y
-            self.y, self.An, self.slip = y, An, slip
+            self.y, self.An, self.slip, self._du0 = y, An, slip, du0
             An_new, slip_new = self._sets(f, w, c, g, An, slip, iz, ir)
             if np.array_equal(An_new, An) and np.array_equal(slip_new, slip):
                 self.converged = True
