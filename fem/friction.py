@@ -149,7 +149,14 @@ class _Condensed:
     columns are solved there alone (`solve_at` of the factor: the contact rows sit at the band's
     end, at the rim), and du = du0 + Z y is one whole solve of the combined right-hand side. The
     gas tangent's rank-one term c g g^T, whose g spans the cavity chain, enters by its weights
-    g.Z, from v = K_ff^-1 g_f (K_ff symmetric)."""
+    g.Z, from v = K_ff^-1 g_f (K_ff symmetric).
+
+    The gas load ends at the chain's cut, the last node on the plane (`fem.cavity`): sets that
+    release the outermost held nodes take the faces beyond out of the gas region, sets that
+    press a node beyond the cut bring them in, and the load jumps (`fem.cavity.ChainCut`).
+    Linearized at the iterate's cut alone, the outer end of the seal peeled off one node per
+    Newton iteration (each release moving the cut in by one). Sets that move the cut are
+    solved again with the jump in the residual and its response in du0 (`_base`)."""
 
     def __init__(self, plane: RigidPlane, old: ContactState, u, res0, K: sp.csr_matrix, fac,
                  du0, held: np.ndarray, tol: float):
@@ -297,17 +304,21 @@ class _Condensed:
 
     def ssn(self) -> None:
         """The semismooth Newton iteration on the condensed problem (module docstring), from the
-        sets of the last call (first: the iterate's). Sets `y`, `An`, `slip`, `converged`."""
+        sets of the last call (first: the iterate's). Sets `y`, `An`, `slip`, `converged`.
+        Under the trapped gas, sets that move the cavity chain's cut (class docstring) are
+        iterated on with the load of the moved cut; if that finds no sets, those of the
+        iterate's cut stand."""
         nh, nn = len(self.held), len(self.nodes)
         iz = np.concatenate([np.arange(nh), 2 * nh + np.arange(nn - nh)])
         ir = nh + np.arange(nh)
         g, d0, mu = self.g_all[self.nodes], self.d0, self.mu
         c = np.abs(self._diag)                      # the augmentation (module docstring)
         An, slip = self.An.copy(), self.slip.copy()
-        self.converged, cut = False, -1
+        self.converged, cut, carried = False, -1, False
         for _ in range(_SSN_ITERATIONS):
-            if self._cut(An) != cut:             # the load at the sets' cut (`_base`)
-                cut = self._cut(An)
+            at = self._cut(An) if carried else None
+            if at != cut:                       # the load at that cut (`_base`)
+                cut = at
                 res0, du0 = self._base(cut)
                 q, w0 = res0[self.rows] + self._Kc @ du0, du0[self.rows]
             self._columns(np.flatnonzero(self._needed(An, slip)))
@@ -326,9 +337,16 @@ class _Condensed:
             self.y, self.An, self.slip, self._du0 = y, An, slip, du0
             An_new, slip_new = self._sets(f, w, c, g, An, slip, iz, ir)
             if np.array_equal(An_new, An) and np.array_equal(slip_new, slip):
+                if not carried and self.chain_cut is not None and self._cut(An) != self._cut0:
+                    carried, kept = True, (y, An, slip, du0)    # the sets move the cut: go on
+                    continue                                    # with the load of theirs
                 self.converged = True
                 break
             An, slip = An_new, slip_new
+        if carried and not self.converged:      # no sets at the moved cut: the iterate's cut's
+            y, self.An, self.slip, self._du0 = kept
+            self.y = np.concatenate([y, np.zeros(len(self.cols) - len(y))])   # (columns added since)
+            self.converged = True
 
     def _sets(self, f, w, c, g, An, slip, iz, ir):
         """The active sets of Alart and Curnier's functions at (f, w), with a hysteresis of the
