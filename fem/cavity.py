@@ -41,6 +41,7 @@ from __future__ import annotations
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -263,11 +264,14 @@ class ChainCut:
         at = np.flatnonzero(on)
         return int(at[-1]) if at.size else self.surface.nodes.size - 1
 
+    @cached_property
+    def _gradient(self) -> np.ndarray:
+        return self.surface.gradient_cut_at(self.x, self.index)
+
     def load_change(self, k: int) -> np.ndarray:
         """dp (dV/du cut at k - dV/du at the iterate's cut) [N, 2 nnodes]: the load the residual
         gains when the cut moves to k."""
-        s = self.surface
-        return self.dp_Pa * (s.gradient_cut_at(self.x, k) - s.gradient_cut_at(self.x, self.index))
+        return self.dp_Pa * (self.surface.gradient_cut_at(self.x, k) - self._gradient)
 
 
 @dataclass(frozen=True)

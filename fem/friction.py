@@ -180,8 +180,8 @@ class _Condensed:
         if self.chain_cut is not None:
             self._chain_at = self.chain_cut.positions(plane.nodes)
             self._chain_on, self._cut0 = self.chain_cut.on_plane(), self.chain_cut.index
-        self._bases: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-        self._du0 = du0                                       # du0 at the cut of the last sets
+        self._bases: dict[tuple, tuple] = {}                  # `_base` by (cut, rows)
+        self._jump = None                                     # the cut's jump of the last sets
         self.support, self.E = np.zeros(0, int), np.zeros((0, 0))
         self._set_rows()
         self.Z = np.zeros((len(self.support), 0))
@@ -267,28 +267,41 @@ class _Condensed:
         on[at[at >= 0]] = An[at >= 0]
         return self.chain_cut.cut_of(on)
 
-    def _base(self, k: int | None) -> tuple[np.ndarray, np.ndarray]:
-        """The residual and the base step with the chain cut at k: the cavity load's jump
-        (`fem.cavity.ChainCut.load_change`) added to res0, and the body's response to it to du0
-        (one solve per cut; the jump on the held dofs is a reaction only)."""
+    def _base(self, k: int | None) -> tuple[np.ndarray, np.ndarray, tuple | None]:
+        """q and w0 (the base step's reactions and displacements at the rows) with the chain cut
+        at k, and the jump on the free dofs (dofs, values; None at the iterate's cut): the cavity
+        load's jump (`fem.cavity.ChainCut.load_change`) is a reaction on the held dofs and moves
+        the body through the free ones, which is solved at the support only (`solve_at`: the
+        jump is at the rim, at the band's end) and enters the whole step in `du`."""
         if k is None or k == self._cut0:
-            return self.res0, self.du0
-        if k not in self._bases:
+            return self.res0[self.rows] + self._Kc @ self.du0, self.du0[self.rows], None
+        key = (k, len(self.rows))
+        if key not in self._bases:
             jump = self.chain_cut.load_change(k)
-            free = jump != 0.0
-            free &= self.fac.free               # (a release's jump is on held dofs alone)
-            self._bases[k] = (self.res0 + jump,
-                              self.du0 + self.fac.solve(-np.where(free, jump, 0.0)) if free.any() else self.du0)
-        return self._bases[k]
+            free = np.flatnonzero((jump != 0.0) & self.fac.free)
+            w = self.du0[self.support]
+            gw = None if self.rank_one is None else self.rank_one[1] @ self.du0
+            if free.size:
+                w = w + solve_at(self.fac, free, -jump[free, None], self.support, len(self.du0))[:, 0]
+                if gw is not None:                  # g.K_ff^-1 b = v.b (K_ff symmetric)
+                    gw -= self._v[free] @ jump[free]
+            q = (self.res0 + jump)[self.rows] + self._Kd @ w
+            if gw is not None:
+                q += self.rank_one[0] * self._Kc.g_rows * gw
+            self._bases[key] = (q, w[self._at], (free, jump[free]) if free.size else None)
+        return self._bases[key]
 
     def du(self) -> np.ndarray:
-        """du0 + Z y: one solve of the columns' right-hand sides combined by y."""
-        if len(self.cols) == 0:
-            return self._du0.copy()
-        dofs, disp = self.rows[self.cols], ~self.force[self.cols]
+        """du0 + Z y: one solve of the columns' right-hand sides combined by y (and of the cavity
+        load's jump on the free dofs, where the sets moved the cut)."""
         b = np.zeros(len(self.du0))
-        b[self.support] = self.E @ self.y
-        du = self._du0 + self.fac.solve(b)
+        if self._jump is not None:
+            b[self._jump[0]] = -self._jump[1]
+        if len(self.cols) == 0:
+            return self.du0 + self.fac.solve(b) if self._jump is not None else self.du0.copy()
+        dofs, disp = self.rows[self.cols], ~self.force[self.cols]
+        b[self.support] += self.E @ self.y
+        du = self.du0 + self.fac.solve(b)
         if self.rank_one is not None:
             du -= self._v * (self.rank_one[0] * self.rank_one[1][dofs[disp]] @ self.y[disp])
         du[dofs[disp]] += self.y[disp]
@@ -319,8 +332,7 @@ class _Condensed:
             at = self._cut(An) if carried else None
             if at != cut:                       # the load at that cut (`_base`)
                 cut = at
-                res0, du0 = self._base(cut)
-                q, w0 = res0[self.rows] + self._Kc @ du0, du0[self.rows]
+                q, w0, jump = self._base(cut)
             self._columns(np.flatnonzero(self._needed(An, slip)))
             F, D = self.F, self.Z[self._at]
             A, b = F.copy(), -q.copy()          # default rows: reaction 0 (off the plane)
@@ -334,17 +346,17 @@ class _Condensed:
             b[ir[sl]] = -(q[ir[sl]] - k * q[iz[:nh][sl]])
             y = np.linalg.solve(A[self.cols], b[self.cols]) if len(self.cols) else np.zeros(0)
             f, w = q + F @ y, w0 + D @ y
-            self.y, self.An, self.slip, self._du0 = y, An, slip, du0
+            self.y, self.An, self.slip, self._jump = y, An, slip, jump
             An_new, slip_new = self._sets(f, w, c, g, An, slip, iz, ir)
             if np.array_equal(An_new, An) and np.array_equal(slip_new, slip):
                 if not carried and self.chain_cut is not None and self._cut(An) != self._cut0:
-                    carried, kept = True, (y, An, slip, du0)    # the sets move the cut: go on
+                    carried, kept = True, (y, An, slip, jump)   # the sets move the cut: go on
                     continue                                    # with the load of theirs
                 self.converged = True
                 break
             An, slip = An_new, slip_new
         if carried and not self.converged:      # no sets at the moved cut: the iterate's cut's
-            y, self.An, self.slip, self._du0 = kept
+            y, self.An, self.slip, self._jump = kept
             self.y = np.concatenate([y, np.zeros(len(self.cols) - len(y))])   # (columns added since)
             self.converged = True
 
