@@ -144,7 +144,7 @@ class CavitySurface:
 
     def gradient_cut_at(self, x: np.ndarray, k: int) -> np.ndarray:
         """dV_phi/du [2 nnodes] of the chain cut at position k instead of at `cut_index`."""
-        V, (dofs, grad), _, _ = self._terms(x, 2, self.wetting_m, k)
+        V, (dofs, grad) = self._terms(x, 1, self.wetting_m, k)
         return np.bincount(dofs, grad, minlength=x.size)
 
     def _chain(self, k: int) -> "_Chain":
@@ -168,9 +168,9 @@ class CavitySurface:
         return chain
 
     def _terms(self, x: np.ndarray, order: int, z_ref: float, cut: int | None = None):
-        """V_phi = pi r_k^2 Phi(z_k) - pi int_chain r^2 phi(z) dz and its derivatives, the chain
-        cut at `cut` (default `cut_index`); all edges at once, in chain order (the last one
-        halved if the cut is at a mid-side node)."""
+        """V_phi = pi r_k^2 Phi(z_k) - pi int_chain r^2 phi(z) dz and its derivatives up to `order`
+        (1: the gradient, 2: and the Hessian), the chain cut at `cut` (default `cut_index`); all
+        edges at once, in chain order (the last one halved if the cut is at a mid-side node)."""
         c = self._chain(self.cut_index(x) if cut is None else cut)
         if z_ref <= 0.0:
             return self._geometric_terms(x, order, c)
@@ -189,6 +189,9 @@ class CavitySurface:
         g_z = np.einsum("eiq,eq->ei", N, r**2 * dphi * dz * w) \
             + np.einsum("eiq,eq->ei", dN, r**2 * phi * w)
         grad = -np.pi * np.concatenate([g_r, g_z], axis=1)
+        seal_grad = np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])
+        if order == 1:
+            return float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad]))
 
         def outer(a, weight, b):
             return np.einsum("eiq,eq,ejq->eij", a, weight, b)
@@ -198,7 +201,6 @@ class CavitySurface:
         H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
         B = outer(N, r**2 * dphi * w, dN)
         H[:, 3:, 3:] = outer(N, r**2 * d2phi * dz * w, N) + B + B.transpose(0, 2, 1)
-        seal_grad = np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])
         seal_hess = np.array([2.0 * np.pi * Phi_k, 2.0 * np.pi * rk * phi_k,
                               2.0 * np.pi * rk * phi_k, np.pi * rk**2 * dphi_k])
         return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
@@ -220,11 +222,13 @@ class CavitySurface:
         g_r = np.einsum("eiq,eq->ei", N, 2.0 * r * dz * w)
         g_z = np.einsum("eiq,eq->ei", dN, r**2 * w)
         grad = -np.pi * np.concatenate([g_r, g_z], axis=1)
+        seal_grad = np.array([2.0 * np.pi * rk * zk, np.pi * rk**2])
+        if order == 1:
+            return float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad]))
         H = np.zeros((edges.shape[0], 6, 6))
         H[:, :3, :3] = np.einsum("eiq,eq,ejq->eij", N, 2.0 * dz * w, N)
         H[:, :3, 3:] = np.einsum("eiq,eq,ejq->eij", N, 2.0 * r * w, dN)
         H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
-        seal_grad = np.array([2.0 * np.pi * rk * zk, np.pi * rk**2])
         seal_hess = np.array([2.0 * np.pi * zk, 2.0 * np.pi * rk, 2.0 * np.pi * rk, 0.0])
         return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
                 np.concatenate([-np.pi * H.ravel(), seal_hess]), c.pairs)

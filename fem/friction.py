@@ -181,6 +181,7 @@ class _Condensed:
             self._chain_at = self.chain_cut.positions(plane.nodes)
             self._chain_on, self._cut0 = self.chain_cut.on_plane(), self.chain_cut.index
         self._bases: dict[tuple, tuple] = {}                  # `_base` by (cut, rows)
+        self._jumps: dict[int, np.ndarray] = {}               # `ChainCut.load_change` by cut
         self._jump = None                                     # the cut's jump of the last sets
         self.support, self.E = np.zeros(0, int), np.zeros((0, 0))
         self._set_rows()
@@ -277,7 +278,9 @@ class _Condensed:
             return self.res0[self.rows] + self._Kc @ self.du0, self.du0[self.rows], None
         key = (k, len(self.rows))
         if key not in self._bases:
-            jump = self.chain_cut.load_change(k)
+            if k not in self._jumps:
+                self._jumps[k] = self.chain_cut.load_change(k)
+            jump = self._jumps[k]
             free = np.flatnonzero((jump != 0.0) & self.fac.free)
             w = self.du0[self.support]
             gw = None if self.rank_one is None else self.rank_one[1] @ self.du0
