@@ -354,9 +354,15 @@ class _Condensed:
             if np.array_equal(An_new, An) and np.array_equal(slip_new, slip):
                 if not carried and self.chain_cut is not None and self._cut(An) != self._cut0:
                     carried, kept = True, (y, An, slip, jump)   # the sets move the cut: go on
-                    continue                                    # with the load of theirs
+                    seen = set()                                # with the load of theirs
+                    continue
                 self.converged = True
                 break
+            if carried:                         # a cycle at the moved cut: no sets there
+                key = An_new.tobytes() + slip_new.tobytes()
+                if key in seen:
+                    break
+                seen.add(key)
             An, slip = An_new, slip_new
         if carried and not self.converged:      # no sets at the moved cut: the iterate's cut's
             y, self.An, self.slip, self._jump = kept
