@@ -79,13 +79,14 @@ def coulomb_medium():
 def test_the_outer_end_peels_in_one_iteration(coulomb_medium, monkeypatch):
     """Cup A, medium, Coulomb 0.5, the largest pull's first 3.5 mm: without the jump in the
     condensed problem (load_change zero: the iterate's cut only) the outer end peels one node per
-    Newton iteration (steps of 9-12 iterations); with it no step takes more than 6."""
+    Newton iteration (steps of 9 and 12 iterations); with it no step takes more than 6."""
     cup, sealed = coulomb_medium
     carried = _pull_iterations(cup, sealed, 3.5e-3)
     monkeypatch.setattr(ChainCut, "load_change", lambda self, k: np.zeros(self.x.size))
     late = _pull_iterations(cup, sealed, 3.5e-3)
     print(carried, late)
     assert len(carried) >= 20 and len(late) >= 20
-    assert max(late) >= 9
-    assert max(carried) <= 6
-    assert sum(carried) < 0.85 * sum(late)
+    peels = lambda its: sum(n >= 8 for n in its)          # noqa: E731
+    assert peels(late) >= 2 and max(late) >= 9
+    assert peels(carried) == 0 and max(carried) <= 6
+    assert sum(carried) < sum(late)
