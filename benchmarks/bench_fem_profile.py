@@ -57,6 +57,7 @@ import contextlib
 import functools
 import io
 import os
+import re
 import resource
 import statistics
 import subprocess
@@ -254,8 +255,9 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     if row is None:              # no lifetime printed: the command's exit status and last message
         last = (err.getvalue().strip().splitlines() or ["?"])[-1]
         row = ["", "?", f"exit {code}: {last}"]
+    largest = re.search(r"largest holdable force (\S+ N)", out.getvalue())
     return {"level": level, "force": force_N, "contact": contact, "cpu": cpu, "lifetime": row[1],
-            "reason": row[2],
+            "reason": row[2], "largest": largest.group(1) if largest else "?",
             "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own,
             "phases": dict(PHASES), "pull_steps": [list(p) for p in PULL_STEPS]}
 
@@ -263,7 +265,7 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
 def report_route(r: dict) -> None:
     total = r["cpu"]
     print(f"\nfem route, cup A {r['level']}, {r['contact']}, F1 = {r['force']:g} N: lifetime {r['lifetime']} s "
-          f"({r['reason']}); in-process CPU time {total:.2f} s")
+          f"({r['reason']}), largest holdable force {r['largest']}; in-process CPU time {total:.2f} s")
     phases = r["phases"]
     rest = total - sum(phases.values())
     print("  phases: " + ", ".join(f"{k} {v:.2f} s" for k, v in phases.items()) + f", rest {rest:.2f} s")

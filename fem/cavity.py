@@ -41,6 +41,7 @@ from __future__ import annotations
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -49,7 +50,7 @@ from skfem import Mesh
 from .forms import Mechanics
 from .mesh import boundary_path
 
-__all__ = ["CavitySurface", "PressurizedMechanics"]
+__all__ = ["CavitySurface", "ChainCut", "PressurizedMechanics"]
 
 _XI, _W = np.polynomial.legendre.leggauss(6)
 
@@ -141,6 +142,11 @@ class CavitySurface:
         dofs 2n (r) and 2n + 1 (z) of node n, as in `fem.kinematics`."""
         return self._terms(x, 2, self.wetting_m)
 
+    def gradient_cut_at(self, x: np.ndarray, k: int) -> np.ndarray:
+        """dV_phi/du [2 nnodes] of the chain cut at position k instead of at `cut_index`."""
+        V, (dofs, grad) = self._terms(x, 1, self.wetting_m, k)
+        return np.bincount(dofs, grad, minlength=x.size)
+
     def _chain(self, k: int) -> "_Chain":
         """The chain cut at position k: its edges and their quadrature, dofs and Hessian dof
         pairs (index work only, kept per cut: a path meets a handful of cuts)."""
@@ -161,11 +167,11 @@ class CavitySurface:
                                              seal, np.concatenate([dofs.ravel(), d]), pairs)
         return chain
 
-    def _terms(self, x: np.ndarray, order: int, z_ref: float):
-        """V_phi = pi r_k^2 Phi(z_k) - pi int_chain r^2 phi(z) dz and its derivatives, the chain
-        cut at `cut_index`; all edges at once, in chain order (the last one halved if the cut is
-        at a mid-side node)."""
-        c = self._chain(self.cut_index(x))
+    def _terms(self, x: np.ndarray, order: int, z_ref: float, cut: int | None = None):
+        """V_phi = pi r_k^2 Phi(z_k) - pi int_chain r^2 phi(z) dz and its derivatives up to `order`
+        (1: the gradient, 2: and the Hessian), the chain cut at `cut` (default `cut_index`); all
+        edges at once, in chain order (the last one halved if the cut is at a mid-side node)."""
+        c = self._chain(self.cut_index(x) if cut is None else cut)
         if z_ref <= 0.0:
             return self._geometric_terms(x, order, c)
         edges, N, dN, w = c.edges, c.N, c.dN, c.w                       # [E, 3], [E, 3, q], [E, q]
@@ -183,6 +189,9 @@ class CavitySurface:
         g_z = np.einsum("eiq,eq->ei", N, r**2 * dphi * dz * w) \
             + np.einsum("eiq,eq->ei", dN, r**2 * phi * w)
         grad = -np.pi * np.concatenate([g_r, g_z], axis=1)
+        seal_grad = np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])
+        if order == 1:
+            return float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad]))
 
         def outer(a, weight, b):
             return np.einsum("eiq,eq,ejq->eij", a, weight, b)
@@ -192,7 +201,6 @@ class CavitySurface:
         H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
         B = outer(N, r**2 * dphi * w, dN)
         H[:, 3:, 3:] = outer(N, r**2 * d2phi * dz * w, N) + B + B.transpose(0, 2, 1)
-        seal_grad = np.array([2.0 * np.pi * rk * Phi_k, np.pi * rk**2 * phi_k])
         seal_hess = np.array([2.0 * np.pi * Phi_k, 2.0 * np.pi * rk * phi_k,
                               2.0 * np.pi * rk * phi_k, np.pi * rk**2 * dphi_k])
         return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
@@ -214,14 +222,60 @@ class CavitySurface:
         g_r = np.einsum("eiq,eq->ei", N, 2.0 * r * dz * w)
         g_z = np.einsum("eiq,eq->ei", dN, r**2 * w)
         grad = -np.pi * np.concatenate([g_r, g_z], axis=1)
+        seal_grad = np.array([2.0 * np.pi * rk * zk, np.pi * rk**2])
+        if order == 1:
+            return float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad]))
         H = np.zeros((edges.shape[0], 6, 6))
         H[:, :3, :3] = np.einsum("eiq,eq,ejq->eij", N, 2.0 * dz * w, N)
         H[:, :3, 3:] = np.einsum("eiq,eq,ejq->eij", N, 2.0 * r * w, dN)
         H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
-        seal_grad = np.array([2.0 * np.pi * rk * zk, np.pi * rk**2])
         seal_hess = np.array([2.0 * np.pi * zk, 2.0 * np.pi * rk, 2.0 * np.pi * rk, 0.0])
         return (float(V), (c.dofs, np.concatenate([grad.ravel(), seal_grad])),
                 np.concatenate([-np.pi * H.ravel(), seal_hess]), c.pairs)
+
+
+@dataclass(frozen=True)
+class ChainCut:
+    """The cavity load dp dV/du at the deformed coordinates x as it depends on where the chain is
+    cut, for a contact step that moves the contact's outer end. Releasing the outermost held
+    node takes the faces beyond the next one out of the gas region, and their suction with
+    them; pressing a node beyond the cut brings the suction onto the faces up to it. The load
+    jumps there (V is continuous, its gradient is not), so a linearization at the iterate's cut
+    alone sees it one Newton iteration late: the outer end of the contact then peels, or lands,
+    one node per iteration."""
+
+    surface: CavitySurface
+    x: np.ndarray
+    dp_Pa: float
+
+    @property
+    def index(self) -> int:
+        """The iterate's cut (`CavitySurface.cut_index`)."""
+        return self.surface.cut_index(self.x)
+
+    def on_plane(self) -> np.ndarray:
+        """Whether each chain node is on the plane at the iterate [n]."""
+        return self.x[1, self.surface.nodes] <= self.surface.tolerance_m
+
+    def positions(self, nodes: np.ndarray) -> np.ndarray:
+        """The chain positions of mesh `nodes` (-1: not on the chain)."""
+        where = np.full(int(max(self.surface.nodes.max(), nodes.max())) + 1, -1)
+        where[self.surface.nodes] = np.arange(self.surface.nodes.size)
+        return where[nodes]
+
+    def cut_of(self, on: np.ndarray) -> int:
+        """The cut of the chain nodes `on` the plane: the last of them, else the chain's end."""
+        at = np.flatnonzero(on)
+        return int(at[-1]) if at.size else self.surface.nodes.size - 1
+
+    @cached_property
+    def _gradient(self) -> np.ndarray:
+        return self.surface.gradient_cut_at(self.x, self.index)
+
+    def load_change(self, k: int) -> np.ndarray:
+        """dp (dV/du cut at k - dV/du at the iterate's cut) [N, 2 nnodes]: the load the residual
+        gains when the cut moves to k."""
+        return self.dp_Pa * (self.surface.gradient_cut_at(self.x, k) - self._gradient)
 
 
 @dataclass(frozen=True)

@@ -149,7 +149,14 @@ class _Condensed:
     columns are solved there alone (`solve_at` of the factor: the contact rows sit at the band's
     end, at the rim), and du = du0 + Z y is one whole solve of the combined right-hand side. The
     gas tangent's rank-one term c g g^T, whose g spans the cavity chain, enters by its weights
-    g.Z, from v = K_ff^-1 g_f (K_ff symmetric)."""
+    g.Z, from v = K_ff^-1 g_f (K_ff symmetric).
+
+    The gas load ends at the chain's cut, the last node on the plane (`fem.cavity`): sets that
+    release the outermost held nodes take the faces beyond out of the gas region, sets that
+    press a node beyond the cut bring them in, and the load jumps (`fem.cavity.ChainCut`).
+    Linearized at the iterate's cut alone, the outer end of the seal peeled off one node per
+    Newton iteration (each release moving the cut in by one). Sets that move the cut are
+    solved again with the jump in the residual and its response in du0 (`_base`)."""
 
     def __init__(self, plane: RigidPlane, old: ContactState, u, res0, K: sp.csr_matrix, fac,
                  du0, held: np.ndarray, tol: float):
@@ -169,6 +176,13 @@ class _Condensed:
             solved = getattr(fac, "solved_g", None)           # K_ff^-1 g_f
             self._v = solved if solved is not None else fac.solve(np.where(fac.free, self.rank_one[1], 0.0))
             self._gv = float(self._v @ self.rank_one[1])
+        self.chain_cut = getattr(K, "chain_cut", None)        # the gas load's cut (`fem.cavity.ChainCut`)
+        if self.chain_cut is not None:
+            self._chain_at = self.chain_cut.positions(plane.nodes)
+            self._chain_on, self._cut0 = self.chain_cut.on_plane(), self.chain_cut.index
+        self._bases: dict[tuple, tuple] = {}                  # `_base` by (cut, rows)
+        self._jumps: dict[int, np.ndarray] = {}               # `ChainCut.load_change` by cut
+        self._jump = None                                     # the cut's jump of the last sets
         self.support, self.E = np.zeros(0, int), np.zeros((0, 0))
         self._set_rows()
         self.Z = np.zeros((len(self.support), 0))
@@ -245,13 +259,51 @@ class _Condensed:
         self.Z, self.F = self._solve(self.E, self.cols)      # on the larger support
         self._columns(np.arange(start, len(self.rows)))
 
+    def _cut(self, An: np.ndarray) -> int | None:
+        """The chain's cut after a step with the rows' nodes pressed where An: the last chain
+        node on the plane, the rows' nodes on it where pressed, the others where they are."""
+        if self.chain_cut is None:
+            return None
+        on, at = self._chain_on.copy(), self._chain_at[self.nodes]
+        on[at[at >= 0]] = An[at >= 0]
+        return self.chain_cut.cut_of(on)
+
+    def _base(self, k: int | None) -> tuple[np.ndarray, np.ndarray, tuple | None]:
+        """q and w0 (the base step's reactions and displacements at the rows) with the chain cut
+        at k, and the jump on the free dofs (dofs, values; None at the iterate's cut): the cavity
+        load's jump (`fem.cavity.ChainCut.load_change`) is a reaction on the held dofs and moves
+        the body through the free ones, which is solved at the support only (`solve_at`: the
+        jump is at the rim, at the band's end) and enters the whole step in `du`."""
+        if k is None or k == self._cut0:
+            return self.res0[self.rows] + self._Kc @ self.du0, self.du0[self.rows], None
+        key = (k, len(self.rows))
+        if key not in self._bases:
+            if k not in self._jumps:
+                self._jumps[k] = self.chain_cut.load_change(k)
+            jump = self._jumps[k]
+            free = np.flatnonzero((jump != 0.0) & self.fac.free)
+            w = self.du0[self.support]
+            gw = None if self.rank_one is None else self.rank_one[1] @ self.du0
+            if free.size:
+                w = w + solve_at(self.fac, free, -jump[free, None], self.support, len(self.du0))[:, 0]
+                if gw is not None:                  # g.K_ff^-1 b = v.b (K_ff symmetric)
+                    gw -= self._v[free] @ jump[free]
+            q = (self.res0 + jump)[self.rows] + self._Kd @ w
+            if gw is not None:
+                q += self.rank_one[0] * self._Kc.g_rows * gw
+            self._bases[key] = (q, w[self._at], (free, jump[free]) if free.size else None)
+        return self._bases[key]
+
     def du(self) -> np.ndarray:
-        """du0 + Z y: one solve of the columns' right-hand sides combined by y."""
-        if len(self.cols) == 0:
-            return self.du0.copy()
-        dofs, disp = self.rows[self.cols], ~self.force[self.cols]
+        """du0 + Z y: one solve of the columns' right-hand sides combined by y (and of the cavity
+        load's jump on the free dofs, where the sets moved the cut)."""
         b = np.zeros(len(self.du0))
-        b[self.support] = self.E @ self.y
+        if self._jump is not None:
+            b[self._jump[0]] = -self._jump[1]
+        if len(self.cols) == 0:
+            return self.du0 + self.fac.solve(b) if self._jump is not None else self.du0.copy()
+        dofs, disp = self.rows[self.cols], ~self.force[self.cols]
+        b[self.support] += self.E @ self.y
         du = self.du0 + self.fac.solve(b)
         if self.rank_one is not None:
             du -= self._v * (self.rank_one[0] * self.rank_one[1][dofs[disp]] @ self.y[disp])
@@ -268,17 +320,22 @@ class _Condensed:
 
     def ssn(self) -> None:
         """The semismooth Newton iteration on the condensed problem (module docstring), from the
-        sets of the last call (first: the iterate's). Sets `y`, `An`, `slip`, `converged`."""
+        sets of the last call (first: the iterate's). Sets `y`, `An`, `slip`, `converged`.
+        Under the trapped gas, sets that move the cavity chain's cut (class docstring) are
+        iterated on with the load of the moved cut; if that finds no sets, those of the
+        iterate's cut stand."""
         nh, nn = len(self.held), len(self.nodes)
         iz = np.concatenate([np.arange(nh), 2 * nh + np.arange(nn - nh)])
         ir = nh + np.arange(nh)
         g, d0, mu = self.g_all[self.nodes], self.d0, self.mu
         c = np.abs(self._diag)                      # the augmentation (module docstring)
-        q = self.res0[self.rows] + self._Kc @ self.du0
-        w0 = self.du0[self.rows]
         An, slip = self.An.copy(), self.slip.copy()
-        self.converged = False
+        self.converged, cut, carried = False, -1, False
         for _ in range(_SSN_ITERATIONS):
+            at = self._cut(An) if carried else None
+            if at != cut:                       # the load at that cut (`_base`)
+                cut = at
+                q, w0, jump = self._base(cut)
             self._columns(np.flatnonzero(self._needed(An, slip)))
             F, D = self.F, self.Z[self._at]
             A, b = F.copy(), -q.copy()          # default rows: reaction 0 (off the plane)
@@ -292,12 +349,25 @@ class _Condensed:
             b[ir[sl]] = -(q[ir[sl]] - k * q[iz[:nh][sl]])
             y = np.linalg.solve(A[self.cols], b[self.cols]) if len(self.cols) else np.zeros(0)
             f, w = q + F @ y, w0 + D @ y
-            self.y, self.An, self.slip = y, An, slip
+            self.y, self.An, self.slip, self._jump = y, An, slip, jump
             An_new, slip_new = self._sets(f, w, c, g, An, slip, iz, ir)
             if np.array_equal(An_new, An) and np.array_equal(slip_new, slip):
+                if not carried and self.chain_cut is not None and self._cut(An) != self._cut0:
+                    carried, kept = True, (y, An, slip, jump)   # the sets move the cut: go on
+                    seen = set()                                # with the load of theirs
+                    continue
                 self.converged = True
                 break
+            if carried:                         # a cycle at the moved cut: no sets there
+                key = An_new.tobytes() + slip_new.tobytes()
+                if key in seen:
+                    break
+                seen.add(key)
             An, slip = An_new, slip_new
+        if carried and not self.converged:      # no sets at the moved cut: the iterate's cut's
+            y, self.An, self.slip, self._jump = kept
+            self.y = np.concatenate([y, np.zeros(len(self.cols) - len(y))])   # (columns added since)
+            self.converged = True
 
     def _sets(self, f, w, c, g, An, slip, iz, ir):
         """The active sets of Alart and Curnier's functions at (f, w), with a hysteresis of the

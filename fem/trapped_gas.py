@@ -47,7 +47,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .cavity import CavitySurface, PressurizedMechanics
+from .cavity import CavitySurface, ChainCut, PressurizedMechanics
 from .condensation import make_solver
 from .contact import RigidPlane
 from .forms import Mechanics
@@ -101,6 +101,7 @@ class GasTangent(sp.csr_matrix):
     slices and the sparse data do not (`plain`)."""
 
     rank_one: tuple[float, np.ndarray] | None = None
+    chain_cut: ChainCut | None = None     # the gas load's jump where the contact's outer end moves
 
     @classmethod
     def of(cls, K: sp.csr_matrix, data: np.ndarray, c: float, g: np.ndarray) -> "GasTangent":
@@ -340,7 +341,9 @@ class GasMechanics:
         W, r, K = self.body.evaluate(u)
         g = np.bincount(dofs, grad, minlength=r.size)
         data = self._load.add_hessian(K, pairs, hess, dp)
-        return W + Pi_gas, r + dp * g, GasTangent.of(K, data, self.gas.NkT_J / V**2, g)
+        T = GasTangent.of(K, data, self.gas.NkT_J / V**2, g)
+        T.chain_cut = ChainCut(self.cavity, self.coordinates(u), dp)
+        return W + Pi_gas, r + dp * g, T
 
 
 def follow_gas_path(mech: GasMechanics, dirichlet: Callable[[float], tuple[np.ndarray, np.ndarray]],
