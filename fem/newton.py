@@ -291,7 +291,7 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
     dofs, values = dirichlet(t)
     u, s, its, history = u_start, state, 0, []
     settled, settle = False, _SETTLED * bound
-    still, stalls, stalled = False, 0, False    # the last sub-step taken moved nothing; failures since
+    still, stalls, stalled, spent = False, 0, False, False   # the last sub-step moved nothing; failures since
     c = np.array([_C_START, _C_START])      # the damping of the body and of the held nodes' slip
     floor, lowered = np.zeros(2), np.zeros(2, bool)     # the least known to converge; just lowered
     last = np.inf                   # the out-of-balance force of the last sub-step (`out_of_balance`)
@@ -310,8 +310,9 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
                 settled, settle = False, 0.1 * settle
                 continue
             stalls += still
-            stalled = bool(opts.relax_move_m) and (stalls >= _STALLS or its > _BUDGET * opts.max_iterations)
-            if c.max() >= _C_MAX or stalled:
+            spent = bool(opts.relax_move_m) and its > _BUDGET * opts.max_iterations
+            stalled = bool(opts.relax_move_m) and stalls >= _STALLS
+            if c.max() >= _C_MAX or stalled or spent:
                 break
             # no stick/slide set (Klarbring): the slip needs damping; else the body does
             which = np.array([False, True]) if fail.cause.startswith(_NO_SET) else np.array([True, False])
@@ -337,7 +338,8 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
         settled = move < settle and c.max() <= _C_SETTLED
         lowered = (move < 0.25 * bound) & (0.25 * c >= floor)
         c = np.where(lowered, 0.25 * c, c)
-    why = "stalled (the sub-steps that converge no longer move)" if stalled else "did not settle"
+    why = "stalled (the sub-steps that converge no longer move)" if stalled else \
+        f"did not settle within {_BUDGET} times the path's iteration cap" if spent else "did not settle"
     fail = StepFailure(f"the damped motion across the instability {why} ({its} Newton "
                        "iterations); likely cause: a friction bound falling with the slip faster "
                        "than the damping can hold", history, indefinite=True)

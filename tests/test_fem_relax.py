@@ -145,3 +145,24 @@ def test_a_sub_step_without_a_stick_slide_set_raises_the_slip_damping(monkeypatc
     body = np.array([w[1] for w in weights])          # c metric on a dof off the plane
     assert weights[1][0] - weights[1][1] == 10.0 * 4.0 and weights[1][1] == 1.0
     assert body[-1] < 1e-3 and np.all(np.diff(body) <= 0.0)
+
+
+def test_a_motion_that_cycles_on_the_branch_gives_up_within_its_budget(monkeypatch):
+    """Sub-steps that move and fail in turn (a contact set cycling) never stall; on a path with
+    its own move bound the motion gives up once it has spent _BUDGET times the path's iteration
+    cap, and says so; the pressing path goes on to its attempts."""
+    state = {"n": 0}
+
+    def sub_step(c, u):
+        state["n"] += 1
+        if state["n"] % 2 == 0:
+            _fail()
+        return u + 0.1 * BOUND * np.array([1.0, 1.0, 1.0, 0.0]) * (-1) ** (state["n"] // 2), 3
+    with pytest.raises(StepFailure, match="did not settle within") as err:
+        _relax(monkeypatch, sub_step, relax_move_m=BOUND)
+    cap = SolverOptions().max_iterations
+    assert newton._BUDGET * cap < err.value.iterations <= newton._BUDGET * cap + 40 + 3   # + a cycle
+    state["n"] = 0
+    with pytest.raises(StepFailure, match="did not settle \\(") as err:
+        _relax(monkeypatch, sub_step)
+    assert err.value.iterations > 2 * newton._BUDGET * cap
