@@ -29,8 +29,10 @@ from .contact_step import ContactStep
 from .failure import StepFailure
 from .linesearch import line_search, total_potential
 
-__all__ = ["newton_step", "relax_step", "balanced", "creeping", "largest_move", "largest_slip", "SLIP"]
+__all__ = ["newton_step", "relax_step", "balanced", "creeping", "largest_move", "largest_slip", "SLIP",
+           "out_of_balance", "slip_metric"]
 
+_NO_SET = "Coulomb's linearized contact problem found no stick/slide set"
 _STALLED = 12           # Newton iterations in a row whose linearized frictional problem found no set
 _CREEP = 20             # Newton iterations of a coupled (Coulomb) step in which the residual must halve
 
@@ -88,9 +90,9 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         indefinite |= shift > 0.0
         stalled = 0 if getattr(step, "solvable", True) else stalled + 1
         if stalled >= stall:
-            raise StepFailure(f"Coulomb's linearized contact problem found no stick/slide set in {stalled} "
-                              "iterations in a row; likely cause: a friction bound falling with the slip "
-                              "faster than the elastic drive grows (no quasi-static solution)", history)
+            raise StepFailure(f"{_NO_SET} in {stalled} iterations in a row; likely cause: a friction "
+                              "bound falling with the slip faster than the elastic drive grows (no "
+                              "quasi-static solution)", history)
         flags["indefinite"] = indefinite
         energy = abs(step.du @ res)
         e_ref = f_ref * max(np.max(np.abs(u)), np.max(np.abs(step.du)), 1e-9 * _size(mech))
@@ -171,6 +173,31 @@ def _force_floor(mech) -> float:
     return 1e-6 * mech.material.mu * _size(mech) ** 2
 
 
+def out_of_balance(mech, dirichlet, f_ext, plane, state, u, r_int, t, rtol: float) -> float:
+    """The undamped out-of-balance force of a damped sub-step's state: its free residual, the
+    friction of `state` included and the viscous force left out, over rtol of the reactions (as
+    `newton_step` measures them); inf where the prescribed values do not hold, a held node pulls
+    on the plane or a stuck one lies outside the cone. At most 1: the state is the undamped
+    equilibrium (at rest). Where the motion comes to rest on the edge of the friction cone (a
+    node that would slide at zero rate) the undamped Newton step from there may have no
+    solution at large mu (sticking lies a round-off outside the cone, sliding runs backwards:
+    Klarbring's non-existence), while the state the damped motion tends to is an equilibrium."""
+    fixed_dofs, fixed_vals = dirichlet(t)
+    if np.any(fixed_vals != u[fixed_dofs]):
+        return np.inf
+    fext = f_ext(t)
+    res = r_int - fext
+    free, dofs, _ = _free_dofs(len(u), fixed_dofs, fixed_vals, u, plane, state)
+    f_ref = max(np.linalg.norm(res[dofs]), np.linalg.norm(fext), _force_floor(mech))
+    if np.any(plane.reactions(res)[state.active] < -rtol * f_ref) or \
+            plane.law.cone_excess(plane, state, res) > 1e3 * rtol:
+        return np.inf
+    fric = plane.law.friction_force(plane, state, res)
+    if fric is not None:
+        res = res - fric
+    return float(np.linalg.norm(res[free]) / (rtol * f_ref))
+
+
 def largest_move(u1: np.ndarray, u0: np.ndarray) -> float:
     """The largest displacement of a node between two states [m]."""
     return float(np.max(np.hypot(*(u1 - u0).reshape(-1, 2).T)))
@@ -214,6 +241,21 @@ _C_START, _C_SETTLED, _C_MAX = 1.0, 1e-3, 1e8
 SLIP = 0.25                         # the largest slip of a held node in a (sub-)step / the bound
 _SETTLED = 1e-3                     # a damped sub-step moving less than this of the bound: try undamped
 _STALLS = 3                         # failed sub-steps after one that moved < _SETTLED bound: stalled
+_BUDGET = 10                        # on a path with its own move bound: Newton iterations of the
+#                                     motion / the path's cap (a contact set cycling, landing and
+#                                     releasing the same nodes, spent minutes on one move)
+
+
+def slip_metric(plane, state, metric: np.ndarray) -> np.ndarray:
+    """The damping metric of the held nodes' slip: mu times a node's normal stiffness (`metric`,
+    the tangent's diagonal) on its radial dof, zero elsewhere. Klarbring's condition compares
+    the tangential stiffness a sliding node meets with mu times its normal-tangential coupling:
+    a viscous slip of this scale restores a solution of the incremental problem without
+    damping the rest of the body (whose soft modes a body-wide damping slows to a creep)."""
+    w = np.zeros_like(metric)
+    held = 2 * plane.nodes[state.active]
+    w[held] = getattr(plane.law, "mu", 0.0) * metric[held + 1]
+    return w
 
 
 def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, policy, bound):
@@ -221,30 +263,40 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
     integrated along it: for an incremental (Coulomb) law, where the quasi-static step has no
     solution or snaps, its end state depends on how the slip is divided into increments.
 
-    Each sub-step minimizes the energy plus the viscous term of `_Damped`, C = c diag(K(u_start))
-    (the damping metric, fixed for the step), from the last sub-step's state, whose positions are
-    the friction's anchors (committed after every sub-step): backward Euler on the damped motion,
-    whose incremental frictional problems have a solution for c large enough (the damping adds to
-    the stiffness that Klarbring's condition compares mu with). c rises fourfold while a sub-step
-    fails, moves a node more than `bound` [m] beyond the prescribed increment or slips a held node
-    by more than SLIP bound, and falls fourfold after a sub-step that moves less than bound / 4.
-    Once a sub-step with c <= _C_SETTLED moves less than _SETTLED bound, the undamped step from
-    its state ends the motion, if it moves no node more than bound. Where the motion stalls (the
-    sub-steps that converge move less than _SETTLED bound and every less damped one fails, _STALLS
-    times: c would only ratchet up to _C_MAX at hundreds of Newton iterations per sub-step) on a
-    path with its own move bound (`SolverOptions.relax_move_m`: the held branch's moves, which
-    have their own way on), the step fails at once and the caller shortens its move; a path whose
-    load is its length (pressing) keeps the damping rising, which there has ended the motion. As
-    bound -> 0 the sequence tends to the damped motion, independent of the load step. Returns
-    (u, r_int, contact state, Newton iterations); raises StepFailure (with the `iterations` spent)."""
+    Each sub-step minimizes the energy plus the viscous term of `_Damped`, C = c_b diag(K(u_start))
+    + c_s `slip_metric` (the body's damping and the held nodes' slip's; the metrics fixed for the
+    step), from the last sub-step's state, whose positions are the friction's anchors (committed
+    after every sub-step): backward Euler on the damped motion, whose incremental frictional
+    problems have a solution for c_s large enough (the damping adds to the stiffness that
+    Klarbring's condition compares mu with). A sub-step whose frictional problem has no
+    stick/slide set raises c_s fourfold; one that fails otherwise, moves a node more than `bound`
+    [m] beyond the prescribed increment or slips a held node by more than SLIP bound raises c_b.
+    Both fall fourfold after a sub-step that moves less than bound / 4, not below a factor that
+    failed right after such a fall (the least damping known to converge, forgotten once a
+    sub-step moves _SETTLED bound): near the critical damping a fall and a failure alternated, 40
+    Newton iterations a failure. The motion ends at a damped sub-step whose state is the
+    undamped equilibrium within the tolerance (`out_of_balance`: where it rests on the cone's
+    edge at large mu the undamped step has no solution), or, once a sub-step with c <=
+    _C_SETTLED moves less than _SETTLED bound, on the undamped step from its state, if it moves
+    no node more than bound. Where the motion stalls (_STALLS times a sub-step that moved less
+    than _SETTLED bound and then a failure, or a converged one at the least damping that neither
+    moves nor halves its out-of-balance force) on a path with its own move bound
+    (`SolverOptions.relax_move_m`: the held branch's moves, which have their own way on), the
+    step fails at once and the caller shortens its move; a path whose load is its length
+    (pressing) goes on. As bound -> 0 the sequence tends to the damped motion, independent of
+    the load step. Returns (u, r_int, contact state, Newton iterations); raises StepFailure
+    (with the `iterations` spent)."""
     metric = np.abs(mech.evaluate(u_start)[2].diagonal())
     sub_opts = replace(opts, max_iterations=min(opts.max_iterations, _SUB_ITERATIONS))
     dofs, values = dirichlet(t)
-    u, s, c, its, history = u_start, state, _C_START, 0, []
+    u, s, its, history = u_start, state, 0, []
     settled, settle = False, _SETTLED * bound
-    still, stalls, stalled = False, 0, False    # the last sub-step taken moved nothing; failures since
+    still, stalls, stalled, spent = False, 0, False, False   # the last sub-step moved nothing; failures since
+    c = np.array([_C_START, _C_START])      # the damping of the body and of the held nodes' slip
+    floor, lowered = np.zeros(2), np.zeros(2, bool)     # the least known to converge; just lowered
+    last = np.inf                   # the out-of-balance force of the last sub-step (`out_of_balance`)
     for _ in range(int(_RELAX_ATTEMPTS * max(1.0, 0.05 / opts.max_step))):   # sub-steps ~ 1 / bound
-        body = mech if settled else _Damped(mech, u, c * metric)
+        body = mech if settled else _Damped(mech, u, c[0] * metric + c[1] * slip_metric(plane, s, metric))
         allowed = bound + np.max(np.abs(values - u[dofs]), initial=0.0)
         try:
             u1, r1, s1, n, _ = newton_step(body, dirichlet, f_ext, plane, s, u, t, sub_opts, solver,
@@ -258,21 +310,36 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
                 settled, settle = False, 0.1 * settle
                 continue
             stalls += still
+            spent = bool(opts.relax_move_m) and its > _BUDGET * opts.max_iterations
             stalled = bool(opts.relax_move_m) and stalls >= _STALLS
-            if c >= _C_MAX or stalled:
+            if c.max() >= _C_MAX or stalled or spent:
                 break
-            c *= 4.0
+            # no stick/slide set (Klarbring): the slip needs damping; else the body does
+            which = np.array([False, True]) if fail.cause.startswith(_NO_SET) else np.array([True, False])
+            floor = np.where(lowered & which, 4.0 * c, floor)   # the least damping known to converge
+            c, lowered = np.where(which, 4.0 * c, c), np.zeros(2, bool)
             continue
         if body is mech:
             return u1, r1, s1, its
+        r_rest = r1 - body.weight * (u1 - u)        # the body's own internal force at u1
+        imbalance = out_of_balance(mech, dirichlet, f_ext, plane, s1, u1, r_rest, t, opts.rtol)
+        if imbalance <= 1.0:
+            return u1, r_rest, s1, its
         move = largest_move(u1, u)
         still = move < _SETTLED * bound
-        stalls = stalls if still else 0
+        stalls, floor = (stalls, floor) if still else (0, np.zeros(2))    # moving: the state is new
+        if still and np.any(0.25 * c < floor) and not imbalance < 0.5 * last:
+            stalls += 1             # at the least damping that converges, neither moving nor settling
+            stalled = bool(opts.relax_move_m) and stalls >= _STALLS
+            if stalled:
+                break
+        last = imbalance
         s, u = plane.law.commit(plane, s1, u1), u1
-        settled = move < settle and c <= _C_SETTLED
-        if move < 0.25 * bound:
-            c *= 0.25
-    why = "stalled (the sub-steps that converge no longer move)" if stalled else "did not settle"
+        settled = move < settle and c.max() <= _C_SETTLED
+        lowered = (move < 0.25 * bound) & (0.25 * c >= floor)
+        c = np.where(lowered, 0.25 * c, c)
+    why = "stalled (the sub-steps that converge no longer move)" if stalled else \
+        f"did not settle within {_BUDGET} times the path's iteration cap" if spent else "did not settle"
     fail = StepFailure(f"the damped motion across the instability {why} ({its} Newton "
                        "iterations); likely cause: a friction bound falling with the slip faster "
                        "than the damping can hold", history, indefinite=True)

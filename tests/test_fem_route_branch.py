@@ -138,3 +138,17 @@ def test_a_branch_that_stops_says_where_and_why(model):
     where += f" u = {last.u_m * 1e3:.4g} mm, N = {last.N / sealed.state.N:.4g} N0: "
     assert b.reason.startswith(where), b.reason
     assert "Newton" in b.reason
+
+
+def test_coulomb_at_large_mu_leaves_the_sealed_state_in_equilibrium(model):
+    """Coulomb at mu = 10: the plate's rise at N0 from the sealed state crosses a seal node on
+    the edge of the friction cone, where the undamped step has no stick/slide set (Klarbring);
+    the damped motion ends at rest there (`fem.newton.out_of_balance`). Followed to u = 4 mm,
+    every state pulls F1 and balances plate, contact pressure and suction, N rises, and the
+    work balance leaves a dissipation >= 0."""
+    cup, b = _branch(model, ContactLaw("coulomb", 10.0), u_min_m=4.0e-3)
+    assert b.reason == "u_min" and len(b.states) >= 5
+    _holds_and_balances(cup, b)
+    D, scale = work_balance(cup, b)
+    print(f"coulomb 10: D = {D:.4g} J of {scale:.4g} J, {len(b.states)} states")
+    assert D >= -1e-4 * scale
