@@ -7,7 +7,7 @@ step, raises the public `fem.solver.ConvergenceError` with its cause and history
 
 from __future__ import annotations
 
-__all__ = ["StepFailure"]
+__all__ = ["StepFailure", "NoContactSet"]
 
 
 class StepFailure(Exception):
@@ -18,3 +18,9 @@ class StepFailure(Exception):
     def __init__(self, cause: str, history: list[float], indefinite: bool = False):
         super().__init__(cause)
         self.cause, self.history, self.indefinite = cause, history, indefinite
+
+
+class NoContactSet(StepFailure):
+    """Coulomb's linearized contact problem found no stick/slide set, iteration after iteration:
+    the incremental frictional problem has no solution at this step (Klarbring), which damping
+    the slip restores (`fem.newton.relax_step`)."""

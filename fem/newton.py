@@ -26,13 +26,12 @@ from dataclasses import replace
 import numpy as np
 
 from .contact_step import ContactStep
-from .failure import StepFailure
+from .failure import NoContactSet, StepFailure
 from .linesearch import line_search, total_potential
 
 __all__ = ["newton_step", "relax_step", "balanced", "creeping", "largest_move", "largest_slip", "SLIP",
            "out_of_balance", "slip_metric"]
 
-_NO_SET = "Coulomb's linearized contact problem found no stick/slide set"
 _STALLED = 12           # Newton iterations in a row whose linearized frictional problem found no set
 _CREEP = 20             # Newton iterations of a coupled (Coulomb) step in which the residual must halve
 
@@ -90,9 +89,9 @@ def _iterate(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, pol
         indefinite |= shift > 0.0
         stalled = 0 if getattr(step, "solvable", True) else stalled + 1
         if stalled >= stall:
-            raise StepFailure(f"{_NO_SET} in {stalled} iterations in a row; likely cause: a friction "
-                              "bound falling with the slip faster than the elastic drive grows (no "
-                              "quasi-static solution)", history)
+            raise NoContactSet(f"Coulomb's linearized contact problem found no stick/slide set in {stalled} "
+                               "iterations in a row; likely cause: a friction bound falling with the slip "
+                               "faster than the elastic drive grows (no quasi-static solution)", history)
         flags["indefinite"] = indefinite
         energy = abs(step.du @ res)
         e_ref = f_ref * max(np.max(np.abs(u)), np.max(np.abs(step.du)), 1e-9 * _size(mech))
@@ -315,7 +314,7 @@ def relax_step(mech, dirichlet, f_ext, plane, state, u_start, t, opts, solver, p
             if c.max() >= _C_MAX or stalled or spent:
                 break
             # no stick/slide set (Klarbring): the slip needs damping; else the body does
-            which = np.array([False, True]) if fail.cause.startswith(_NO_SET) else np.array([True, False])
+            which = np.array([False, True]) if isinstance(fail, NoContactSet) else np.array([True, False])
             floor = np.where(lowered & which, 4.0 * c, floor)   # the least damping known to converge
             c, lowered = np.where(which, 4.0 * c, c), np.zeros(2, bool)
             continue

@@ -335,14 +335,15 @@ class GasMechanics:
         return self.evaluate(u)[1:]
 
     def evaluate(self, u: np.ndarray) -> tuple[float, np.ndarray, GasTangent]:
-        V, (dofs, grad), hess, pairs = self.cavity.derivatives(self.coordinates(u))
+        x = self.coordinates(u)
+        V, (dofs, grad), hess, pairs = self.cavity.derivatives(x)
         Pi_gas = self.gas.potential_J(V)
         dp = self.gas.p_a_Pa - self.gas.pressure_Pa(V)
         W, r, K = self.body.evaluate(u)
         g = np.bincount(dofs, grad, minlength=r.size)
         data = self._load.add_hessian(K, pairs, hess, dp)
         T = GasTangent.of(K, data, self.gas.NkT_J / V**2, g)
-        T.chain_cut = ChainCut(self.cavity, self.coordinates(u), dp)
+        T.chain_cut = ChainCut(self.cavity, x, dp)
         return W + Pi_gas, r + dp * g, T
 
 

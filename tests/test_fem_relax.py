@@ -11,7 +11,7 @@ import pytest
 import scipy.sparse as sp
 
 import fem.newton as newton
-from fem.failure import StepFailure
+from fem.failure import NoContactSet, StepFailure
 from fem.solver import SolverOptions
 
 N_DOFS, BOUND = 4, 1e-4         # dofs, the largest node move of a sub-step [m]
@@ -112,7 +112,7 @@ def test_a_motion_at_rest_where_the_undamped_step_has_no_solution_ends_there(mon
 
     def sub_step(c, u):
         if c is None:
-            raise StepFailure(newton._NO_SET, [1.0] * 4)
+            raise NoContactSet("no stick/slide set", [1.0] * 4)
         du = next(moves)
         u1 = u + np.array([du, du, du, 0.0])
         return u1, 2, np.array([1e4 * du, 1e4 * du, 1e4 * du, 1.0])   # 1 N: the plate's reaction
@@ -132,10 +132,10 @@ def test_a_sub_step_without_a_stick_slide_set_raises_the_slip_damping(monkeypatc
 
     def newton_step(body, dirichlet, f_ext, plane, s, u, t, opts, solver, policy, stall):
         if not isinstance(body, newton._Damped):
-            raise StepFailure(newton._NO_SET, [1.0] * 4)
+            raise NoContactSet("no stick/slide set", [1.0] * 4)
         weights.append(body.weight.copy())
         if body.weight[0] - body.weight[1] < 10.0 * 4.0:    # the slip's damping: mu c_s metric
-            raise StepFailure(newton._NO_SET, [1.0] * 4)
+            raise NoContactSet("no stick/slide set", [1.0] * 4)
         du = 1e-3 * BOUND * 0.5 ** len(weights)
         u1 = u + np.array([0.0, 0.0, du, 0.0])
         return u1, body.weight * (u1 - u) + np.array([0.0, 1e4 * du, 0.0, 1.0]), s, 1, False
