@@ -61,7 +61,7 @@ def u_leads(tangent) -> bool:
 def seal_open(cup: CupWithGas, s: "Trial") -> bool:
     """Whether no node of the cavity chain is on the plane (the cavity is open to the outside)."""
     x = cup.mesh.doflocs + np.stack([s.step.u[0::2], s.step.u[1::2]])
-    return not np.any(x[1, cup.cavity.nodes] <= cup.cavity.tolerance_m)
+    return not np.any(cup.cavity.on_plane(x))
 
 
 class _Crossed(ConvergenceError):

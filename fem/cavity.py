@@ -112,17 +112,26 @@ class CavitySurface:
         size = float(np.max(np.ptp(mesh.doflocs, axis=1)))
         return cls(nodes, 1e-12 * size, float(wetting_m))
 
+    def on_plane(self, x: np.ndarray) -> np.ndarray:
+        """Whether each chain node lies on the plane at the deformed coordinates x [n]."""
+        return x[1, self.nodes] <= self.tolerance_m
+
     def seal_index(self, x: np.ndarray) -> int:
         """Position along the chain of the first node on the plane, the seal (the last node if
         none is)."""
-        on = np.flatnonzero(x[1, self.nodes] <= self.tolerance_m)
+        on = np.flatnonzero(self.on_plane(x))
         return int(on[0]) if on.size else self.nodes.size - 1
 
     def cut_index(self, x: np.ndarray) -> int:
         """Position of the last node on the plane, the outer end of the outermost contact: the
         load acts on the chain up to here (module docstring); the last node if none is."""
-        on = np.flatnonzero(x[1, self.nodes] <= self.tolerance_m)
-        return int(on[-1]) if on.size else self.nodes.size - 1
+        return self.cut_of(self.on_plane(x))
+
+    def cut_of(self, on: np.ndarray) -> int:
+        """The cut of a chain whose nodes `on` lie on the plane: the last of them, else the
+        chain's end (`cut_index`)."""
+        at = np.flatnonzero(on)
+        return int(at[-1]) if at.size else self.nodes.size - 1
 
     def seal_radius(self, x: np.ndarray) -> float:
         """r_k: the deformed radius of the seal node [m]."""
@@ -255,7 +264,7 @@ class ChainCut:
 
     def on_plane(self) -> np.ndarray:
         """Whether each chain node is on the plane at the iterate [n]."""
-        return self.x[1, self.surface.nodes] <= self.surface.tolerance_m
+        return self.surface.on_plane(self.x)
 
     def positions(self, nodes: np.ndarray) -> np.ndarray:
         """The chain positions of mesh `nodes` (-1: not on the chain)."""
@@ -264,9 +273,8 @@ class ChainCut:
         return where[nodes]
 
     def cut_of(self, on: np.ndarray) -> int:
-        """The cut of the chain nodes `on` the plane: the last of them, else the chain's end."""
-        at = np.flatnonzero(on)
-        return int(at[-1]) if at.size else self.surface.nodes.size - 1
+        """The cut of the chain nodes `on` the plane (`CavitySurface.cut_of`)."""
+        return self.surface.cut_of(on)
 
     @cached_property
     def _gradient(self) -> np.ndarray:

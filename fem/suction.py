@@ -364,7 +364,7 @@ def _measured(state: StepResult, mech, cup: CupSetup, cavity: CavitySurface) -> 
     """`_outputs`, whether the state is sealed (module docstring: a node of the cavity chain on
     the plane) and the plane's reactions at its held nodes (`fem.contact.RigidPlane.held_reactions`)."""
     x = mech.kin.node_coordinates() + np.stack([state.u[0::2], state.u[1::2]])
-    return (*_outputs(state, mech, cup, cavity), bool(np.any(x[1, cavity.nodes] <= cavity.tolerance_m)),
+    return (*_outputs(state, mech, cup, cavity), bool(np.any(cavity.on_plane(x))),
             cup.plane.held_reactions(state))
 
 
