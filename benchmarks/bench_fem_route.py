@@ -166,7 +166,8 @@ def _one(model, cup, level, law, du, F, t_press, largest, jsonl, press=None, par
     row = {"level": level, "law": law, "du_mm": 1e3 * du, "F1_N": F, "largest_N": largest,
            "largest_lower_bound": partial is not None, "press_u_mm": None if press is None else 1e3 * press.value}
     try:
-        life = reduced.solve_lifetime(model, F, route="fem", cup=cup, du_m=du, press=press)
+        life = reduced.solve_lifetime(model, F, route="fem", cup=cup, du_m=du, press=press,
+                                      largest=math.isfinite(largest) or partial is not None)
     except (FemRouteError, RuntimeError) as err:
         wall = time.perf_counter() - t0
         print(f"| {level} | {law} | {1e3 * du:g} | {F:g} | failed | {str(err)[:90]} | | | | | "

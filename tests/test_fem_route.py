@@ -67,6 +67,29 @@ def test_bad_options_name_the_field(model):
         Press("depth", 1.0)
     with pytest.raises(ValueError, match="^du_m: "):
         lifetimes(model, [10.0], "fem", cup=FemCup(), du_m=-1.0)
+    with pytest.raises(ValueError, match="^largest: "):
+        lifetimes(model, [10.0], "fem", cup=FemCup(), largest="no")
+
+
+def test_the_largest_force_is_computed_only_when_asked(model, monkeypatch):
+    """largest=False: no largest pull run (it would raise here), the result says it was not
+    computed instead of a bare NaN, and the lifetime is the one computed with it (a press of
+    its own, so no cached pull of another test answers)."""
+    import fem.gas_pull
+
+    cup, press = FemCup("A", "coarse"), Press("r_start_m", 12.1e-3)
+    with monkeypatch.context() as m:
+        m.setattr(fem.gas_pull, "largest_pull_checked", _refuse)
+        life = reduced.solve_lifetime(model, 10.0, route="fem", cup=cup, press=press, largest=False)
+        with pytest.raises(AssertionError, match="largest pull ran"):
+            reduced.solve_lifetime(model, 10.0, route="fem", cup=cup, press=press)
+    assert math.isnan(life.largest_force_N) and "not computed" in life.details["largest_force"]
+    full = reduced.solve_lifetime(model, 10.0, route="fem", cup=cup, press=press)
+    assert full.lifetime_s == life.lifetime_s and full.largest_force_N > 10.0
+
+
+def _refuse(*args, **kwargs):
+    raise AssertionError("the largest pull ran")
 
 
 def test_coulomb_run_completes(model):

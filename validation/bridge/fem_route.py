@@ -129,10 +129,12 @@ class Sealed:
 class FemRoute:
     """The route "fem" (module docstring). Options: cup (a `FemCup`, required), press (a `Press`;
     None: the model's r_start), du_m (the plate step along the branch [m]), radial (the rings'
-    geometry, `reduced.profile_leak`)."""
+    geometry, `reduced.profile_leak`), largest (whether the lifetime also reports the largest
+    pull the sealed cup holds, `fem.gas_pull`: often the larger part of the cost; False leaves
+    largest_force_N NaN and says so in the details)."""
 
     name = "fem"
-    options = {"cup": None, "press": None, "du_m": DEFAULT_DU_M, "radial": "annulus"}
+    options = {"cup": None, "press": None, "du_m": DEFAULT_DU_M, "radial": "annulus", "largest": True}
 
     def __init__(self) -> None:
         self._sealed: dict[tuple, Sealed] = {}
@@ -152,6 +154,8 @@ class FemRoute:
         du = options["du_m"]
         if not (isinstance(du, (int, float)) and math.isfinite(du) and du > 0):
             raise ValueError(f"du_m: the plate step must be a number > 0 m, got {du!r}")
+        if not isinstance(options["largest"], bool):
+            raise ValueError(f"largest: expected True or False, got {options['largest']!r}")
         if options["radial"] not in ("annulus", "strip"):
             raise ValueError(f"radial: expected 'annulus' or 'strip', got {options['radial']!r}")
         if model.u_c is None:
@@ -206,7 +210,7 @@ class FemRoute:
         branch = (water_branch if water else equilibrium_branch)(
             sealed.cup, sealed.state, float(force_N), du_m=float(options["du_m"]),
             progress=_branch_progress(run.progress, force_N, sealed, "V_w" if water else "N"))
-        largest, partial = self._largest_checked(model, options)
+        largest, partial = self._largest_checked(model, options) if options["largest"] else (math.nan, None)
         s0 = sealed.state
         provenance = {"route": self.name, "options": {**options, "cup": options["cup"].describe(),
                                                        "press": options["press"] and vars(options["press"])},
@@ -218,6 +222,8 @@ class FemRoute:
                 "seal_r_sealed_mm": 1e3 * s0.seal_r_m, "branch_reason": branch.reason}
         if partial is not None:       # the pull was still rising where the solver stopped
             base["largest_force_lower_bound"] = partial
+        if not options["largest"]:
+            base["largest_force"] = "not computed (largest=False)"
         if branch.reason == "not held":
             return Lifetime(reason="over_force", lifetime_s=0.0, message=f"F1 = {force_N:g} N exceeds "
                             f"what the sealed cup holds: it detaches at once", trajectory={},
