@@ -47,7 +47,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .cavity import CavitySurface, ChainCut, PressurizedMechanics
+from .cavity import CavitySurface, PressurizedMechanics
+from .chain_cut import ChainCut
 from .condensation import make_solver
 from .contact import RigidPlane
 from .forms import Mechanics

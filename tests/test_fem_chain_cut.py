@@ -1,4 +1,4 @@
-"""The cavity load's jump where the contact's outer end moves (`fem.cavity.ChainCut`), against the
+"""The cavity load's jump where the contact's outer end moves (`fem.chain_cut.ChainCut`), against the
 gas mechanics' own residual, and the Coulomb Newton iteration that carries it: the outer end of
 the seal peels (or lands) in one iteration instead of one node per iteration."""
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import fem.gas_pull as gas_pull
-from fem.cavity import ChainCut
+from fem.chain_cut import ChainCut
 from fem.interface import ContactLaw
 from fem.trapped_gas import GasMechanics, TrappedGas
 from reduced.cup import CUPS

@@ -11,7 +11,7 @@ import pytest
 import scipy.sparse as sp
 
 from fem.condensation import _scatter_matrix
-from fem.friction import _rows
+from fem.friction_condensed import _rows
 from fem.newton import creeping
 from fem.trapped_gas import GasTangent
 
@@ -36,7 +36,7 @@ def test_scatter_matrix_sums_like_bincount_bit_for_bit(m):
 
 
 def test_rank_one_rows_equal_the_rows_of_the_whole_gas_tangent():
-    """`fem.friction._rows` of a gas tangent K_s + c g g^T: its dense rows and its products with
+    """`fem.friction_condensed._rows` of a gas tangent K_s + c g g^T: its dense rows and its products with
     columns equal those of the whole tangent (its product with the identity); a plain tangent's
     rows are its slices."""
     rng = np.random.default_rng(3)
@@ -78,14 +78,14 @@ def frictional_iterate():
     """The arguments of a Coulomb Newton iteration's condensed problem (coarse cup A, mu 0.5,
     pressed to 0.35 h1, solved with whole solves, so that it does not depend on `solve_at`): the
     first with more than four held nodes, some of them sliding."""
-    import fem.friction as friction
+    import fem.friction_condensed as condensed
     from fem.cup import compress_cup
     from fem.geometry import cup_geometry
     from fem.material import NeoHookean
     from fem.mesh import cup_mesh
 
     kept = {}
-    init = friction._Condensed.__init__
+    init = condensed.CondensedProblem.__init__
 
     def record(self, plane, old, u, res0, K, fac, du0, held, tol):
         if "args" not in kept and len(held) > 4 and np.any(old.slip[held] != 0):
@@ -93,12 +93,12 @@ def frictional_iterate():
         init(self, plane, old, u, res0, K, _WholeSolves(fac), du0, held, tol)
 
     geometry = cup_geometry("A")
-    friction._Condensed.__init__ = record
+    condensed.CondensedProblem.__init__ = record
     try:
         compress_cup(cup_mesh(geometry, "coarse"), NeoHookean(), contact="coulomb", friction=0.5,
                      u_max_m=0.35 * geometry.h1_m)
     finally:
-        friction._Condensed.__init__ = init
+        condensed.CondensedProblem.__init__ = init
     return kept["args"]
 
 
@@ -186,7 +186,7 @@ def test_condensed_problem_with_solve_at_equals_the_plain_one(frictional_iterate
     the linearized conditions on the whole tangent; also with a rank-one gas term whose g lies on
     the contact rows and elsewhere, and after free nodes join (a larger support)."""
     from fem.condensation import make_solver
-    from fem.friction import _Condensed
+    from fem.friction_condensed import CondensedProblem
     from fem.trapped_gas import RankOneSolver
 
     plane, old, u, res0, K, fac, du0, held, tol = frictional_iterate
@@ -200,8 +200,8 @@ def test_condensed_problem_with_solve_at_equals_the_plain_one(frictional_iterate
     gfac = RankOneSolver(make_solver(K, plane.kin.node_coordinates(), plane.kin.mesh)).factor(gas, fac.free)
     cases.append((gas, gfac, gfac.solve(-res0)))
     for K_, f, d0 in cases:
-        a = _Condensed(plane, old, u, res0, K_, f, d0, held, tol)
-        b = _Condensed(plane, old, u, res0, K_, _WholeSolves(f), d0, held, tol)
+        a = CondensedProblem(plane, old, u, res0, K_, f, d0, held, tol)
+        b = CondensedProblem(plane, old, u, res0, K_, _WholeSolves(f), d0, held, tol)
         for sub in (a, b):
             sub.ssn()
         assert a.converged and b.converged
