@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .contact import ContactState
 from .gas_path import CupWithGas, GasState
 from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
@@ -124,6 +125,9 @@ class Walk:
         self.predict_from: Trial | None = None
         # only a law without a history (frictionless) starts its trials predicted (`_predictor`)
         self.predicts = bool(cup.cup.plane.law.conservative)
+        # Coulomb (incremental: its history is the last state's anchors) predicts only the trials
+        # that correct another trial from the same state (`_corrects`)
+        self.incremental = cup.cup.plane.law.name == "coulomb"
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
         self.tolerance = cup.options.rtol * cup.p_a_Pa * math.pi * rim**2
@@ -168,6 +172,7 @@ class Walk:
             last.append(step)
             if stop_at_crossing and self.relaxes and step.unstable:
                 raise _Crossed("the path crossed an instability")
+        corrects = self._corrects(start)
         try:
             stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=self._start(start),
                                     options=options or self.options, on_step=on_step,
@@ -176,8 +181,15 @@ class Walk:
             stats = stop.stats
         except ConvergenceError as err:         # the cost of a failed trial counts too
             self._count(err.stats)
+            if corrects:
+                return self._unpredicted(start, u_m, N, options)
             raise
         self._count(stats)
+        if corrects and (len(last) < 2 or np.any(last[-1].contact.active & ~start.step.contact.active)
+                         or any(st.unstable for st in last)):
+            # a node landed (its anchor is the path's touchdown), or the path crossed an
+            # instability from the last trial's state: solved again from `start` alone
+            return self._unpredicted(start, u_m, N, options)
 
         def trial(step: StepResult, f: float) -> Trial:
             at_end = f >= 1.0
@@ -190,6 +202,13 @@ class Walk:
             return replace(end, crossed=end if crossed is last[-1] else trial(crossed, crossed.t))
         return end
 
+    def _unpredicted(self, start: Trial, u_m: float, N: float, options) -> Trial:
+        base, self.predict_from = self.predict_from, None
+        try:
+            return self.solve(start, u_m, N, options)
+        finally:
+            self.predict_from = base
+
     def _solve_from(self, base: Trial, start: Trial, u_m: float, N: float, options=None) -> Trial:
         """`solve` with its Newton starts predicted by `base`'s linear response (`_predictor`)."""
         self.predict_from = base
@@ -201,11 +220,30 @@ class Walk:
     def _start(self, start: Trial) -> StepResult:
         """The path's start state: `start`'s, with the contact set of `predict_from` where the law
         carries no history (frictionless: the state does not depend on the path, and the Newton
-        then starts from the predicting state's contact set as from its displacement)."""
+        then starts from the predicting state's contact set as from its displacement); Coulomb's
+        correcting trials (`_corrects`) start from the last trial's stick/slide set with
+        `start`'s anchors (its history)."""
         base = self.predict_from
-        if not self.predicts or base is None or base is start or base not in self.responses:
+        if base is None or base is start or base not in self.responses:
             return start.step
-        return replace(start.step, contact=base.step.contact)
+        if self.predicts:
+            return replace(start.step, contact=base.step.contact)
+        if self._corrects(start):
+            held, set_ = start.step.contact, base.step.contact
+            return replace(start.step, contact=ContactState(set_.active, held.u_r_stick_m, set_.slip))
+        return start.step
+
+    def _corrects(self, start: Trial) -> bool:
+        """Whether a trial of an incremental law (Coulomb) starts from the last trial
+        (`predict_from`, reached from the same `start` to a nearby end, whose linear response is
+        known): its displacement moved by that response, its stick/slide set, `start`'s anchors.
+        Only where the last trial let go of nodes and landed none: a landing node's anchor (its
+        touchdown) is the path's, not the last trial's; where the trial still lands one, it is
+        solved again from `start` (`solve`)."""
+        base = self.predict_from
+        if not self.incremental or base is None or base is start or base not in self.responses:
+            return False
+        return not np.any(base.step.contact.active & ~start.step.contact.active)
 
     def _predictor(self, start: Trial, u_m: float, N: float):
         """Each load step's first Newton iterate on the line from `start` to (u_m, N): the linear
@@ -216,7 +254,7 @@ class Walk:
         sets, and a predicted start moved a lifetime by more than the step error, and cost more."""
         base = self.predict_from
         response = self.responses.get(base) if base is not None else None
-        if response is None or not self.predicts:
+        if response is None or not (self.predicts or self._corrects(start)):
             return None
         x_N, x_u = response
         u0, N0 = start.u_m, start.N
