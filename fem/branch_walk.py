@@ -26,6 +26,7 @@ from .trapped_gas import GasMechanics, follow_gas_path
 __all__ = ["Branch", "Walk", "Trial", "Jump", "STICKING_STEPS", "seal_open", "u_leads"]
 
 STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
+PREDICTED_ITERATIONS = 4  # Newton iterations of a Coulomb trial started from the last trial (`Walk._corrects`)
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,6 +70,14 @@ class _Crossed(ConvergenceError):
     """Stops a trial's path at the first instability it crosses (`Walk.solve`)."""
 
 
+class _Contradiction(Exception):
+    """Two trials of an F1 root, one started from another trial, contradict a monotone F1(x)."""
+
+
+def _x(s: "Trial", k: int) -> float:
+    return s.N if k == 0 else s.u_m
+
+
 class Jump(RuntimeError):
     """The pull jumps across F1 between two states close together in N or u (module docstring)."""
 
@@ -86,6 +95,7 @@ class Trial:
     F1_N: float
     step: StepResult
     crossed: "Trial | None" = None   # the state after the first instability its path crossed
+    predicted: bool = False          # started from another trial (`Walk._corrects`)
 
 
 class Walk:
@@ -128,6 +138,7 @@ class Walk:
         # Coulomb (incremental: its history is the last state's anchors) predicts only the trials
         # that correct another trial from the same state (`_corrects`)
         self.incremental = cup.cup.plane.law.name == "coulomb"
+        self.predicting = True
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
         self.tolerance = cup.options.rtol * cup.p_a_Pa * math.pi * rim**2
@@ -157,7 +168,7 @@ class Walk:
         """The state at (u_m, N), reached from `start` with the plate and N on a line; its
         `crossed` is the state after the first instability the path crossed by damped motion
         (a law that `relaxes`), where the path stops while `stop_at_crossing` is set (`_root`)."""
-        stop_at_crossing = self.stop_at_crossing
+        stop_at_crossing, caller_options = self.stop_at_crossing, options
         u0, N0 = start.u_m, start.N
         mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
                             schedule=lambda t: N0 + t * (N - N0), relaxes=True)
@@ -173,23 +184,26 @@ class Walk:
             if stop_at_crossing and self.relaxes and step.unstable:
                 raise _Crossed("the path crossed an instability")
         corrects = self._corrects(start)
+        options = options or self.options
+        if corrects:            # one step, given up early: it is solved again from `start` alone
+            options = replace(options, max_iterations=min(options.max_iterations, PREDICTED_ITERATIONS),
+                              min_step=1.0)
         try:
             stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=self._start(start),
-                                    options=options or self.options, on_step=on_step,
+                                    options=options, on_step=on_step,
                                     predict=self._predictor(start, u_m, N))
         except _Crossed as stop:
             stats = stop.stats
         except ConvergenceError as err:         # the cost of a failed trial counts too
             self._count(err.stats)
             if corrects:
-                return self._unpredicted(start, u_m, N, options)
+                return self._unpredicted(start, u_m, N, caller_options)
             raise
         self._count(stats)
-        if corrects and (len(last) < 2 or np.any(last[-1].contact.active & ~start.step.contact.active)
-                         or any(st.unstable for st in last)):
-            # a node landed (its anchor is the path's touchdown), or the path crossed an
-            # instability from the last trial's state: solved again from `start` alone
-            return self._unpredicted(start, u_m, N, options)
+        if corrects and not self._same_set(last):
+            # the set changed (a node landed, one more let go, a slide turned): another solution
+            # of the step may have been found than the one `start` leads to; solved again from it
+            return self._unpredicted(start, u_m, N, caller_options)
 
         def trial(step: StepResult, f: float) -> Trial:
             at_end = f >= 1.0
@@ -197,10 +211,18 @@ class Walk:
                           float(N if at_end else N0 + f * (N - N0)),
                           float(np.sum(step.r_int[2 * top + 1])), step)
         crossed = next((st for st in last if st.unstable), None) if self.relaxes else None
-        end = trial(last[-1], last[-1].t)
+        end = replace(trial(last[-1], last[-1].t), predicted=corrects)
         if crossed is not None:
             return replace(end, crossed=end if crossed is last[-1] else trial(crossed, crossed.t))
         return end
+
+    def _same_set(self, path: list[StepResult]) -> bool:
+        """Whether a predicted trial's path (`_corrects`) ended on its start's stick/slide set
+        (the last trial's) in one stable step."""
+        if len(path) != 2 or path[-1].unstable:
+            return False
+        a, b = path[0].contact, path[-1].contact
+        return bool(np.array_equal(a.active, b.active) and np.array_equal(a.slip, b.slip))
 
     def _unpredicted(self, start: Trial, u_m: float, N: float, options) -> Trial:
         base, self.predict_from = self.predict_from, None
@@ -241,7 +263,8 @@ class Walk:
         touchdown) is the path's, not the last trial's; where the trial still lands one, it is
         solved again from `start` (`solve`)."""
         base = self.predict_from
-        if not self.incremental or base is None or base is start or base not in self.responses:
+        if not (self.incremental and self.predicting) or base is None or base is start \
+                or base not in self.responses:
             return False
         return not np.any(base.step.contact.active & ~start.step.contact.active)
 
@@ -283,8 +306,27 @@ class Walk:
     def _root(self, prev: Trial, u_m: float, N: float, k: int) -> Trial:
         """F1(x) = F1 for x = N at the plate u_m (k = 0) or x = u at N (k = 1), every trial
         reached from prev: Newton with the exact dF1/dx, the secant where it does not halve the
-        mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`)."""
+        mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`).
+        Coulomb's corrections start from the last trial (`_corrects`); where a trial so started
+        and another contradict an F1 monotone in x (the sign of dF1/dx at prev), or the root
+        fails, the step from prev has more than one solution and the started trial may have found
+        another than prev's: the root is found again with every trial started at prev."""
+        trials: list[Trial] = []
+        try:
+            return self._root_from(prev, u_m, N, k, trials)
+        except (RuntimeError, _Contradiction):
+            if not any(t.predicted for t in trials):
+                raise
+        self.predicting = False
+        try:
+            return self._root_from(prev, u_m, N, k, [])
+        finally:
+            self.predicting = True
+
+    def _root_from(self, prev: Trial, u_m: float, N: float, k: int, trials: list[Trial]) -> Trial:
+        """`_root`'s search; every trial is appended to `trials`."""
         name = "N" if k == 0 else "the plate position"
+        sign = np.sign(self.derivatives(prev)[k]) if self.incremental and self.predicting else 0.0
 
         def at(x, base=prev):
             self.stop_at_crossing, self.predict_from = True, base
@@ -293,9 +335,13 @@ class Walk:
                     self.solve(prev, x, N, self.trial_options)
             finally:
                 self.stop_at_crossing, self.predict_from = False, None
+            trials.append(s)
             if s.crossed is not None:       # the cup meets an instability on the way: it jumps
                 raise Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
                             f"crossed on the way to {name} {x:.6g}", instability=True)
+            if sign and any((t.predicted or s.predicted) and
+                            sign * (_x(s, k) - _x(t, k)) * (s.F1_N - t.F1_N) < 0.0 for t in trials[:-1]):
+                raise _Contradiction()
             return s
         x0, x_prev = (N, prev.N) if k == 0 else (u_m, prev.u_m)
         s = at(x0)
