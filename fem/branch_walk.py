@@ -317,11 +317,11 @@ class Walk:
         except (RuntimeError, _Contradiction):
             if not any(t.predicted for t in trials):
                 raise
-        self.predicting = False
+        was, self.predicting = self.predicting, False
         try:
             return self._root_from(prev, u_m, N, k, [])
         finally:
-            self.predicting = True
+            self.predicting = was
 
     def _root_from(self, prev: Trial, u_m: float, N: float, k: int, trials: list[Trial]) -> Trial:
         """`_root`'s search; every trial is appended to `trials`."""
