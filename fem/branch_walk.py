@@ -6,7 +6,11 @@ the fold and the seal's opening located between two states; the branch measured.
 
 The sensitivities dF1/dN and dF1/du are the linear response of a converged state at the held
 plate (`fem.branch_slopes`). With the frictionless law, that response (du/dN, du/du_plate,
-`linear_response`) also gives each trial's first Newton iterate (`Walk._predictor`).
+`linear_response`) also gives each trial's first Newton iterate (`Walk._predictor`). Coulomb's
+trials are solved from the last state of the branch (its anchors are the step's history), and
+the first trial of an F1 root from there as Newton goes; its corrections start from that trial's
+state and stick/slide set, moved by its response (`Walk._corrects`: 0-1 Newton iterations
+instead of 4), and are checked against the step's other solution (`Walk._root`).
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from .trapped_gas import GasMechanics, follow_gas_path
 __all__ = ["Branch", "Walk", "Trial", "Jump", "STICKING_STEPS", "seal_open", "u_leads"]
 
 STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
-PREDICTED_ITERATIONS = 4  # Newton iterations of a Coulomb trial started from the last trial (`Walk._corrects`)
+PREDICTED_ITERATIONS = 4  # Newton iterations of a Coulomb trial started from another (`Walk._corrects`)
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,6 +79,7 @@ class _Contradiction(Exception):
 
 
 def _x(s: "Trial", k: int) -> float:
+    """The unknown of an F1 root (`Walk._root`): N (k = 0) or the plate position (k = 1)."""
     return s.N if k == 0 else s.u_m
 
 
@@ -136,7 +141,7 @@ class Walk:
         # only a law without a history (frictionless) starts its trials predicted (`_predictor`)
         self.predicts = bool(cup.cup.plane.law.conservative)
         # Coulomb (incremental: its history is the last state's anchors) predicts only the trials
-        # that correct another trial from the same state (`_corrects`)
+        # that correct another trial from the same state (`_corrects`; off in `_root`'s second try)
         self.incremental = cup.cup.plane.law.name == "coulomb"
         self.predicting = True
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
@@ -225,6 +230,7 @@ class Walk:
         return bool(np.array_equal(a.active, b.active) and np.array_equal(a.slip, b.slip))
 
     def _unpredicted(self, start: Trial, u_m: float, N: float, options) -> Trial:
+        """`solve` from `start` alone (no started Newton iterate)."""
         base, self.predict_from = self.predict_from, None
         try:
             return self.solve(start, u_m, N, options)
@@ -259,9 +265,10 @@ class Walk:
         """Whether a trial of an incremental law (Coulomb) starts from the last trial
         (`predict_from`, reached from the same `start` to a nearby end, whose linear response is
         known): its displacement moved by that response, its stick/slide set, `start`'s anchors.
-        Only where the last trial let go of nodes and landed none: a landing node's anchor (its
-        touchdown) is the path's, not the last trial's; where the trial still lands one, it is
-        solved again from `start` (`solve`)."""
+        Only where the last trial landed no node (it may have let some go): a landing node's
+        anchor (its touchdown) is the path's, not the last trial's. `solve` takes the trial only
+        on that set in one step of at most PREDICTED_ITERATIONS, else solves it again from
+        `start` alone; `_root` checks the roots so found against the others' trials."""
         base = self.predict_from
         if not (self.incremental and self.predicting) or base is None or base is start \
                 or base not in self.responses:
@@ -273,8 +280,10 @@ class Walk:
         response of `predict_from` (a state whose slopes are known, e.g. the last trial of an F1
         root) to the change of plate and N, from that state for the first step and from the last
         converged one after it; None (Newton from the last converged state) without one, and for
-        a law with a history (sticking, Coulomb): there the iterate picks among the stick/slide
-        sets, and a predicted start moved a lifetime by more than the step error, and cost more."""
+        a law with a history (sticking, Coulomb) from `start` itself: there the iterate picks
+        among the stick/slide sets, and a predicted start moved a lifetime by more than the step
+        error, and cost more. Coulomb's corrections of a trial start from that trial
+        (`_corrects`): the same step's solution nearby, on its set."""
         base = self.predict_from
         response = self.responses.get(base) if base is not None else None
         if response is None or not (self.predicts or self._corrects(start)):
@@ -326,7 +335,6 @@ class Walk:
     def _root_from(self, prev: Trial, u_m: float, N: float, k: int, trials: list[Trial]) -> Trial:
         """`_root`'s search; every trial is appended to `trials`."""
         name = "N" if k == 0 else "the plate position"
-        sign = np.sign(self.derivatives(prev)[k]) if self.incremental and self.predicting else 0.0
 
         def at(x, base=prev):
             self.stop_at_crossing, self.predict_from = True, base
@@ -339,9 +347,10 @@ class Walk:
             if s.crossed is not None:       # the cup meets an instability on the way: it jumps
                 raise Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
                             f"crossed on the way to {name} {x:.6g}", instability=True)
-            if sign and any((t.predicted or s.predicted) and
-                            sign * (_x(s, k) - _x(t, k)) * (s.F1_N - t.F1_N) < 0.0 for t in trials[:-1]):
-                raise _Contradiction()
+            if s.predicted:     # dF1/dx of the first trial (from prev, known: it was corrected)
+                sign = np.sign(self.derivatives(trials[0])[k])
+                if any(sign * (_x(s, k) - _x(t, k)) * (s.F1_N - t.F1_N) < 0.0 for t in trials[:-1]):
+                    raise _Contradiction()
             return s
         x0, x_prev = (N, prev.N) if k == 0 else (u_m, prev.u_m)
         s = at(x0)
