@@ -1,8 +1,9 @@
 """The state-to-state machinery of the held branch (`fem.gas_branch`): a trial state reached
 from the last state of the branch with the plate and N on a line, the root of F1(u, N) = F1 in N
 (or in u) by Newton on the exact sensitivities, regula falsi on the bracket its trials found,
-and the jump of the pull where that bracket closes without a root; the plate raised at N0 to F1;
-the fold and the seal's opening located between two states; the branch measured.
+and the jump of the pull where that bracket closes without a root (`fem.branch_root`); the plate
+raised at N0 to F1; the fold and the seal's opening located between two states; the branch
+measured.
 
 The sensitivities dF1/dN and dF1/du are the linear response of a converged state at the held
 plate (`fem.branch_slopes`). With the frictionless law, that response (du/dN, du/du_plate,
@@ -10,7 +11,7 @@ plate (`fem.branch_slopes`). With the frictionless law, that response (du/dN, du
 trials are solved from the last state of the branch (its anchors are the step's history), and
 the first trial of an F1 root from there as Newton goes; its corrections start from that trial's
 state and stick/slide set, moved by its response (`Walk._corrects`: 0-1 Newton iterations
-instead of 4), and are checked against the step's other solution (`Walk._root`).
+instead of 4), and are checked against the step's other solution (`fem.branch_root`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from .contact import ContactState
 from .gas_path import CupWithGas, GasState
 from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
+from .branch_root import Jump, PullRoot, Trial
 from .branch_slopes import linear_response, sensitivities
 from .trapped_gas import GasMechanics, follow_gas_path
 
@@ -74,36 +76,7 @@ class _Crossed(ConvergenceError):
     """Stops a trial's path at the first instability it crosses (`Walk.solve`)."""
 
 
-class _Contradiction(Exception):
-    """Two trials of an F1 root, one started from another trial, contradict a monotone F1(x)."""
-
-
-def _x(s: "Trial", k: int) -> float:
-    """The unknown of an F1 root (`Walk._root`): N (k = 0) or the plate position (k = 1)."""
-    return s.N if k == 0 else s.u_m
-
-
-class Jump(RuntimeError):
-    """The pull jumps across F1 between two states close together in N or u (module docstring)."""
-
-    def __init__(self, before: "Trial", after: "Trial", message: str, instability: bool = False):
-        super().__init__(message)
-        self.before, self.after, self.instability = before, after, instability
-
-
-@dataclass(frozen=True, eq=False)
-class Trial:
-    """A converged sealed state before its measurement: plate position, N, pull, solver state."""
-
-    u_m: float
-    N: float
-    F1_N: float
-    step: StepResult
-    crossed: "Trial | None" = None   # the state after the first instability its path crossed
-    predicted: bool = False          # started from another trial (`Walk._corrects`)
-
-
-class Walk:
+class Walk(PullRoot):
     """The state-to-state machinery of `equilibrium_branch`: solves, the F1 root, the costs."""
 
     def __init__(self, cup: CupWithGas, F1_N: float):
@@ -301,110 +274,6 @@ class Walk:
     def _count(self, stats: SolverStats | None) -> None:
         if stats is not None:
             self.stats = stats if self.stats is None else _joined(self.stats, stats)
-
-    def hold(self, prev: Trial, u_m: float, N_guess: float) -> Trial:
-        """The state at plate position u_m whose pull is F1 (N by Newton on F1(N), module
-        docstring), reached from prev. Raises `Jump` where F1(N) jumps across F1."""
-        return self._root(prev, u_m, N_guess, 0)
-
-    def hold_u(self, prev: Trial, u_guess: float, N: float) -> Trial:
-        """The state at N whose pull is F1 (the plate position by Newton on F1(u)), reached
-        from prev. Raises `Jump` where F1(u) jumps across F1."""
-        return self._root(prev, u_guess, N, 1)
-
-    def _root(self, prev: Trial, u_m: float, N: float, k: int) -> Trial:
-        """F1(x) = F1 for x = N at the plate u_m (k = 0) or x = u at N (k = 1), every trial
-        reached from prev: Newton with the exact dF1/dx, the secant where it does not halve the
-        mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`).
-        Coulomb's corrections start from the last trial (`_corrects`); where a trial so started
-        and another contradict an F1 monotone in x (the sign of dF1/dx at prev), or the root
-        fails, the step from prev has more than one solution and the started trial may have found
-        another than prev's: the root is found again with every trial started at prev."""
-        trials: list[Trial] = []
-        try:
-            return self._root_from(prev, u_m, N, k, trials)
-        except (RuntimeError, _Contradiction):
-            if not any(t.predicted for t in trials):
-                raise
-        was, self.predicting = self.predicting, False
-        try:
-            return self._root_from(prev, u_m, N, k, [])
-        finally:
-            self.predicting = was
-
-    def _root_from(self, prev: Trial, u_m: float, N: float, k: int, trials: list[Trial]) -> Trial:
-        """`_root`'s search; every trial is appended to `trials`."""
-        name = "N" if k == 0 else "the plate position"
-
-        def at(x, base=prev):
-            self.stop_at_crossing, self.predict_from = True, base
-            try:
-                s = self.solve(prev, u_m, x, self.trial_options) if k == 0 else \
-                    self.solve(prev, x, N, self.trial_options)
-            finally:
-                self.stop_at_crossing, self.predict_from = False, None
-            trials.append(s)
-            if s.crossed is not None:       # the cup meets an instability on the way: it jumps
-                raise Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
-                            f"crossed on the way to {name} {x:.6g}", instability=True)
-            if s.predicted:     # dF1/dx of the first trial (from prev, known: it was corrected)
-                sign = np.sign(self.derivatives(trials[0])[k])
-                if any(sign * (_x(s, k) - _x(t, k)) * (s.F1_N - t.F1_N) < 0.0 for t in trials[:-1]):
-                    raise _Contradiction()
-            return s
-        x0, x_prev = (N, prev.N) if k == 0 else (u_m, prev.u_m)
-        s = at(x0)
-        tried: list[tuple[float, float, Trial]] = [(x0, s.F1_N - self.F1, s)]
-        for _ in range(12):
-            miss = s.F1_N - self.F1
-            if abs(miss) <= self.tolerance:
-                return s
-            x_new = tried[-1][0] - miss / self.derivatives(s)[k]
-            if len(tried) >= 2 and abs(miss) > 0.1 * abs(tried[-2][1]):   # slow: secant
-                (xa, fa, _), (xb, fb, _) = tried[-2:]
-                if fb != fa:
-                    x_new = xb - fb * (xb - xa) / (fb - fa)
-            if k == 0 and not x_new > 0.0:
-                break
-            s = at(x_new, s)
-            tried.append((x_new, s.F1_N - self.F1, s))
-        return self._bracket(at, tried, x0 - x_prev, name)
-
-    def _bracket(self, at, tried, travel: float, name: str) -> Trial:
-        """The root of F1(x) = F1 on the closest bracket among the trials (Illinois regula
-        falsi, every third trial a bisection). Where the bracket closes to 1e-3 of the trial's
-        move from the previous state without a root, F1 jumps across F1 there (a slip of the
-        sticking law, a snap): `Jump` with the states on both sides. RuntimeError where the
-        trials found no bracket."""
-        pos = [t for t in tried if t[1] > 0.0]
-        neg = [t for t in tried if t[1] < 0.0]
-        x, f, s = tried[-1]
-        if not (pos and neg):
-            raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (pull off by "
-                               f"{f:.3g} N after {len(tried) - 1} corrections)")
-        a, b = min(((p, n) for p in pos for n in neg), key=lambda pn: abs(pn[0][0] - pn[1][0]))
-        xtol = 1e-3 * abs(travel) + 1e-12 * abs(x)
-        side = 0
-        for i in range(60):
-            (xa, fa, sa), (xb, fb, sb) = a, b
-            if abs(xa - xb) <= xtol:
-                before, after = (a, b) if (xb - xa) * travel > 0.0 else (b, a)
-                raise Jump(before[2], after[2], f"F1_N = {self.F1:g} N: the pull jumps from "
-                            f"{before[2].F1_N:.4g} to {after[2].F1_N:.4g} N at {name} {xa:.6g}")
-            x = 0.5 * (xa + xb) if i % 3 == 2 else xb - fb * (xb - xa) / (fb - fa)
-            s = at(x)
-            f = s.F1_N - self.F1
-            if abs(f) <= self.tolerance:
-                return s
-            if f > 0.0:
-                a = (x, f, s)
-                b = (xb, 0.5 * fb if side == 1 else fb, sb)
-                side = 1
-            else:
-                b = (x, f, s)
-                a = (xa, 0.5 * fa if side == -1 else fa, sa)
-                side = -1
-        raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (bracket not closed)")
 
     def pull_to_force(self, sealed: Trial, du_m: float, u_min: float) -> Trial | None:
         """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m
