@@ -36,7 +36,8 @@ def model():
 
 def _both(model, mu: float, u_min_m: float):
     route = register()
-    sealed = route.seal(model, {**route.options, "cup": FemCup("A", "coarse", contact=ContactLaw("coulomb", mu))})
+    cup = FemCup("A", "coarse", contact=ContactLaw("coulomb", mu))
+    sealed = route.seal(model, {**route.options, "cup": cup})
     run = lambda walk: equilibrium_branch(sealed.cup, sealed.state, F1, du_m=DEFAULT_DU_M,  # noqa: E731
                                           u_min_m=u_min_m, walk=walk)
     return sealed.cup, run(None), run(FromState)
@@ -53,7 +54,7 @@ def _same_states(cup, b, ref) -> None:
         assert s.seal_r_m == pytest.approx(r.seal_r_m, rel=1e-6)
 
 
-def test_coulomb_corrections_started_from_the_first_trial_find_the_same_states_for_fewer_iterations(model):
+def test_corrections_started_from_the_first_trial_find_the_same_states_in_fewer_iterations(model):
     """mu = 0.5 from the sealed state to u = 4.4 mm (7 states): every state but the first is the
     tangent's trial and one correction; the correction from the branch state takes 4 Newton
     iterations, started from the first trial 0-1."""
@@ -88,13 +89,15 @@ def test_a_started_root_that_contradicts_a_monotone_pull_is_found_again_from_the
     from fem.gas_branch import state_between
 
     route = register()
-    sealed = route.seal(model, {**route.options, "cup": FemCup("A", "coarse", contact=ContactLaw("coulomb", 2.0))})
+    cup = FemCup("A", "coarse", contact=ContactLaw("coulomb", 2.0))
+    sealed = route.seal(model, {**route.options, "cup": cup})
     b = equilibrium_branch(sealed.cup, sealed.state, F1, du_m=DEFAULT_DU_M)
     u = b.column("u_m")
     k = int(np.argmin(np.abs(u - 0.769e-3)))
     assert abs(u[k] - 0.769e-3) < 0.01e-3 and abs(u[k + 1] - 0.525e-3) < 0.01e-3
     mid = state_between(sealed.cup, b.states[k], b.states[k + 1], F1)
     ref = state_between(sealed.cup, b.states[k], b.states[k + 1], F1, walk=FromState)
-    print(f"midway: u = {mid.u_m * 1e3:.6g} mm, N = {mid.N:.8g}; from the state {ref.u_m * 1e3:.6g} mm, {ref.N:.8g}")
+    print(f"midway: u = {mid.u_m * 1e3:.6g} mm, N = {mid.N:.8g}; "
+          f"from the state {ref.u_m * 1e3:.6g} mm, {ref.N:.8g}")
     assert mid.N == pytest.approx(0.5 * (b.states[k].N + b.states[k + 1].N), rel=1e-12)   # N midway
     assert mid.u_m == pytest.approx(ref.u_m, rel=1e-6) and mid.N == pytest.approx(ref.N, rel=1e-9)
