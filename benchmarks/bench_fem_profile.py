@@ -38,6 +38,10 @@ the leak), its CPU time per part as above plus
              the held plate's free block, `fem.free_block`, outside the solver's factorizations);
   setup      building a linear solver (`fem.condensation.make_solver`'s orderings and maps);
 
+the branch walk's solves by kind (an F1 root's first trial, Coulomb's corrections started from
+it, those given up, later trials, moves outside a root) with their Newton
+iterations, and the damped relax_step sub-steps inside them;
+
 and the calls of each, the inclusive CPU time of the route's phases (pressing and sealing, the
 largest holdable force's pull at fixed N, the branch at F1; the rest is the leak along it and the
 states the route adds), the largest pull's Newton iterations per load step, and the CPU time
@@ -182,11 +186,69 @@ def _counted_steps(follow):
     return counted
 
 
+BRANCH: dict[str, list[int]] = {}   # kind of solve of the branch walk -> Newton iterations of each
+BRANCH_KINDS = {"first": "an F1 root's first trial (from the branch state)",
+                "started": "a correction started from the last trial (`Walk._corrects`)",
+                "given up": "a started correction given up and solved from the state",
+                "later": "a later trial, Newton not started by Coulomb's rule (frictionless: from the last "
+                         "trial's response; Coulomb: from the state: secant, regula falsi, second try)",
+                "move": "outside a root: the raise at N0, the moves across jumps",
+                "relax": "relax_step calls inside the walk's solves (damped sub-steps)"}
+
+
+def _count_branch() -> None:
+    """Count the branch walk's solves by kind (BRANCH_KINDS) and their Newton iterations."""
+    import fem.solver
+    walk = fem.branch_walk.Walk
+    solve, root_from, unpredicted, relax = walk.solve, walk._root_from, walk._unpredicted, fem.solver.relax_step
+    ctx = {"depth": 0, "trial": None, "redone": False}
+
+    def counted_solve(self, *args, **kwargs):
+        ctx["depth"] += 1
+        before, t = (self.stats.newton_iterations if self.stats else 0), None
+        try:
+            t = solve(self, *args, **kwargs)
+            return t
+        finally:
+            ctx["depth"] -= 1
+            if ctx["depth"] == 0:
+                its = (self.stats.newton_iterations if self.stats else 0) - before
+                kind = ("move" if ctx["trial"] is None else "given up" if ctx["redone"] else
+                        "started" if t is not None and t.predicted else
+                        "first" if ctx["trial"] == 0 else "later")
+                BRANCH.setdefault(kind, []).append(its)
+                ctx["redone"] = False
+                if ctx["trial"] is not None:
+                    ctx["trial"] += 1
+
+    def counted_root(self, *args, **kwargs):
+        ctx["trial"] = 0
+        try:
+            return root_from(self, *args, **kwargs)
+        finally:
+            ctx["trial"] = None
+
+    def counted_unpredicted(self, *args, **kwargs):
+        ctx["redone"] = True
+        return unpredicted(self, *args, **kwargs)
+
+    def counted_relax(*args, **kwargs):
+        out = relax(*args, **kwargs)
+        if ctx["depth"]:
+            BRANCH.setdefault("relax", []).append(out[3])
+        return out
+    walk.solve, walk._root_from, walk._unpredicted = counted_solve, counted_root, counted_unpredicted
+    fem.solver.relax_step = counted_relax
+
+
 def _instrument_route() -> None:
     """Time the fem route's phases (module docstring), once."""
     import fem.gas_branch
     import fem.gas_pull
     import validation.bridge.fem_route as route
+
+    if hasattr(fem.branch_walk.Walk, "_root_from"):     # (the walk's counts, since the started corrections)
+        _count_branch()
 
     route.FemRoute.seal = _phase("press + seal", route.FemRoute.seal)
     fem.gas_pull.largest_pull_checked = _phase("largest pull", fem.gas_pull.largest_pull_checked)
@@ -243,6 +305,7 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     CLOCK.reset()
     PHASES.clear()
     PULL_STEPS.clear()
+    BRANCH.clear()
     t = time.process_time()
     with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()) as err:
         code = cli(["lifetime", "--route", "fem", "--cup", "A", "--force", f"{force_N:g}", "--fidelity", level]
@@ -259,7 +322,8 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     return {"level": level, "force": force_N, "contact": contact, "cpu": cpu, "lifetime": row[1],
             "reason": row[2], "largest": largest.group(1) if largest else "?",
             "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own,
-            "phases": dict(PHASES), "pull_steps": [list(p) for p in PULL_STEPS]}
+            "phases": dict(PHASES), "pull_steps": [list(p) for p in PULL_STEPS],
+            "branch": {k: list(v) for k, v in BRANCH.items()}}
 
 
 def report_route(r: dict) -> None:
@@ -272,6 +336,12 @@ def report_route(r: dict) -> None:
     pull = r["pull_steps"]
     print(f"  largest pull: {sum(map(len, pull))} load steps, {sum(map(sum, pull))} Newton iterations; per step "
           f"(a path per group): " + " | ".join(" ".join(map(str, p)) for p in pull))
+    if r["branch"]:
+        print("  branch walk (the route's whole: the branch, its refinement): solves / Newton iterations "
+              "(per solve: most common, largest) by kind:")
+        for kind, its in r["branch"].items():
+            common = max(set(its), key=its.count)
+            print(f"    {kind:10} {len(its):4d} / {sum(its):5d} ({common}, {max(its)})  {BRANCH_KINDS[kind]}")
     per = total / r["calls"]["factor"]
     print(f"  per solver factorization (~ per Newton iteration) {1e3 * per:.2f} ms; one factorization of the "
           f"last tangent {1e3 * r['own_factor']:.2f} ms: a Newton iteration costs {per / r['own_factor']:.1f} of them")

@@ -1,12 +1,17 @@
 """The state-to-state machinery of the held branch (`fem.gas_branch`): a trial state reached
 from the last state of the branch with the plate and N on a line, the root of F1(u, N) = F1 in N
 (or in u) by Newton on the exact sensitivities, regula falsi on the bracket its trials found,
-and the jump of the pull where that bracket closes without a root; the plate raised at N0 to F1;
-the fold and the seal's opening located between two states; the branch measured.
+and the jump of the pull where that bracket closes without a root (`fem.branch_root`); the plate
+raised at N0 to F1; the fold and the seal's opening located between two states; the branch
+measured.
 
 The sensitivities dF1/dN and dF1/du are the linear response of a converged state at the held
 plate (`fem.branch_slopes`). With the frictionless law, that response (du/dN, du/du_plate,
-`linear_response`) also gives each trial's first Newton iterate (`Walk._predictor`).
+`linear_response`) also gives each trial's first Newton iterate (`Walk._predictor`). Coulomb's
+trials are solved from the last state of the branch (its anchors are the step's history), and
+the first trial of an F1 root from there as Newton goes; its corrections start from that trial's
+state and stick/slide set, moved by its response (`Walk._corrects`: 0-1 Newton iterations
+instead of 4), and are checked against the step's other solution (`fem.branch_root`).
 """
 
 from __future__ import annotations
@@ -16,15 +21,18 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .contact import ContactState
 from .gas_path import CupWithGas, GasState
 from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
+from .branch_root import Jump, PullRoot, Trial
 from .branch_slopes import linear_response, sensitivities
 from .trapped_gas import GasMechanics, follow_gas_path
 
 __all__ = ["Branch", "Walk", "Trial", "Jump", "STICKING_STEPS", "seal_open", "u_leads"]
 
 STICKING_STEPS = 4  # load steps per move between states for the sticking law (its slips)
+PREDICTED_ITERATIONS = 4  # Newton iterations of a Coulomb trial started from another (`Walk._corrects`)
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,26 +76,7 @@ class _Crossed(ConvergenceError):
     """Stops a trial's path at the first instability it crosses (`Walk.solve`)."""
 
 
-class Jump(RuntimeError):
-    """The pull jumps across F1 between two states close together in N or u (module docstring)."""
-
-    def __init__(self, before: "Trial", after: "Trial", message: str, instability: bool = False):
-        super().__init__(message)
-        self.before, self.after, self.instability = before, after, instability
-
-
-@dataclass(frozen=True, eq=False)
-class Trial:
-    """A converged sealed state before its measurement: plate position, N, pull, solver state."""
-
-    u_m: float
-    N: float
-    F1_N: float
-    step: StepResult
-    crossed: "Trial | None" = None   # the state after the first instability its path crossed
-
-
-class Walk:
+class Walk(PullRoot):
     """The state-to-state machinery of `equilibrium_branch`: solves, the F1 root, the costs."""
 
     def __init__(self, cup: CupWithGas, F1_N: float):
@@ -124,6 +113,10 @@ class Walk:
         self.predict_from: Trial | None = None
         # only a law without a history (frictionless) starts its trials predicted (`_predictor`)
         self.predicts = bool(cup.cup.plane.law.conservative)
+        # Coulomb (incremental: its history is the last state's anchors) predicts only the trials
+        # that correct another trial from the same state (`_corrects`; off in `_root`'s second try)
+        self.incremental = cup.cup.plane.law.name == "coulomb"
+        self.predicting = True
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
         self.tolerance = cup.options.rtol * cup.p_a_Pa * math.pi * rim**2
@@ -153,7 +146,7 @@ class Walk:
         """The state at (u_m, N), reached from `start` with the plate and N on a line; its
         `crossed` is the state after the first instability the path crossed by damped motion
         (a law that `relaxes`), where the path stops while `stop_at_crossing` is set (`_root`)."""
-        stop_at_crossing = self.stop_at_crossing
+        stop_at_crossing, caller_options = self.stop_at_crossing, options
         u0, N0 = start.u_m, start.N
         mech = GasMechanics(self.cup.cup.mech, self.cup.cavity, self.cup._gas(N0),
                             schedule=lambda t: N0 + t * (N - N0), relaxes=True)
@@ -168,16 +161,27 @@ class Walk:
             last.append(step)
             if stop_at_crossing and self.relaxes and step.unstable:
                 raise _Crossed("the path crossed an instability")
+        corrects = self._corrects(start)
+        options = options or self.options
+        if corrects:            # one step, given up early: it is solved again from `start` alone
+            options = replace(options, max_iterations=min(options.max_iterations, PREDICTED_ITERATIONS),
+                              min_step=1.0)
         try:
             stats = follow_gas_path(mech, plate, 1.0, plane=self.cup.cup.plane, start=self._start(start),
-                                    options=options or self.options, on_step=on_step,
+                                    options=options, on_step=on_step,
                                     predict=self._predictor(start, u_m, N))
         except _Crossed as stop:
             stats = stop.stats
         except ConvergenceError as err:         # the cost of a failed trial counts too
             self._count(err.stats)
+            if corrects:
+                return self._unpredicted(start, u_m, N, caller_options)
             raise
         self._count(stats)
+        if corrects and not self._same_set(last):
+            # the set changed (a node landed, one more let go, a slide turned): another solution
+            # of the step may have been found than the one `start` leads to; solved again from it
+            return self._unpredicted(start, u_m, N, caller_options)
 
         def trial(step: StepResult, f: float) -> Trial:
             at_end = f >= 1.0
@@ -185,10 +189,26 @@ class Walk:
                           float(N if at_end else N0 + f * (N - N0)),
                           float(np.sum(step.r_int[2 * top + 1])), step)
         crossed = next((st for st in last if st.unstable), None) if self.relaxes else None
-        end = trial(last[-1], last[-1].t)
+        end = replace(trial(last[-1], last[-1].t), predicted=corrects)
         if crossed is not None:
             return replace(end, crossed=end if crossed is last[-1] else trial(crossed, crossed.t))
         return end
+
+    def _same_set(self, path: list[StepResult]) -> bool:
+        """Whether a predicted trial's path (`_corrects`) ended on its start's stick/slide set
+        (the last trial's) in one stable step."""
+        if len(path) != 2 or path[-1].unstable:
+            return False
+        a, b = path[0].contact, path[-1].contact
+        return bool(np.array_equal(a.active, b.active) and np.array_equal(a.slip, b.slip))
+
+    def _unpredicted(self, start: Trial, u_m: float, N: float, options) -> Trial:
+        """`solve` from `start` alone (no started Newton iterate)."""
+        base, self.predict_from = self.predict_from, None
+        try:
+            return self.solve(start, u_m, N, options)
+        finally:
+            self.predict_from = base
 
     def _solve_from(self, base: Trial, start: Trial, u_m: float, N: float, options=None) -> Trial:
         """`solve` with its Newton starts predicted by `base`'s linear response (`_predictor`)."""
@@ -201,22 +221,45 @@ class Walk:
     def _start(self, start: Trial) -> StepResult:
         """The path's start state: `start`'s, with the contact set of `predict_from` where the law
         carries no history (frictionless: the state does not depend on the path, and the Newton
-        then starts from the predicting state's contact set as from its displacement)."""
+        then starts from the predicting state's contact set as from its displacement); Coulomb's
+        correcting trials (`_corrects`) start from the last trial's stick/slide set with
+        `start`'s anchors (its history)."""
         base = self.predict_from
-        if not self.predicts or base is None or base is start or base not in self.responses:
+        if base is None or base is start or base not in self.responses:
             return start.step
-        return replace(start.step, contact=base.step.contact)
+        if self.predicts:
+            return replace(start.step, contact=base.step.contact)
+        if self._corrects(start):
+            held, set_ = start.step.contact, base.step.contact
+            return replace(start.step, contact=ContactState(set_.active, held.u_r_stick_m, set_.slip))
+        return start.step
+
+    def _corrects(self, start: Trial) -> bool:
+        """Whether a trial of an incremental law (Coulomb) starts from the last trial
+        (`predict_from`, reached from the same `start` to a nearby end, whose linear response is
+        known): its displacement moved by that response, its stick/slide set, `start`'s anchors.
+        Only where the last trial landed no node (it may have let some go): a landing node's
+        anchor (its touchdown) is the path's, not the last trial's. `solve` takes the trial only
+        on that set in one step of at most PREDICTED_ITERATIONS, else solves it again from
+        `start` alone; `_root` checks the roots so found against the others' trials."""
+        base = self.predict_from
+        if not (self.incremental and self.predicting) or base is None or base is start \
+                or base not in self.responses:
+            return False
+        return not np.any(base.step.contact.active & ~start.step.contact.active)
 
     def _predictor(self, start: Trial, u_m: float, N: float):
         """Each load step's first Newton iterate on the line from `start` to (u_m, N): the linear
         response of `predict_from` (a state whose slopes are known, e.g. the last trial of an F1
         root) to the change of plate and N, from that state for the first step and from the last
         converged one after it; None (Newton from the last converged state) without one, and for
-        a law with a history (sticking, Coulomb): there the iterate picks among the stick/slide
-        sets, and a predicted start moved a lifetime by more than the step error, and cost more."""
+        a law with a history (sticking, Coulomb) from `start` itself: there the iterate picks
+        among the stick/slide sets, and a predicted start moved a lifetime by more than the step
+        error, and cost more. Coulomb's corrections of a trial start from that trial
+        (`_corrects`): the same step's solution nearby, on its set."""
         base = self.predict_from
         response = self.responses.get(base) if base is not None else None
-        if response is None or not self.predicts:
+        if response is None or not (self.predicts or self._corrects(start)):
             return None
         x_N, x_u = response
         u0, N0 = start.u_m, start.N
@@ -231,87 +274,6 @@ class Walk:
     def _count(self, stats: SolverStats | None) -> None:
         if stats is not None:
             self.stats = stats if self.stats is None else _joined(self.stats, stats)
-
-    def hold(self, prev: Trial, u_m: float, N_guess: float) -> Trial:
-        """The state at plate position u_m whose pull is F1 (N by Newton on F1(N), module
-        docstring), reached from prev. Raises `Jump` where F1(N) jumps across F1."""
-        return self._root(prev, u_m, N_guess, 0)
-
-    def hold_u(self, prev: Trial, u_guess: float, N: float) -> Trial:
-        """The state at N whose pull is F1 (the plate position by Newton on F1(u)), reached
-        from prev. Raises `Jump` where F1(u) jumps across F1."""
-        return self._root(prev, u_guess, N, 1)
-
-    def _root(self, prev: Trial, u_m: float, N: float, k: int) -> Trial:
-        """F1(x) = F1 for x = N at the plate u_m (k = 0) or x = u at N (k = 1), every trial
-        reached from prev: Newton with the exact dF1/dx, the secant where it does not halve the
-        mismatch; where that fails, regula falsi on the bracket its trials found (`_bracket`)."""
-        name = "N" if k == 0 else "the plate position"
-
-        def at(x, base=prev):
-            self.stop_at_crossing, self.predict_from = True, base
-            try:
-                s = self.solve(prev, u_m, x, self.trial_options) if k == 0 else \
-                    self.solve(prev, x, N, self.trial_options)
-            finally:
-                self.stop_at_crossing, self.predict_from = False, None
-            if s.crossed is not None:       # the cup meets an instability on the way: it jumps
-                raise Jump(prev, s.crossed, f"F1_N = {self.F1:g} N: an instability (a slip) "
-                            f"crossed on the way to {name} {x:.6g}", instability=True)
-            return s
-        x0, x_prev = (N, prev.N) if k == 0 else (u_m, prev.u_m)
-        s = at(x0)
-        tried: list[tuple[float, float, Trial]] = [(x0, s.F1_N - self.F1, s)]
-        for _ in range(12):
-            miss = s.F1_N - self.F1
-            if abs(miss) <= self.tolerance:
-                return s
-            x_new = tried[-1][0] - miss / self.derivatives(s)[k]
-            if len(tried) >= 2 and abs(miss) > 0.1 * abs(tried[-2][1]):   # slow: secant
-                (xa, fa, _), (xb, fb, _) = tried[-2:]
-                if fb != fa:
-                    x_new = xb - fb * (xb - xa) / (fb - fa)
-            if k == 0 and not x_new > 0.0:
-                break
-            s = at(x_new, s)
-            tried.append((x_new, s.F1_N - self.F1, s))
-        return self._bracket(at, tried, x0 - x_prev, name)
-
-    def _bracket(self, at, tried, travel: float, name: str) -> Trial:
-        """The root of F1(x) = F1 on the closest bracket among the trials (Illinois regula
-        falsi, every third trial a bisection). Where the bracket closes to 1e-3 of the trial's
-        move from the previous state without a root, F1 jumps across F1 there (a slip of the
-        sticking law, a snap): `Jump` with the states on both sides. RuntimeError where the
-        trials found no bracket."""
-        pos = [t for t in tried if t[1] > 0.0]
-        neg = [t for t in tried if t[1] < 0.0]
-        x, f, s = tried[-1]
-        if not (pos and neg):
-            raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (pull off by "
-                               f"{f:.3g} N after {len(tried) - 1} corrections)")
-        a, b = min(((p, n) for p in pos for n in neg), key=lambda pn: abs(pn[0][0] - pn[1][0]))
-        xtol = 1e-3 * abs(travel) + 1e-12 * abs(x)
-        side = 0
-        for i in range(60):
-            (xa, fa, sa), (xb, fb, sb) = a, b
-            if abs(xa - xb) <= xtol:
-                before, after = (a, b) if (xb - xa) * travel > 0.0 else (b, a)
-                raise Jump(before[2], after[2], f"F1_N = {self.F1:g} N: the pull jumps from "
-                            f"{before[2].F1_N:.4g} to {after[2].F1_N:.4g} N at {name} {xa:.6g}")
-            x = 0.5 * (xa + xb) if i % 3 == 2 else xb - fb * (xb - xa) / (fb - fa)
-            s = at(x)
-            f = s.F1_N - self.F1
-            if abs(f) <= self.tolerance:
-                return s
-            if f > 0.0:
-                a = (x, f, s)
-                b = (xb, 0.5 * fb if side == 1 else fb, sb)
-                side = 1
-            else:
-                b = (x, f, s)
-                a = (xa, 0.5 * fa if side == -1 else fa, sa)
-                side = -1
-        raise RuntimeError(f"F1_N = {self.F1:g} N: {name} not found at {x:.6g} (bracket not closed)")
 
     def pull_to_force(self, sealed: Trial, du_m: float, u_min: float) -> Trial | None:
         """Raise the plate at fixed N from `sealed` until the pull is F1: steps up of at most du_m

@@ -18,7 +18,8 @@ derivative dF1/dN is exact for the state's contact set: the linear response of t
 to dN at the held plate, solved with the rank-one gas tangent (`fem.trapped_gas`), the held
 contact dofs fixed and Coulomb's sliding nodes sliding (`pull_sensitivities`). Every trial N is
 reached from the previous state of the branch (not from the last trial: with friction a trial's
-back-and-forth would enter the history); a secant step takes over when the tangent's step does
+back-and-forth would enter the history; Coulomb's corrections only start their Newton iteration
+at the last trial's state, `fem.branch_walk`); a secant step takes over when the tangent's step does
 not reduce the mismatch tenfold (the contact set changed in between), and regula falsi on the
 bracket of the trials where neither converges. A bordered Newton (N an unknown of the solver's
 Newton iteration beside u) would need the solver's Newton step and line search (`fem.newton`)
