@@ -115,7 +115,7 @@ class Walk(PullRoot):
         self.predicts = bool(cup.cup.plane.law.conservative)
         # Coulomb (incremental: its history is the last state's anchors) predicts only the trials
         # that correct another trial from the same state (`_corrects`; off in `_root`'s second try)
-        self.incremental = cup.cup.plane.law.name == "coulomb"
+        self.incremental = cup.cup.plane.law.incremental
         self.predicting = True
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]

@@ -80,6 +80,7 @@ class PlaneLaw(Protocol):
     mu: float                       # Coulomb's coefficient (0 but for coulomb)
     conservative: ClassVar[bool]    # the total energy is the path's potential
     anchored: ClassVar[bool]        # held nodes keep their radial anchor
+    incremental: ClassVar[bool]     # the anchors move to the converged state at every commit (Coulomb)
 
     def step(self, plane: "RigidPlane", state: ContactState, u: np.ndarray, res: np.ndarray,
              free: np.ndarray, du_fixed: np.ndarray, tol: float, friction: np.ndarray) -> Any:

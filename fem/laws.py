@@ -35,6 +35,7 @@ class Frictionless:
     conservative: ClassVar[bool] = True     # the total energy is the path's potential
     anchored: ClassVar[bool] = False        # held nodes keep their radial anchor
     relaxes: ClassVar[bool] = False         # instabilities crossed by damped motion (`fem.newton.relax_step`)
+    incremental: ClassVar[bool] = False     # its anchors move to the converged state at every commit
     mu: ClassVar[float] = 0.0
 
     @property
@@ -79,6 +80,7 @@ class Coulomb:
     conservative: ClassVar[bool] = False
     anchored: ClassVar[bool] = True
     relaxes: ClassVar[bool] = True          # its slip across an instability is integrated in increments
+    incremental: ClassVar[bool] = True      # its anchors move to the converged state at every commit
 
     def __post_init__(self) -> None:
         ContactLaw(self.name, self.mu)          # the one check of mu
