@@ -46,9 +46,9 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
     A law without a history (frictionless: the state at a plate position does not depend on the
     steps that led there) is scouted with double steps and the single steps filled in around the
     maximum only (`_Pull.scouted`); a pull the scout finds irregular is followed in single steps.
-    A law with a history (Coulomb, sticking) is followed in double steps while its pull rises in
-    easy steps, and in single steps from the last double step but one on (`_Pull.resumed`): its
-    path then depends on the steps, within the single steps' own step-refinement error."""
+    A law with a history (Coulomb, sticking) takes double steps only where no node lands, sticks
+    again or turns (`_Pull.resumed`): the end of such a step solves the same problem whatever
+    the steps between, so the states are the single steps' to Newton's tolerance."""
     pull = _Pull(cup, sealed, drop)
     if cup.cup.plane.law.conservative:
         found = pull.scouted()
