@@ -44,7 +44,8 @@ iterations, and the damped relax_step sub-steps inside them;
 
 and the calls of each, the inclusive CPU time of the route's phases (pressing and sealing, the
 largest holdable force's pull at fixed N, the branch at F1; the rest is the leak along it and the
-states the route adds), the largest pull's Newton iterations per load step, and the CPU time
+states the route adds), the largest pull's Newton iterations per load step (its maximum's state,
+the states and iterations before and past it, its slips and failed Newton steps), and the CPU time
 per solver factorization (each Newton iteration factors once; a shifted retry or a freed contact
 node adds one) against one factorization of the last tangent the route factored.
 With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
