@@ -60,8 +60,8 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
 
 class _OffGrid(Exception):
     """Stops a scout whose path left the grid of single steps (a cut-back, the floor's last
-    step) or slipped; a rising scout (`_Pull.resumed`) also where its pull stops rising or a
-    step is hard."""
+    step) or slipped; in `_Pull.resumed`, also at a double step that is not `_easy`."""
+
 
 class _Easy(Exception):
     """Stops single steps that may go on in double steps (`_Pull.resumed`)."""
@@ -199,7 +199,8 @@ class _Pull:
         no history the steps decide) for as long as each double step is easy too. A double step
         that is not is redone in single steps from its start, or from the start of the double
         step before where the pull fell, so that every maximum and the stop are found in single
-        steps."""
+        steps; single steps follow to the stop (double steps once per pull: the contact test is
+        not a proof, and taken again after later easy pairs they were mostly rejected)."""
         if not self.uniform:
             return self.follow(1)
         try:
