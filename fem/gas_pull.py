@@ -154,7 +154,8 @@ class _Pull:
         # fractions of the rest of the way that are the steps (in u) of the whole way
         o, f = self.options, self.span / (self.span - t0) if t0 > 0 else 1.0
         options = o if f == 1.0 else replace(o, initial_step=min(1.0, f * o.initial_step),
-                                             max_step=min(1.0, f * o.max_step), min_step=f * o.min_step,
+                                             max_step=min(1.0, f * o.max_step),
+                                             min_step=min(1.0, f * o.min_step),
                                              jump_min_step=min(1.0, f * o.jump_min_step))
         if stride > 1:
             size = min(1.0, stride * options.max_step)
