@@ -44,7 +44,8 @@ iterations, and the damped relax_step sub-steps inside them;
 
 and the calls of each, the inclusive CPU time of the route's phases (pressing and sealing, the
 largest holdable force's pull at fixed N, the branch at F1; the rest is the leak along it and the
-states the route adds), the largest pull's Newton iterations per load step, and the CPU time
+states the route adds), the largest pull's Newton iterations per load step (its maximum's state,
+the states and iterations before and past it, its slips and failed Newton steps), and the CPU time
 per solver factorization (each Newton iteration factors once; a shifted retry or a freed contact
 node adds one) against one factorization of the last tangent the route factored.
 With --whole, also the whole process `cupcheck stiffness --cup A --fidelity LEVEL` (median of
@@ -168,6 +169,25 @@ def _phase(name: str, fn):
 
 
 PULL_STEPS: list[list[int]] = []
+PULL_STATES: list[tuple[float, float, int, int]] = []   # (rise of the plate [m], F1 [N], Newton iterations, path);
+#                                                          the first: the sealed plate's position [m] and pull
+PULL_CUTS = [0]                                      # the largest pull's failed Newton steps (cut-backs)
+
+
+def _count_cutbacks() -> None:
+    """Count the Newton steps that fail inside the largest pull's paths (each one a cut-back or a
+    relax_step's retry)."""
+    import fem.solver
+    newton_step = fem.solver.newton_step
+
+    def counted(*args, **kwargs):
+        try:
+            return newton_step(*args, **kwargs)
+        except Exception:
+            if PHASES.get("_in pull"):
+                PULL_CUTS[0] += 1
+            raise
+    fem.solver.newton_step = counted
 
 
 def _counted_steps(follow):
@@ -178,9 +198,17 @@ def _counted_steps(follow):
         its = []
         PULL_STEPS.append(its)
 
+        dofs, z = args[1](0.0)
+        lift = dofs[dofs.size // 2:]           # the plate's vertical dofs: its rise and pull
+        if not PULL_STATES:          # the sealed state: its plate position and pull
+            PULL_STATES.append((float(z[-1]), float(np.sum(kwargs["start"].r_int[lift])), 0, 0))
+        z0 = PULL_STATES[0][0]
+
         def step(s):
             if s.t > 0:
                 its.append(s.iterations)
+                PULL_STATES.append((float(args[1](s.t)[1][-1] - z0), float(np.sum(s.r_int[lift])),
+                                    s.iterations, len(PULL_STEPS)))
             on_step(s)
         return follow(*args, on_step=step, **kwargs)
     return counted
@@ -251,7 +279,16 @@ def _instrument_route() -> None:
         _count_branch()
 
     route.FemRoute.seal = _phase("press + seal", route.FemRoute.seal)
-    fem.gas_pull.largest_pull_checked = _phase("largest pull", fem.gas_pull.largest_pull_checked)
+    largest = _phase("largest pull", fem.gas_pull.largest_pull_checked)
+
+    def flagged(*args, **kwargs):
+        PHASES["_in pull"] = 1.0
+        try:
+            return largest(*args, **kwargs)
+        finally:
+            PHASES.pop("_in pull")
+    fem.gas_pull.largest_pull_checked = functools.wraps(largest)(flagged)
+    _count_cutbacks()
     fem.gas_pull.follow_gas_path = _counted_steps(fem.gas_pull.follow_gas_path)
     fem.gas_branch.equilibrium_branch = _phase("branch", fem.gas_branch.equilibrium_branch)
 
@@ -305,6 +342,8 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
     CLOCK.reset()
     PHASES.clear()
     PULL_STEPS.clear()
+    PULL_STATES.clear()
+    PULL_CUTS[0] = 0
     BRANCH.clear()
     t = time.process_time()
     with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()) as err:
@@ -323,6 +362,7 @@ def profile_route(level: str, force_N: float, contact: str = "frictionless") -> 
             "reason": row[2], "largest": largest.group(1) if largest else "?",
             "parts": dict(CLOCK.time), "calls": dict(CLOCK.calls), "own_factor": own,
             "phases": dict(PHASES), "pull_steps": [list(p) for p in PULL_STEPS],
+            "pull_states": list(PULL_STATES), "pull_cuts": PULL_CUTS[0],
             "branch": {k: list(v) for k, v in BRANCH.items()}}
 
 
@@ -336,6 +376,7 @@ def report_route(r: dict) -> None:
     pull = r["pull_steps"]
     print(f"  largest pull: {sum(map(len, pull))} load steps, {sum(map(sum, pull))} Newton iterations; per step "
           f"(a path per group): " + " | ".join(" ".join(map(str, p)) for p in pull))
+    _report_pull(r)
     if r["branch"]:
         print("  branch walk (the route's whole: the branch, its refinement): solves / Newton iterations "
               "(per solve: most common, largest) by kind:")
@@ -351,6 +392,21 @@ def report_route(r: dict) -> None:
         calls = r["calls"].get(part, 0)
         per_call = f"{1e3 * t / calls:11.3f}" if calls else f"{'':11}"
         print(f"  {part:9} {t:7.3f} {t / total:6.1%} {calls:6d} {per_call}")
+
+
+def _report_pull(r: dict) -> None:
+    """Where the largest pull's Newton iterations go: the states before its maximum and past it
+    (the search goes on until the pull has fallen by 2 % since the last slip), the slips (a fall of
+    more than 2 % of the largest pull in one step) and the failed Newton steps."""
+    states = sorted(r["pull_states"][1:])      # by the plate's rise (a scout's filled steps in their place)
+    if not states:
+        return
+    F, its = [s[1] for s in states], [s[2] for s in states]
+    k = int(np.argmax(F))
+    slips = sum(1 for a, b in zip(F, F[1:]) if a - b > 0.02 * F[k])
+    print(f"    its maximum {F[k]:.4f} N at state {k + 1} of {len(F)} (the plate {1e3 * states[k][0]:.3f} mm above "
+          f"the sealed one); before it {k + 1} states / {sum(its[:k + 1])} Newton iterations, past it "
+          f"{len(F) - k - 1} / {sum(its[k + 1:])}; {slips} slips; {r['pull_cuts']} failed Newton steps")
 
 
 def whole_process(level: str, contact: str, repeat: int) -> tuple[float, float]:

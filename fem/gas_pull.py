@@ -45,18 +45,50 @@ def largest_pull_checked(cup: CupWithGas, sealed: GasState, drop: float = 0.02) 
     was still rising (the maximum not reached: a lower bound only), why; else None.
     A law without a history (frictionless: the state at a plate position does not depend on the
     steps that led there) is scouted with double steps and the single steps filled in around the
-    maximum only (`_Pull.scouted`); a pull the scout finds irregular is followed in single steps."""
+    maximum only (`_Pull.scouted`); a pull the scout finds irregular is followed in single steps.
+    A law with a history (Coulomb, sticking) takes double steps only where no node lands, sticks
+    again or turns (`_Pull.resumed`): the end of such a step solves the same problem whatever
+    the steps between, so the states are the single steps' to Newton's tolerance."""
     pull = _Pull(cup, sealed, drop)
     if cup.cup.plane.law.conservative:
         found = pull.scouted()
         if found is not None:
             return found
-    return pull.largest(*pull.follow(1))
+        return pull.largest(*pull.follow(1))
+    return pull.largest(*pull.resumed())
 
 
 class _OffGrid(Exception):
     """Stops a scout whose path left the grid of single steps (a cut-back, the floor's last
-    step) or slipped."""
+    step) or slipped; in `_Pull.resumed`, also at a double step that is not `_easy`."""
+
+
+class _Easy(Exception):
+    """Stops single steps that may go on in double steps (`_Pull.resumed`)."""
+
+
+#: an easy step's largest Newton iterations, and the easy single steps in a row before double
+#: steps are taken (`_Pull.resumed`)
+EASY_ITERATIONS, EASY_STEPS = 4, 2
+
+
+def _easy(before: tuple[float, float, Any], F1: float, step) -> bool:
+    """Whether a step from the state `before` (t, F1, state) to `step` (its pull F1) could have
+    been one of two: the pull rises, Newton took at most EASY_ITERATIONS iterations, and the
+    contact leaves no history that the steps decide (`_history_free`)."""
+    return F1 > before[1] and step.iterations <= EASY_ITERATIONS and \
+        _history_free(before[2].contact, step.contact)
+
+
+def _history_free(a, b) -> bool:
+    """Whether the step from contact state a to b leaves no history that its steps decide: no
+    node lands (its anchor is where it touches down) and no sliding node sticks again or turns
+    (its anchor is where that step starts); nodes may start to slide and leave the plane. The
+    end state then solves the same problem whatever the steps between (`fem.contact.ContactState`)."""
+    if a is None or b is None:
+        return a is b
+    held = a.active & b.active
+    return not (np.any(b.active & ~a.active) or np.any(held & (a.slip != 0) & (b.slip != a.slip)))
 
 
 class _Pull:
@@ -84,17 +116,29 @@ class _Pull:
     def pull_N(self, step) -> float:
         return float(np.sum(step.r_int[2 * self.top + 1]))
 
-    def follow(self, stride: int) -> tuple[list[tuple[float, float, Any]], str | None]:
+    def follow(self, stride: int, prefix: list | None = None,
+               switch: bool = False) -> tuple[list[tuple[float, float, Any]], str | None]:
         """The states (t, F1, state) along the path in steps of `stride` dt up to the stop
         (`largest_pull`), and the solver's message where it stopped; stride > 1 raises `_OffGrid`
-        at a step off the grid or a slip."""
-        drop, seen = self.drop, [(0.0, self.sealed.F1_N, self.sealed.state)]
-        since_slip = [self.sealed.F1_N]              # the pulls since the last slip
+        at a step off the grid or a slip. prefix: the states followed before; the path goes on
+        from the last (default: the sealed state). With `switch` (`resumed`), a double step
+        whose step is not `_easy` raises `_OffGrid`, and single steps raise `_Easy` after
+        EASY_STEPS easy ones in a row (the states so far in self.seen, in both)."""
+        drop = self.drop
+        seen = self.seen = list(prefix or [(0.0, self.sealed.F1_N, self.sealed.state)])
+        since_slip = self.since_slip([s[1] for s in seen])   # the pulls since the last slip
+        t0, start, easy = seen[-1][0], seen[-1][2], [0]
 
         def on_step(step) -> None:
-            F1 = self.pull_N(step)
-            if stride > 1 and step.t > 0 and abs(step.t - seen[-1][0] - stride * self.dt) > 1e-9 * self.dt:
+            if prefix and step.t == 0:                   # the start: seen already
+                return
+            t, F1 = t0 + step.t, self.pull_N(step)
+            if stride > 1 and step.t > 0 and abs(t - seen[-1][0] - stride * self.dt) > 1e-9 * self.dt:
                 raise _OffGrid
+            if switch and step.t > 0:
+                easy[0] = easy[0] + 1 if _easy(seen[-1], F1, step) else 0
+                if stride > 1 and not easy[0]:
+                    raise _OffGrid(F1 <= seen[-1][1])          # (whether the pull fell)
             best = max(since_slip)
             if best > 0 and seen[-1][1] - F1 > drop * best:    # fell by more than drop in one step: a slip
                 if stride > 1:
@@ -102,20 +146,39 @@ class _Pull:
                 since_slip[:] = [F1]
             else:
                 since_slip.append(F1)
-            seen.append((step.t, F1, step))
+            seen.append((t, F1, step))
             if best > 0 and len(since_slip) > 1 and F1 < (1.0 - drop) * max(since_slip):
                 raise _Past
-        size = stride * self.options.max_step
-        options = self.options if stride == 1 else replace(self.options, initial_step=size, max_step=size)
+            if switch and stride == 1 and easy[0] >= EASY_STEPS:
+                raise _Easy
+        # fractions of the rest of the way that are the steps (in u) of the whole way
+        o, f = self.options, self.span / (self.span - t0) if t0 > 0 else 1.0
+        options = o if f == 1.0 else replace(o, initial_step=min(1.0, f * o.initial_step),
+                                             max_step=min(1.0, f * o.max_step),
+                                             min_step=min(1.0, f * o.min_step),
+                                             jump_min_step=min(1.0, f * o.jump_min_step))
+        if stride > 1:
+            size = min(1.0, stride * options.max_step)
+            options = replace(options, initial_step=size, max_step=size)
         stopped = None
         try:
-            follow_gas_path(self.mech, self.plate(0.0), self.span, plane=self.cup.cup.plane,
-                            start=self.sealed.state, options=options, on_step=on_step)
+            follow_gas_path(self.mech, self.plate(t0), self.span - t0, plane=self.cup.cup.plane,
+                            start=start, options=options, on_step=on_step)
         except _Past:
             pass
         except ConvergenceError as err:
             stopped = str(err)
         return seen, stopped
+
+    def since_slip(self, pulls: list[float]) -> list[float]:
+        """The pulls since the last slip among `pulls` (`follow`'s rule)."""
+        since = pulls[:1]
+        for before, F1 in zip(pulls, pulls[1:]):
+            if max(since) > 0 and before - F1 > self.drop * max(since):
+                since = [F1]
+            else:
+                since.append(F1)
+        return since
 
     def largest(self, seen, stopped: str | None) -> tuple[float, str | None]:
         """The largest pull over `seen` refined by the parabola through the three states around
@@ -130,6 +193,27 @@ class _Pull:
             if a < 0:
                 return float(max(F[k], c - b * b / (4 * a))), partial
         return float(F[k]), partial
+
+    def resumed(self) -> tuple[list[tuple[float, float, Any]], str | None]:
+        """`follow`'s states of a law with a history: single steps, and double steps after
+        EASY_STEPS easy single steps in a row (`_easy`: the pull rising, few Newton iterations,
+        no history the steps decide) for as long as each double step is easy too. A double step
+        that is not is redone in single steps from its start, or from the start of the double
+        step before where the pull fell, so that every maximum and the stop are found in single
+        steps; single steps follow to the stop (double steps once per pull: the contact test is
+        not a proof, and taken again after later easy pairs they were mostly rejected)."""
+        if not self.uniform:
+            return self.follow(1)
+        try:
+            return self.follow(1, switch=True)
+        except _Easy:
+            seen = self.seen
+        try:
+            seen, stopped = self.follow(2, seen, switch=True)    # ended: the floor or the solver's stop
+            return self.follow(1, seen[:-1])
+        except _OffGrid as off:
+            fell = off.args and off.args[0] and len(self.seen) > 2
+            return self.follow(1, self.seen[:-1] if fell else self.seen)
 
     def scouted(self) -> tuple[float, str | None] | None:
         """The largest pull from double steps, the single steps between them filled in next to

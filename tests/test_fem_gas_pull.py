@@ -1,8 +1,10 @@
 """The largest pull of a frictionless cup scouted with double steps (`fem.gas_pull`) against the
-same pull followed in single steps all the way: the same maximum, in fewer Newton iterations."""
+same pull followed in single steps all the way: the same maximum, in fewer Newton iterations; and
+Coulomb's pull in double steps where the contact makes no history (`fem.gas_pull._Pull.resumed`)."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import fem.gas_pull as gas_pull
@@ -40,3 +42,39 @@ def test_the_scouted_pull_is_the_single_step_pull(sealed, monkeypatch):
     assert why is None and why2 is None
     assert scouted == pytest.approx(single, rel=1e-7)
     assert scouted_its < 0.8 * single_its
+
+
+@pytest.fixture(scope="module")
+def sealed_coulomb():
+    cup = FemCup("A", "coarse", contact=ContactLaw("coulomb", 0.5)).build(293.15, 1e5)
+    return cup, cup.press_to(r_start_m=CUPS["A"].r_start_m)[-1]
+
+
+def test_a_coulomb_pull_in_double_steps_where_no_history_is_made_is_the_single_step_pull(sealed_coulomb,
+                                                                                           monkeypatch):
+    """Coulomb 0.5, coarse: the pull taken in double steps where no node lands, sticks again or
+    turns (`_Pull.resumed`) reaches the same states as single steps all the way (its maximum to
+    Newton's tolerance, not the ~2e-6 by which halving the steps moves it), in under 80 % of the
+    Newton iterations (192 against 253)."""
+    cup, state = sealed_coulomb
+    pull = gas_pull._Pull(cup, state, 0.02)
+    (single, why), single_its = _counted(monkeypatch, lambda: pull.largest(*pull.follow(1)))
+    (resumed, why2), resumed_its = _counted(monkeypatch, lambda: gas_pull.largest_pull_checked(cup, state))
+    print(single, resumed, single_its, resumed_its)
+    assert why is None and why2 is None
+    assert resumed == pytest.approx(single, rel=1e-9)
+    assert resumed_its < 0.8 * single_its
+
+
+def test_a_double_step_that_lands_or_resticks_a_node_makes_history():
+    """`_history_free`: nodes may start to slide or leave the plane; a landing node, a sliding
+    node that sticks again or turns makes a history the steps decide."""
+    from fem.contact import ContactState
+
+    def state(active, slip):
+        return ContactState(np.array(active, bool), np.zeros(len(active)), np.array(slip, np.int8))
+    a = state([1, 1, 1, 0], [0, -1, -1, 0])
+    assert gas_pull._history_free(a, state([1, 1, 0, 0], [-1, -1, 0, 0]))     # slides, leaves
+    assert not gas_pull._history_free(a, state([1, 1, 1, 1], [0, -1, -1, 0]))  # lands
+    assert not gas_pull._history_free(a, state([1, 1, 1, 0], [0, 0, -1, 0]))   # sticks again
+    assert not gas_pull._history_free(a, state([1, 1, 1, 0], [0, 1, -1, 0]))   # turns
