@@ -89,8 +89,11 @@ class Walk(PullRoot):
         # of its move is given up (the walk shortens its step) rather than ground through
         self.trial_options = replace(self.options, min_step=max(cup.options.min_step, 1.0 / 16.0),
                                      max_iterations=min(cup.options.max_iterations, 40))
-        if cup.cup.plane.law.name == "sticking":
-            # its slips land where the load step puts them: every move in STICKING_STEPS steps
+        law = cup.cup.plane.law
+        # a law anchored where its nodes touched down (sticking: anchored, not incremental): its
+        # slips land where the load step puts them, every move in STICKING_STEPS steps
+        touchdown = law.anchored and not law.incremental
+        if touchdown:
             self.options = replace(self.options, initial_step=1.0 / STICKING_STEPS,
                                    max_step=1.0 / STICKING_STEPS)
             self.trial_options = replace(self.trial_options, initial_step=1.0 / STICKING_STEPS,
@@ -105,7 +108,7 @@ class Walk(PullRoot):
         # crosses one has jumped (the state after it is the jump's far side, `_root`)
         self.relaxes = bool(getattr(cup.cup.plane.law, "relaxes", False))
         self.stop_at_crossing = False
-        self.staircase = cup.cup.plane.law.name == "sticking"
+        self.staircase = touchdown
         self.slopes: dict[Trial, tuple[float, float]] = {}     # by identity
         # the linear response (du/dN, du/du_plate) of the states whose slopes are known, and the
         # state whose response predicts the next solve's Newton start (`solve`)
@@ -115,7 +118,7 @@ class Walk(PullRoot):
         self.predicts = bool(cup.cup.plane.law.conservative)
         # Coulomb (incremental: its history is the last state's anchors) predicts only the trials
         # that correct another trial from the same state (`_corrects`; off in `_root`'s second try)
-        self.incremental = cup.cup.plane.law.incremental
+        self.incremental = law.incremental
         self.predicting = True
         rim = cup.mesh.doflocs[0, cup.cavity.nodes[-1]]
         # |F1 - F1_N| accepted: rtol of the largest suction force on the cup, p_a pi r_rim^2 [N]
