@@ -13,7 +13,6 @@ Each change is (mesh node, position along the cavity chain or -1 off it, on/off,
 from __future__ import annotations
 
 import argparse
-import math
 
 import numpy as np
 

@@ -26,7 +26,7 @@ from .gas_path import CupWithGas, GasState
 from .solver import ConvergenceError, SolverStats, StepResult
 from .cup import _joined
 from .branch_root import Jump, PullRoot, Trial
-from .branch_slopes import linear_response, sensitivities
+from .branch_slopes import linear_response
 from .trapped_gas import GasMechanics, follow_gas_path
 
 __all__ = ["Branch", "Walk", "Trial", "Jump", "STICKING_STEPS", "seal_open", "u_leads"]
